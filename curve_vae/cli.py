@@ -1,0 +1,339 @@
+"""`curve-vae` command line: dataset, train, export, evaluate, serve.
+
+Each subcommand imports what it needs when it runs, so `curve-vae serve` works in the
+base install (no torch).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import fields
+from pathlib import Path
+from typing import Any
+
+DEFAULT_DATA = "data/curves.npz"
+DEFAULT_MODELS = "models"
+FRESH_TEST_SEED = 7919  # the second test set: a seed no training or model selection uses
+
+
+def _add_data_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("data set (paper §3.1)")
+    g.add_argument(
+        "--data",
+        default=DEFAULT_DATA,
+        help=f"data set cache file; generated if missing or made with other parameters (default: {DEFAULT_DATA})",
+    )
+    g.add_argument("--n-train", type=int, default=70_000, help="training curves (default: 70000)")
+    g.add_argument("--n-val", type=int, default=2_000, help="validation curves (default: 2000)")
+    g.add_argument("--n-test", type=int, default=1_000, help="test curves (default: 1000)")
+    g.add_argument("--data-seed", type=int, default=0, help="seed of the data set (default: 0)")
+
+
+def _data_config(a: argparse.Namespace):
+    from training.data import DataConfig
+
+    return DataConfig(n_train=a.n_train, n_val=a.n_val, n_test=a.n_test, seed=a.data_seed)
+
+
+# ------------------------------------------------------------------------------ dataset
+
+
+def cmd_dataset(a: argparse.Namespace) -> int:
+    import time
+
+    import numpy as np
+
+    from training.data import load_or_generate
+    from training.evaluate import _plt, _save
+
+    t = time.perf_counter()
+    ds = load_or_generate(_data_config(a), a.data)
+    dt = time.perf_counter() - t
+    print(
+        f"{a.data}: train {ds.train.shape}, val {ds.val.shape}, test {ds.test.shape} "
+        f"in {dt:.1f} s; coordinates in [{ds.train.min():.1f}, {ds.train.max():.1f}]"
+    )
+    if a.preview:
+        plt = _plt()
+        fig, axes = plt.subplots(3, 6, figsize=(13, 6.5))
+        for ax, c in zip(axes.flat, ds.train[:18]):
+            ax.plot(*c.T, lw=1)
+            ax.plot(*c[0], "go", ms=3)
+            ax.set_xlim(0, 128)
+            ax.set_ylim(0, 128)
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+        fig.suptitle("training curves (green: first point)")
+        _save(fig, Path(a.preview))
+        print(f"preview: {a.preview}")
+    del np
+    return 0
+
+
+# -------------------------------------------------------------------------------- train
+
+
+def _add_train_options(p: argparse.ArgumentParser) -> None:
+    from training.config import SCHEDULES, VARIANTS, TrainConfig
+
+    g = p.add_argument_group("model (paper §3.5)")
+    g.add_argument(
+        "--variant",
+        default="inception",
+        help=f"architecture: {', '.join(VARIANTS)} "
+        "(cnn6 = inception, the paper's model; cnn1…cnn5: Table 1's ablations) (default: inception)",
+    )
+    g.add_argument("--latent-dim", type=int, default=32, help="latent size, paper Table 2 (default: 32)")
+    d = TrainConfig()
+    g = p.add_argument_group("training")
+    helps = {
+        "epochs": "epochs (passes over the training curves)",
+        "batch_size": "global batch size, split across DDP processes",
+        "lr": "Adam learning rate; the peak rate of the onecycle schedule",
+        "schedule": f"learning-rate schedule: {' | '.join(SCHEDULES)}",
+        "warmup": "onecycle: fraction of the steps spent warming up",
+        "beta": "weight of the KL term",
+        "lap_weight": "weight of the Laplacian smoothness term (0: off)",
+        "grad_clip": "clip the gradient norm to this (0: off)",
+        "patience": "early stopping: epochs without a better validation MSE (0: off)",
+        "bf16": "bf16 autocast (fast only with AMX/AVX512-BF16 CPUs or GPUs)",
+        "compile": "torch.compile the model",
+        "seed": "seed of initialisation, batch order and sampling noise",
+        "threads": "torch CPU threads (0: torch's default)",
+        "device": "auto | cpu | cuda",
+        "train_limit": "use only the first N training curves (0: all)",
+    }
+    for f in fields(TrainConfig):
+        flag = "--" + f.name.replace("_", "-")
+        default = getattr(d, f.name)
+        if isinstance(default, bool):
+            g.add_argument(
+                flag,
+                action=argparse.BooleanOptionalAction,
+                default=default,
+                help=f"{helps[f.name]} (default: {default})",
+            )
+        else:
+            g.add_argument(flag, type=type(default), default=default, help=f"{helps[f.name]} (default: {default})")
+
+
+def cmd_train(a: argparse.Namespace) -> int:
+    import os
+
+    from training.config import ModelConfig, TrainConfig
+    from training.evaluate import plot_training, run_evaluation, torch_codec
+    from training.train import train
+
+    model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim)
+    cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
+    run_dir = Path(a.run_dir)
+    state = train(
+        run_dir,
+        model_cfg,
+        _data_config(a),
+        cfg,
+        data_cache=a.data,
+        resume=a.resume,
+        progress=not a.no_progress,
+        stop_after=a.stop_after,
+    )
+    if int(os.environ.get("RANK", "0")) != 0:
+        return 0
+    print(f"best validation MSE {state.best_val:.4f} at epoch {state.best_epoch}; checkpoints in {run_dir}")
+    if state.epoch >= cfg.epochs or (cfg.patience and state.epoch - state.best_epoch >= cfg.patience):
+        from training.data import load_or_generate
+
+        ds = load_or_generate(_data_config(a), a.data)
+        enc, dec, _ = torch_codec(run_dir / "best.pt")
+        report = run_evaluation(enc, dec, {"test": ds.test}, run_dir, log_path=run_dir / "log.jsonl")
+        print(
+            f"test MSE (paper eq. 4) {report['test_sets']['test']['mse']:.4f}; "
+            f"report {run_dir / 'report.json'}, figures {run_dir}/*.png"
+        )
+    elif (run_dir / "log.jsonl").exists():
+        plot_training(run_dir / "log.jsonl", run_dir / "training.png")
+    return 0
+
+
+# ------------------------------------------------------------------------------- export
+
+
+def cmd_export(a: argparse.Namespace) -> int:
+    from training.data import DataConfig, load_or_generate
+    from training.evaluate import onnx_codec, run_evaluation
+    from training.export import export, model_size_of
+    from training.io import atomic_write_text
+    from training.train import load_checkpoint, model_from_checkpoint
+
+    ckpt = load_checkpoint(a.checkpoint)
+    data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
+    ds = load_or_generate(data_cfg, a.data)
+    model = model_from_checkpoint(a.checkpoint)
+    training: dict[str, Any] = {
+        "data": ckpt["data_config"],
+        "train": ckpt["train_config"],
+        "epochs_run": ckpt["state"]["epoch"],
+        "best_epoch": ckpt["state"]["best_epoch"],
+        "best_val_mse": ckpt["state"]["best_val"],
+    }
+    if a.training_info:
+        training.update(json.loads(Path(a.training_info).read_text()))
+    manifest = export(
+        model, a.out, name=a.name, version=a.version, model_size=model_size_of(ds.train), extra={"training": training}
+    )
+    print(f"exported {a.checkpoint} → {a.out}/encoder.onnx, decoder.onnx, vae.pt, manifest.json")
+    if a.evaluate:
+        from training.data import generate_curves
+
+        fresh, _ = generate_curves(1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
+        enc, dec, _ = onnx_codec(a.out)
+        report = run_evaluation(
+            enc, dec, {"test": ds.test, f"fresh_seed_{a.fresh_seed}": fresh}, Path(a.out) / "report", figures=False
+        )
+        manifest["metrics"] = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
+        atomic_write_text(Path(a.out) / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+        (Path(a.out) / "report" / "report.json").unlink()
+        (Path(a.out) / "report").rmdir()
+        for name, r in report["test_sets"].items():
+            print(f"{name}: MSE {r['mse']:.4f} (median {r['mse_median']:.4f}) over {r['n_curves']} curves")
+    return 0
+
+
+# ----------------------------------------------------------------------------- evaluate
+
+
+def cmd_evaluate(a: argparse.Namespace) -> int:
+    from training.data import DataConfig, generate_curves, load_or_generate
+    from training.evaluate import onnx_codec, run_evaluation, torch_codec
+
+    if a.checkpoint:
+        enc, dec, meta = torch_codec(a.checkpoint)
+        import torch
+
+        data_cfg_d = torch.load(a.checkpoint, map_location="cpu", weights_only=True).get("data_config")
+    else:
+        enc, dec, meta = onnx_codec(a.model_dir)
+        data_cfg_d = meta.get("training", {}).get("data")
+    data_cfg = DataConfig(**{**data_cfg_d, "center": tuple(data_cfg_d["center"])}) if data_cfg_d else DataConfig()
+    ds = load_or_generate(data_cfg, a.data)
+    sets = {"test": ds.test}
+    if a.fresh_seed >= 0:
+        sets[f"fresh_seed_{a.fresh_seed}"] = generate_curves(
+            1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points
+        )[0]
+    log = Path(a.checkpoint).parent / "log.jsonl" if a.checkpoint else None
+    report = run_evaluation(enc, dec, sets, a.out, log_path=log, figures=not a.no_figures)
+    for name, r in report["test_sets"].items():
+        s_in, s_out = r["smoothness_input"]["roughness"], r["smoothness_output"]["roughness"]
+        print(
+            f"{name}: MSE {r['mse']:.4f} (paper eq. 4, {r['n_curves']} curves; median {r['mse_median']:.4f}); "
+            f"roughness in {s_in:.3f}° out {s_out:.3f}°; self-intersecting outputs {r['self_intersecting_outputs']:.1%}"
+        )
+    print(f"report: {Path(a.out) / 'report.json'}")
+    return 0
+
+
+# -------------------------------------------------------------------------------- main
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="curve-vae", description=__doc__.splitlines()[0], formatter_class=argparse.ArgumentDefaultsHelpFormatter
+    )
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    s = sub.add_parser("dataset", help="generate (or check) the cached curve data set")
+    _add_data_options(s)
+    s.add_argument("--preview", default="", help="also write a PNG grid of training curves to this path")
+    s.set_defaults(func=cmd_dataset)
+
+    s = sub.add_parser("train", help="train a VAE (resumable; DDP under torchrun)")
+    s.add_argument(
+        "--run-dir", default="runs/default", help="checkpoints, log and report go here (default: runs/default)"
+    )
+    s.add_argument("--resume", action="store_true", help="continue from RUN_DIR/last.pt if it exists")
+    s.add_argument(
+        "--stop-after",
+        type=int,
+        default=0,
+        help="stop after this many epochs of this call; resume later (default: 0 = run to --epochs)",
+    )
+    s.add_argument("--no-progress", action="store_true", help="no progress bar; one line per epoch")
+    _add_data_options(s)
+    _add_train_options(s)
+    s.set_defaults(func=cmd_train)
+
+    s = sub.add_parser("export", help="export a checkpoint to ONNX + manifest (the service's model)")
+    s.add_argument("--checkpoint", required=True, help="a training checkpoint (best.pt / last.pt)")
+    s.add_argument("--out", default=DEFAULT_MODELS, help=f"output directory (default: {DEFAULT_MODELS})")
+    s.add_argument("--name", default="curve-vae-inception", help="model name in the manifest")
+    s.add_argument("--version", default="0.1.0", help="model version in the manifest")
+    s.add_argument(
+        "--data", default=DEFAULT_DATA, help=f"data set cache of the checkpoint's data config (default: {DEFAULT_DATA})"
+    )
+    s.add_argument(
+        "--fresh-seed",
+        type=int,
+        default=FRESH_TEST_SEED,
+        help=f"seed of the second test set (default: {FRESH_TEST_SEED})",
+    )
+    s.add_argument(
+        "--training-info",
+        default="",
+        help="JSON file merged into the manifest's training section (wall time, hardware)",
+    )
+    s.add_argument(
+        "--evaluate",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="measure the exported graphs on both test sets and store the metrics in the manifest (default: on)",
+    )
+    s.set_defaults(func=cmd_export)
+
+    s = sub.add_parser("evaluate", help="reconstruction MSE, smoothness and figures on the test sets")
+    src = s.add_mutually_exclusive_group()
+    src.add_argument(
+        "--model-dir",
+        default=DEFAULT_MODELS,
+        help=f"exported model to evaluate with onnxruntime (default: {DEFAULT_MODELS})",
+    )
+    src.add_argument("--checkpoint", default="", help="evaluate a torch checkpoint instead")
+    s.add_argument("--data", default=DEFAULT_DATA, help=f"data set cache (default: {DEFAULT_DATA})")
+    s.add_argument(
+        "--fresh-seed",
+        type=int,
+        default=FRESH_TEST_SEED,
+        help=f"also test on 1000 curves of this seed, -1 to skip (default: {FRESH_TEST_SEED})",
+    )
+    s.add_argument(
+        "--out", default="runs/evaluation", help="report.json and figures go here (default: runs/evaluation)"
+    )
+    s.add_argument("--no-figures", action="store_true", help="write only report.json")
+    s.set_defaults(func=cmd_evaluate)
+
+    s = sub.add_parser("serve", help="run the REST service on a model directory")
+    try:
+        from service.cli import configure_parser, run
+    except ImportError as e:  # the service's dependencies are part of the base install
+        reason = str(e)
+        s.set_defaults(func=lambda _a: sys.exit(f"curve-vae serve is unavailable: {reason}"))
+    else:
+        configure_parser(s)
+        s.set_defaults(func=run)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (ValueError, FileNotFoundError, RuntimeError) as e:
+        print(f"curve-vae {args.command}: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

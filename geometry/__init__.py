@@ -1,0 +1,39 @@
+"""Curve geometry shared by training and service: pure numpy/scipy, no torch.
+
+One place for everything the project knows about curves: B-spline sampling and fitting,
+arc-length resampling, frame normalisation, self-intersection and smoothness metrics.
+A curve is an array of shape (n_points, 2); a batch is (batch, n_points, 2).
+"""
+
+from geometry.bspline import (
+    BSplineFit,
+    clamped_uniform_knots,
+    fit_bspline,
+    random_control_points,
+    sample_bspline,
+)
+from geometry.frame import Frame, blend_frames, fit_frame, resample
+from geometry.metrics import (
+    curve_length,
+    mse_per_curve,
+    self_intersects,
+    smoothness,
+    turning_angles,
+)
+
+__all__ = [
+    "BSplineFit",
+    "Frame",
+    "blend_frames",
+    "clamped_uniform_knots",
+    "curve_length",
+    "fit_bspline",
+    "fit_frame",
+    "mse_per_curve",
+    "random_control_points",
+    "resample",
+    "sample_bspline",
+    "self_intersects",
+    "smoothness",
+    "turning_angles",
+]

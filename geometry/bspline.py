@@ -1,0 +1,107 @@
+"""Open (clamped) uniform cubic B-splines: random control points, sampling, least-squares fit.
+
+The data set of the paper (§3.1) is built from these: 10 control points, one per random
+angular sector of a radius-64 circle centred in the 128×128 plane, sampled at 161 points
+uniformly in the curve parameter. scipy evaluates the basis; batches are a matrix product.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import BSpline, make_lsq_spline
+
+
+def clamped_uniform_knots(n_ctrl: int, degree: int = 3) -> np.ndarray:
+    """Knot vector on [0, 1] of an open uniform B-spline: end knots repeated degree+1 times."""
+    if n_ctrl <= degree:
+        raise ValueError(f"need more than {degree} control points for degree {degree}, got {n_ctrl}")
+    interior = np.linspace(0.0, 1.0, n_ctrl - degree + 1)[1:-1]
+    return np.concatenate([np.zeros(degree + 1), interior, np.ones(degree + 1)])
+
+
+def random_control_points(
+    rng: np.random.Generator,
+    count: int,
+    *,
+    n_ctrl: int = 10,
+    radius: float = 64.0,
+    center: tuple[float, float] = (64.0, 64.0),
+) -> np.ndarray:
+    """(count, n_ctrl, 2) control points, one per non-uniform angular sector of a circle.
+
+    Sector boundaries start at angle 0 and are n_ctrl-1 sorted uniform angles in (0, 2π);
+    inside its sector each point has a uniform angle and a radius uniform over the area
+    (radius·√u), so points are spread over the disc rather than crowded at its centre.
+    """
+    cuts = np.sort(rng.uniform(0.0, 2 * np.pi, size=(count, n_ctrl - 1)), axis=1)
+    bounds = np.concatenate([np.zeros((count, 1)), cuts, np.full((count, 1), 2 * np.pi)], axis=1)
+    lo, hi = bounds[:, :-1], bounds[:, 1:]
+    theta = lo + (hi - lo) * rng.uniform(size=(count, n_ctrl))
+    r = radius * np.sqrt(rng.uniform(size=(count, n_ctrl)))
+    pts = np.stack([center[0] + r * np.cos(theta), center[1] + r * np.sin(theta)], axis=-1)
+    return pts
+
+
+def sample_bspline(ctrl: np.ndarray, n_points: int = 161, degree: int = 3) -> np.ndarray:
+    """Sample clamped uniform B-splines at n_points parameters evenly spaced in [0, 1].
+
+    ctrl: (n_ctrl, 2) or (batch, n_ctrl, 2). Returns (n_points, 2) or (batch, n_points, 2).
+    """
+    ctrl = np.asarray(ctrl, dtype=np.float64)
+    knots = clamped_uniform_knots(ctrl.shape[-2], degree)
+    u = np.linspace(0.0, 1.0, n_points)
+    basis = BSpline.design_matrix(u, knots, degree).toarray()  # (n_points, n_ctrl)
+    return np.einsum("pc,...cd->...pd", basis, ctrl)
+
+
+@dataclass(frozen=True)
+class BSplineFit:
+    """A least-squares B-spline: control points, knots and how far the curve is from it."""
+
+    control_points: np.ndarray  # (n_ctrl, 2)
+    knots: np.ndarray  # (n_ctrl + degree + 1,)
+    degree: int
+    params: np.ndarray  # (n_points,) parameter of each input point
+    rms_error: float  # root mean squared distance, input points to fitted curve at params
+    max_error: float
+
+    def evaluate(self, n_points: int) -> np.ndarray:
+        """(n_points, 2) points of the fitted spline, evenly spaced in its parameter."""
+        return BSpline(self.knots, self.control_points, self.degree)(np.linspace(0, 1, n_points))
+
+
+def fit_bspline(points: np.ndarray, n_ctrl: int = 10, *, degree: int = 3, param: str = "uniform") -> BSplineFit:
+    """Least-squares clamped uniform B-spline through a polyline.
+
+    param: "uniform" gives point i the parameter i/(n-1), which recovers a B-spline exactly
+    from its own evenly-parameterised samples (the paper's data); "chord" uses cumulative
+    chord length, better for curves drawn or resampled by arc length.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise ValueError(f"points must have shape (n, 2), got {pts.shape}")
+    if len(pts) < n_ctrl:
+        raise ValueError(f"need at least n_ctrl={n_ctrl} points to fit, got {len(pts)}")
+    if param == "uniform":
+        u = np.linspace(0.0, 1.0, len(pts))
+    elif param == "chord":
+        seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+        if seg.sum() <= 0:
+            raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+        u = np.concatenate([[0.0], np.cumsum(seg)]) / seg.sum()
+        # make_lsq_spline needs non-decreasing abscissae; repeated points share a parameter.
+    else:
+        raise ValueError(f"param must be 'uniform' or 'chord', got {param!r}")
+    knots = clamped_uniform_knots(n_ctrl, degree)
+    spline = make_lsq_spline(u, pts, knots, k=degree)
+    err = np.linalg.norm(spline(u) - pts, axis=1)
+    return BSplineFit(
+        control_points=np.asarray(spline.c),
+        knots=knots,
+        degree=degree,
+        params=u,
+        rms_error=float(np.sqrt(np.mean(err**2))),
+        max_error=float(err.max()),
+    )

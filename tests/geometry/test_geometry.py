@@ -1,0 +1,116 @@
+"""Geometry: B-spline sampling and fitting, resampling, frames, metrics."""
+
+import numpy as np
+import pytest
+
+from geometry import (
+    blend_frames,
+    clamped_uniform_knots,
+    curve_length,
+    fit_bspline,
+    fit_frame,
+    mse_per_curve,
+    random_control_points,
+    resample,
+    sample_bspline,
+    self_intersects,
+    smoothness,
+    turning_angles,
+)
+
+
+def test_knots_are_clamped_and_uniform():
+    k = clamped_uniform_knots(10)
+    assert len(k) == 14
+    np.testing.assert_array_equal(k[:4], 0)
+    np.testing.assert_array_equal(k[-4:], 1)
+    np.testing.assert_allclose(np.diff(k[3:11]), 1 / 7)
+
+
+def test_clamped_spline_interpolates_its_end_control_points():
+    ctrl = random_control_points(np.random.default_rng(1), 5)
+    pts = sample_bspline(ctrl, 161)
+    assert pts.shape == (5, 161, 2)
+    np.testing.assert_allclose(pts[:, 0], ctrl[:, 0], atol=1e-12)
+    np.testing.assert_allclose(pts[:, -1], ctrl[:, -1], atol=1e-12)
+
+
+def test_control_points_lie_in_their_sectors():
+    ctrl = random_control_points(np.random.default_rng(2), 1000)
+    d = ctrl - 64.0
+    r = np.linalg.norm(d, axis=-1)
+    theta = np.mod(np.arctan2(d[..., 1], d[..., 0]), 2 * np.pi)
+    assert r.max() <= 64.0
+    assert np.all(np.diff(theta, axis=1) > 0), "one point per sector, in angular order"
+
+
+def test_fit_recovers_control_points_of_exact_samples():
+    ctrl = random_control_points(np.random.default_rng(3), 1)[0]
+    fit = fit_bspline(sample_bspline(ctrl, 161), n_ctrl=10)
+    np.testing.assert_allclose(fit.control_points, ctrl, atol=1e-6)
+    assert fit.rms_error < 1e-9
+    np.testing.assert_allclose(fit.evaluate(161), sample_bspline(ctrl, 161), atol=1e-6)
+
+
+def test_fit_rejects_too_few_points():
+    with pytest.raises(ValueError, match="at least n_ctrl"):
+        fit_bspline(np.zeros((5, 2)), n_ctrl=10)
+
+
+def test_resample_keeps_ends_and_spaces_evenly():
+    ctrl = random_control_points(np.random.default_rng(4), 1)[0]
+    pts = sample_bspline(ctrl, 161)
+    r = resample(pts, 50)
+    assert r.shape == (50, 2)
+    np.testing.assert_allclose(r[[0, -1]], pts[[0, -1]])
+    seg = np.linalg.norm(np.diff(r, axis=0), axis=1)
+    assert seg.std() / seg.mean() < 0.02  # chords of equal arcs: nearly equal
+    assert abs(curve_length(r) - curve_length(pts)) / curve_length(pts) < 0.01
+
+
+def test_resample_tolerates_repeated_points():
+    pts = np.array([[0, 0], [0, 0], [1, 0], [1, 0], [2, 0]], float)
+    np.testing.assert_allclose(resample(pts, 5)[:, 0], [0, 0.5, 1, 1.5, 2])
+
+
+def test_frame_round_trip_and_equivariance():
+    rng = np.random.default_rng(5)
+    pts = sample_bspline(random_control_points(rng, 1)[0])
+    moved = pts * 3.5 + np.array([-1000.0, 42.0])
+    f, g = fit_frame(pts), fit_frame(moved)
+    np.testing.assert_allclose(f.to_model(pts, 100.0), g.to_model(moved, 100.0), atol=1e-9)
+    np.testing.assert_allclose(g.from_model(g.to_model(moved, 100.0), 100.0), moved, atol=1e-9)
+    with pytest.raises(ValueError, match="coincide"):
+        fit_frame(np.ones((4, 2)))
+
+
+def test_blend_frames_is_affine():
+    a, b = fit_frame(np.array([[0, 0], [2, 1.0]])), fit_frame(np.array([[10, 10], [14, 12.0]]))
+    mid = blend_frames([a, b], np.array([[0.5, 0.5]]))[0]
+    assert mid.center == (6.5, 5.75) and mid.size == 3.0
+
+
+def test_self_intersection():
+    arc = np.stack([np.cos(np.linspace(0, 3, 50)), np.sin(np.linspace(0, 3, 50))], axis=1)
+    loop = np.stack([np.cos(np.linspace(0, 7, 50)), np.sin(np.linspace(0, 7, 50)) * 0.5], axis=1)
+    assert not self_intersects(arc)
+    assert self_intersects(loop)
+    np.testing.assert_array_equal(self_intersects(np.stack([arc, loop])), [False, True])
+
+
+def test_turning_angles_of_circle_arc_are_constant():
+    t = np.linspace(0, np.pi, 101)
+    arc = np.stack([np.cos(t), np.sin(t)], axis=1)
+    a = turning_angles(arc)
+    np.testing.assert_allclose(a, np.pi / 100, rtol=1e-9)
+    s = smoothness(arc[None])
+    assert s["roughness"][0] < 1e-9
+    noisy = arc + np.random.default_rng(0).normal(0, 1e-3, arc.shape)
+    assert smoothness(noisy[None])["roughness"][0] > 0.01
+
+
+def test_mse_per_curve_is_paper_eq4():
+    a = np.zeros((2, 3, 2))
+    b = a.copy()
+    b[1, 0, 0] = 3.0  # one coordinate of six off by 3 → 9/6
+    np.testing.assert_allclose(mse_per_curve(a, b), [0.0, 1.5])

@@ -1,0 +1,69 @@
+"""The curve data set: shape, range, validity, determinism, caching."""
+
+import numpy as np
+import pytest
+
+from geometry import self_intersects
+from training.data import CurveDataset, DataConfig, generate_curves, load_or_generate
+
+SMALL = DataConfig(n_train=300, n_val=50, n_test=40, seed=11)
+
+
+@pytest.fixture(scope="module")
+def small() -> CurveDataset:
+    return CurveDataset.generate(SMALL)
+
+
+def test_shapes_and_dtype(small):
+    assert small.train.shape == (300, 161, 2)
+    assert small.val.shape == (50, 161, 2)
+    assert small.test.shape == (40, 161, 2)
+    assert small.test_ctrl.shape == (40, 10, 2)
+    assert small.train.dtype == np.float32
+
+
+def test_curves_stay_in_the_circle(small):
+    # A B-spline lies in the convex hull of its control points, all inside the radius-64 disc.
+    r = np.linalg.norm(np.concatenate([small.train, small.val, small.test]) - 64.0, axis=-1)
+    assert r.max() <= 64.0 + 1e-3
+    assert small.train.min() >= 0 and small.train.max() <= 128
+
+
+def test_no_self_intersections(small):
+    assert not self_intersects(small.train.astype(np.float64)).any()
+
+
+def test_rejection_actually_happens():
+    # Without the filter some curves do intersect; the generator must have dropped them.
+    from geometry import random_control_points, sample_bspline
+
+    raw = sample_bspline(random_control_points(np.random.default_rng(0), 20_000))
+    assert self_intersects(raw).any()
+
+
+def test_deterministic_and_prefix_stable():
+    a, _ = generate_curves(100, seed=5)
+    b, _ = generate_curves(100, seed=5)
+    c, _ = generate_curves(30, seed=5)
+    d, _ = generate_curves(100, seed=6)
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(a[:30], c)
+    assert not np.allclose(a, d)
+
+
+def test_splits_are_disjoint(small):
+    flat = {c.tobytes() for c in np.concatenate([small.train, small.val, small.test])}
+    assert len(flat) == 390
+
+
+def test_cache_round_trip_and_mismatch(tmp_path, small):
+    path = tmp_path / "d.npz"
+    small.save(path)
+    back = load_or_generate(SMALL, path)
+    np.testing.assert_array_equal(back.train, small.train)
+    assert back.config == SMALL
+    other = DataConfig(n_train=100, n_val=10, n_test=10, seed=11)
+    regenerated = load_or_generate(other, path)  # a different config is not served from the cache
+    assert regenerated.train.shape == (100, 161, 2)
+    assert CurveDataset.load(path).config == other
+    assert not list(tmp_path.glob("*.tmp")), "no temporary files left behind"

@@ -1,0 +1,115 @@
+"""Tiny real runs: train → checkpoint → resume → export → ONNX parity → evaluate; DDP with 2 processes."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import onnxruntime as ort
+import pytest
+import torch
+
+from curve_vae.cli import main
+from training.export import sha256
+from training.train import load_checkpoint, model_from_checkpoint
+
+pytestmark = pytest.mark.slow
+
+TINY = ["--n-train", "256", "--n-val", "32", "--n-test", "32", "--batch-size", "32", "--no-progress",
+        "--threads", "2"]
+
+
+def _log(run):
+    return [json.loads(line) for line in (run / "log.jsonl").read_text().splitlines()]
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory):
+    """A 3-epoch run interrupted after 2 epochs and resumed, plus an uninterrupted twin."""
+    tmp = tmp_path_factory.mktemp("e2e")
+    data = str(tmp / "curves.npz")
+    cut, whole = tmp / "cut", tmp / "whole"
+    common = [*TINY, "--data", data, "--epochs", "3"]
+    assert main(["train", "--run-dir", str(cut), "--stop-after", "2", *common]) == 0
+    after_two = _log(cut)
+    assert main(["train", "--run-dir", str(cut), "--resume", *common]) == 0
+    assert main(["train", "--run-dir", str(whole), *common]) == 0
+    return tmp, data, cut, whole, after_two
+
+
+def test_checkpoints_log_report_figures(trained):
+    _, _, cut, _, after_two = trained
+    assert len(after_two) == 2
+    rows = _log(cut)
+    assert [r["epoch"] for r in rows] == [1, 2, 3]
+    assert {"train_mse", "train_kl", "train_lap", "val_mse", "lr"} <= rows[0].keys()
+    for name in ("last.pt", "best.pt", "report.json", "training.png", "reconstructions_test.png"):
+        assert (cut / name).stat().st_size > 0, name
+    ck = load_checkpoint(cut / "last.pt")  # weights_only=True: no pickled code in checkpoints
+    assert ck["state"]["epoch"] == 3
+    report = json.loads((cut / "report.json").read_text())
+    assert report["test_sets"]["test"]["n_curves"] == 32
+
+
+def test_resume_reproduces_an_uninterrupted_run(trained):
+    _, _, cut, whole, _ = trained
+    a, b = load_checkpoint(cut / "last.pt"), load_checkpoint(whole / "last.pt")
+    for k in a["model"]:
+        torch.testing.assert_close(a["model"][k], b["model"][k], rtol=1e-5, atol=1e-6, msg=k)
+    assert [r["val_mse"] for r in _log(cut)] == pytest.approx([r["val_mse"] for r in _log(whole)], rel=1e-5)
+
+
+def test_export_parity_and_manifest(trained):
+    tmp, data, cut, _, _ = trained
+    out = tmp / "models"
+    assert main(["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data,
+                 "--version", "9.9.9"]) == 0
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["version"] == "9.9.9" and manifest["latent_dim"] == 32 and manifest["n_points"] == 161
+    for name, meta in manifest["files"].items():
+        assert sha256(out / name) == meta["sha256"], name
+    assert set(manifest["metrics"]["test_sets"]) == {"test", "fresh_seed_7919"}
+    assert manifest["training"]["train"]["epochs"] == 3
+
+    model = model_from_checkpoint(cut / "best.pt")
+    enc = ort.InferenceSession(str(out / "encoder.onnx"), providers=["CPUExecutionProvider"])
+    dec = ort.InferenceSession(str(out / "decoder.onnx"), providers=["CPUExecutionProvider"])
+    rng = np.random.default_rng(0)
+    for batch in (1, 7, 128):
+        x = rng.uniform(0, 128, (batch, 161, 2)).astype(np.float32)
+        mean, log_var = enc.run(None, {"curves": x})
+        curves = dec.run(None, {"latent": mean})[0]
+        with torch.no_grad():
+            t_mean, t_log_var = model.encoder(torch.from_numpy(x))
+            t_curves = model.decoder(t_mean)
+        np.testing.assert_allclose(mean, t_mean.numpy(), atol=1e-4, rtol=0)
+        np.testing.assert_allclose(log_var, t_log_var.numpy(), atol=1e-4, rtol=0)
+        # Curves are compared in the network's normalised units (pixels / 64): float32
+        # rounding alone moves pixel outputs of ~100 by ~1e-4, in torch as in onnxruntime.
+        np.testing.assert_allclose(curves / 64, t_curves.numpy() / 64, atol=1e-4, rtol=0)
+        assert curves.shape == (batch, 161, 2)
+
+
+def test_evaluate_exported_model(trained, capsys):
+    tmp, data, _, _, _ = trained
+    out = tmp / "eval"
+    assert main(["evaluate", "--model-dir", str(tmp / "models"), "--data", data, "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "test: MSE" in printed and "fresh_seed_7919: MSE" in printed
+    report = json.loads((out / "report.json").read_text())
+    assert report["interpolation"]["latent"]["self_intersecting"] >= 0
+    assert (out / "tangents_test.png").exists()
+
+
+def test_ddp_two_cpu_processes(tmp_path):
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc-per-node", "2",
+           "-m", "curve_vae.cli", "train", "--run-dir", str(tmp_path / "run"), "--data",
+           str(tmp_path / "d.npz"), "--epochs", "2", *TINY[:-2], "--threads", "1"]
+    proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
+    rows = _log(tmp_path / "run")
+    assert [r["epoch"] for r in rows] == [1, 2]  # one writer: rank 0
+    # Each of the 2 processes takes half of every global batch: 256 curves → 8 steps of 16 each.
+    assert load_checkpoint(tmp_path / "run" / "last.pt")["optimizer"]["state"][0]["step"] == 16

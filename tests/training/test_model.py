@@ -1,0 +1,58 @@
+"""Model shapes for every variant and latent size; mean decoding at inference."""
+
+import pytest
+import torch
+
+from training.config import VARIANTS, ModelConfig
+from training.model import VAE, count_parameters
+
+
+@pytest.mark.parametrize("variant", [*VARIANTS, "cnn6"])
+@pytest.mark.parametrize("latent_dim", [8, 32])
+def test_shapes_forward_backward(variant, latent_dim):
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant=variant, latent_dim=latent_dim))
+    x = torch.rand(3, 161, 2) * 128
+    y, mean, log_var = model(x)
+    assert y.shape == (3, 161, 2)
+    assert mean.shape == log_var.shape == (3, latent_dim)
+    (y.square().mean() + mean.square().mean()).backward()
+    assert all(p.grad is not None for p in model.parameters())
+
+
+def test_reference_architecture_size():
+    m = VAE(ModelConfig())
+    assert (m.encoder.feat_channels, m.encoder.feat_len) == (256, 16)  # Flatten 16×256, DESIGN.md
+    assert 1.8e6 < count_parameters(m) < 2.0e6
+
+
+def test_eval_decodes_the_mean_and_train_samples():
+    torch.manual_seed(0)
+    m = VAE(ModelConfig(variant="cnn1"))
+    x = torch.rand(4, 161, 2) * 128
+    m.eval()
+    with torch.no_grad():
+        a, mean, _ = m(x)
+        b, _, _ = m(x)
+        assert torch.equal(a, b)
+        assert torch.allclose(a, m.decoder(mean))
+    m.train()
+    with torch.no_grad():
+        c, _, _ = m(x)
+        d, _, _ = m(x)
+    assert not torch.allclose(c, d), "training forward samples z = μ + σ·ε"
+
+
+def test_output_can_be_negative():
+    # The reference code's output ReLU would clamp coordinates at 0; ours has none.
+    m = VAE(ModelConfig(variant="cnn1")).eval()
+    with torch.no_grad():
+        m.decoder.features[-1].weight.zero_()
+        m.decoder.features[-1].bias.fill_(-2.0)  # normalised −2 → 64 − 2·64 = −64 px
+        y = m.decoder(torch.zeros(1, 32))
+    torch.testing.assert_close(y, torch.full((1, 161, 2), -64.0))
+
+
+def test_unknown_variant_is_rejected():
+    with pytest.raises(ValueError, match="unknown variant"):
+        ModelConfig(variant="resnet")

@@ -1,0 +1,1 @@
+"""Training package: data set, Inception VAE, losses, trainer, ONNX export, evaluation."""

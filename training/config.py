@@ -1,0 +1,65 @@
+"""Model and training configurations: frozen dataclasses, torch-free so the CLI can list them.
+
+Checkpoints store `asdict(config)`, so export and evaluation rebuild a model from the
+checkpoint alone, whatever the defaults here become.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# Table 1's shallow networks: (filters, kernel) of each conv layer of the encoder; the
+# decoder mirrors them with transposed convolutions. CNN_6 is the Inception network.
+CONV_VARIANTS: dict[str, tuple[tuple[int, int], ...]] = {
+    "cnn1": ((64, 3), (128, 3)),  # two conv layers, kernel 3
+    "cnn2": ((64, 5), (128, 5)),  # kernel 5
+    "cnn3": ((64, 5), (128, 3)),  # mixed kernels 5 then 3
+    "cnn4": ((128, 5), (256, 3)),  # CNN_3 with twice the filters
+    "cnn5": ((64, 5), (128, 3), (256, 3)),  # three conv layers
+}
+VARIANTS = (*CONV_VARIANTS, "inception")
+ALIASES = {"cnn6": "inception"}
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    variant: str = "inception"  # "inception" (= CNN_6, the paper's model) or cnn1 … cnn5
+    latent_dim: int = 32  # paper Table 2: 32 balances accuracy and cost
+    n_points: int = 161  # points per curve, fixed by the network's shape arithmetic
+    center: float = 64.0  # plane centre: inputs are shifted by this ...
+    scale: float = 64.0  # ... and divided by this, so the data lie in about [-1, 1]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "variant", ALIASES.get(self.variant.lower(), self.variant.lower()))
+        if self.variant not in VARIANTS:
+            raise ValueError(f"unknown variant {self.variant!r}; choose one of {', '.join(VARIANTS)}")
+        if self.latent_dim < 1:
+            raise ValueError(f"latent_dim must be ≥ 1, got {self.latent_dim}")
+
+
+SCHEDULES = ("onecycle", "cosine", "constant", "plateau")
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    epochs: int = 30  # CPU budget; the paper ran 900 epochs on a GPU
+    batch_size: int = 128  # paper §3.5 (global batch; split across DDP processes)
+    lr: float = 1e-3  # paper §3.5 (Adam); peak rate for onecycle
+    schedule: str = "onecycle"  # onecycle | cosine | constant | plateau
+    warmup: float = 0.1  # onecycle: fraction of steps spent warming up
+    beta: float = 1e-3  # KL weight
+    lap_weight: float = 1.0  # Laplacian (smoothness) weight; 0 disables the term
+    grad_clip: float = 0.0  # clip the gradient norm to this (0: off)
+    patience: int = 0  # stop after this many epochs without a better validation MSE (0: off)
+    bf16: bool = False  # bf16 autocast (AMX on recent Xeons, tensor cores on GPUs)
+    compile: bool = False  # torch.compile the model
+    seed: int = 0  # weight init, batch order and ε of the reparameterisation
+    threads: int = 0  # torch intra-op threads (0: torch's default)
+    device: str = "auto"  # auto | cpu | cuda
+    train_limit: int = 0  # use only the first N training curves (0: all)
+
+    def __post_init__(self) -> None:
+        if self.schedule not in SCHEDULES:
+            raise ValueError(f"schedule must be one of {', '.join(SCHEDULES)}, got {self.schedule!r}")
+        if self.epochs < 1 or self.batch_size < 1 or self.lr <= 0:
+            raise ValueError("epochs and batch_size must be ≥ 1 and lr > 0")

@@ -1,0 +1,110 @@
+"""The curve data set (paper §3.1): random open cubic B-splines, sampled, split and cached."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from geometry import random_control_points, sample_bspline, self_intersects
+from training.io import atomic_path
+
+FORMAT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class DataConfig:
+    n_train: int = 70_000  # paper §3.1
+    n_val: int = 2_000  # model selection / early stopping; never used for the reported MSE
+    n_test: int = 1_000  # paper Table 1 evaluates on 1,000 curves
+    seed: int = 0  # one seed draws all three splits, in this order
+    n_ctrl: int = 10  # control points per curve, one per angular sector
+    n_points: int = 161  # samples per curve, evenly spaced in the curve parameter
+    radius: float = 64.0  # control points lie in this circle ...
+    center: tuple[float, float] = (64.0, 64.0)  # ... centred in the 128×128 plane
+
+
+def generate_curves(
+    count: int,
+    seed: int,
+    *,
+    n_ctrl: int = 10,
+    n_points: int = 161,
+    radius: float = 64.0,
+    center: tuple[float, float] = (64.0, 64.0),
+    chunk: int = 8192,
+) -> tuple[np.ndarray, np.ndarray]:
+    """`count` non-self-intersecting curves (count, n_points, 2) float32 and their control points.
+
+    Draws in chunks and rejects self-intersecting curves, so the result for a given seed
+    does not depend on how many are asked for beyond a prefix: the first k of a request for
+    n > k curves are the curves a request for k returns.
+    """
+    rng = np.random.default_rng(seed)
+    curves, ctrls, have = [], [], 0
+    while have < count:
+        ctrl = random_control_points(rng, chunk, n_ctrl=n_ctrl, radius=radius, center=center)
+        pts = sample_bspline(ctrl, n_points)
+        ok = ~self_intersects(pts)
+        curves.append(pts[ok].astype(np.float32))
+        ctrls.append(ctrl[ok].astype(np.float32))
+        have += int(ok.sum())
+    return np.concatenate(curves)[:count], np.concatenate(ctrls)[:count]
+
+
+@dataclass(frozen=True)
+class CurveDataset:
+    """The three splits as (n, n_points, 2) float32 arrays in the 128×128 plane."""
+
+    config: DataConfig
+    train: np.ndarray
+    val: np.ndarray
+    test: np.ndarray
+    test_ctrl: np.ndarray  # control points of the test curves, for B-spline comparisons
+
+    @classmethod
+    def generate(cls, config: DataConfig) -> CurveDataset:
+        total = config.n_train + config.n_val + config.n_test
+        curves, ctrl = generate_curves(
+            total,
+            config.seed,
+            n_ctrl=config.n_ctrl,
+            n_points=config.n_points,
+            radius=config.radius,
+            center=config.center,
+        )
+        a, b = config.n_train, config.n_train + config.n_val
+        return cls(config, curves[:a], curves[a:b], curves[b:], ctrl[b:])
+
+    def save(self, path: str | Path) -> None:
+        """Write atomically: a crash never leaves a half-written cache behind."""
+        meta = json.dumps({"format_version": FORMAT_VERSION, "config": asdict(self.config)})
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:
+            np.savez(f, meta=np.array(meta), train=self.train, val=self.val, test=self.test, test_ctrl=self.test_ctrl)
+
+    @classmethod
+    def load(cls, path: str | Path) -> CurveDataset:
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(str(z["meta"]))
+            if meta.get("format_version") != FORMAT_VERSION:
+                raise ValueError(
+                    f"{path}: data set format {meta.get('format_version')}, "
+                    f"expected {FORMAT_VERSION}; regenerate it with `curve-vae dataset`"
+                )
+            cfg = meta["config"]
+            cfg["center"] = tuple(cfg["center"])
+            return cls(DataConfig(**cfg), z["train"], z["val"], z["test"], z["test_ctrl"])
+
+
+def load_or_generate(config: DataConfig, cache: str | Path | None) -> CurveDataset:
+    """The data set for `config`, from `cache` when it holds exactly that configuration."""
+    if cache is not None and Path(cache).exists():
+        ds = CurveDataset.load(cache)
+        if ds.config == config:
+            return ds
+    ds = CurveDataset.generate(config)
+    if cache is not None:
+        ds.save(cache)
+    return ds

@@ -1,0 +1,216 @@
+"""Evaluation (paper §3.4, §4): reconstruction MSE (eq. 4), tangent smoothness, figures.
+
+Works on a torch checkpoint or on an exported model directory (ONNX, as the service runs
+it), so the shipped artefacts are measured exactly as users receive them.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from geometry import mse_per_curve, self_intersects, smoothness
+from training.io import atomic_path, atomic_write_text
+
+Reconstructor = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, N, 2), decoding the mean
+Encoder = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, Z) latent means
+Decoder = Callable[[np.ndarray], np.ndarray]  # (B, Z) → (B, N, 2)
+
+
+def onnx_codec(model_dir: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]:
+    """Encoder/decoder callables over the ONNX graphs of an exported model, and its manifest."""
+    import onnxruntime as ort
+
+    model_dir = Path(model_dir)
+    manifest = json.loads((model_dir / "manifest.json").read_text())
+    enc = ort.InferenceSession(str(model_dir / "encoder.onnx"), providers=["CPUExecutionProvider"])
+    dec = ort.InferenceSession(str(model_dir / "decoder.onnx"), providers=["CPUExecutionProvider"])
+
+    def encode(curves: np.ndarray) -> np.ndarray:
+        return enc.run(["mean"], {"curves": np.ascontiguousarray(curves, np.float32)})[0]
+
+    def decode(z: np.ndarray) -> np.ndarray:
+        return dec.run(["curves"], {"latent": np.ascontiguousarray(z, np.float32)})[0]
+
+    return encode, decode, manifest
+
+
+def torch_codec(checkpoint: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]:
+    """Encoder/decoder callables over a torch checkpoint (last.pt, best.pt or vae.pt)."""
+    import torch
+
+    from training.model import VAE, ModelConfig
+
+    ckpt = torch.load(checkpoint, map_location="cpu", weights_only=True)
+    model = VAE(ModelConfig(**ckpt["model_config"]))
+    model.load_state_dict(ckpt["model"])
+    model.eval()
+
+    @torch.no_grad()
+    def encode(curves: np.ndarray) -> np.ndarray:
+        return model.encoder(torch.as_tensor(curves, dtype=torch.float32))[0].numpy()
+
+    @torch.no_grad()
+    def decode(z: np.ndarray) -> np.ndarray:
+        return model.decoder(torch.as_tensor(z, dtype=torch.float32)).numpy()
+
+    return encode, decode, {"model_config": ckpt["model_config"]}
+
+
+def batched(fn: Callable[[np.ndarray], np.ndarray], x: np.ndarray, batch: int = 500) -> np.ndarray:
+    return np.concatenate([fn(x[i : i + batch]) for i in range(0, len(x), batch)])
+
+
+def evaluate_set(curves: np.ndarray, recon: np.ndarray) -> dict[str, Any]:
+    """The report of one test set: eq. 4 MSE statistics and smoothness of inputs vs outputs."""
+    mse = mse_per_curve(curves, recon)
+    s_in, s_out = smoothness(curves), smoothness(recon)
+    return {
+        "n_curves": len(curves),
+        "mse": float(mse.mean()),  # paper eq. 4, averaged over the set (Table 1's number)
+        "mse_median": float(np.median(mse)),
+        "mse_p95": float(np.percentile(mse, 95)),
+        "mse_max": float(mse.max()),
+        "smoothness_input": {k: float(v.mean()) for k, v in s_in.items()},
+        "smoothness_output": {k: float(v.mean()) for k, v in s_out.items()},
+        "self_intersecting_outputs": float(self_intersects(recon).mean()),
+    }
+
+
+def interpolation_report(
+    encode: Encoder, decode: Decoder, curves: np.ndarray, *, pairs: int = 200, steps: int = 5, seed: int = 0
+) -> dict[str, Any]:
+    """Latent vs point-wise interpolation of random test pairs (paper eq. 9, Fig. 10)."""
+    rng = np.random.default_rng(seed)
+    idx = rng.choice(len(curves), size=(pairs, 2), replace=True)
+    idx = idx[idx[:, 0] != idx[:, 1]]
+    w = np.linspace(0, 1, steps)[1:-1]  # the interior steps: the new curves
+    mu = encode(curves[idx.reshape(-1)]).reshape(len(idx), 2, -1)
+    z = w[None, :, None] * mu[:, None, 0] + (1 - w[None, :, None]) * mu[:, None, 1]  # (P, S, Z)
+    latent = decode(z.reshape(-1, z.shape[-1])).reshape(len(idx), len(w), *curves.shape[1:])
+    a, b = curves[idx[:, 0]], curves[idx[:, 1]]
+    pointwise = w[None, :, None, None] * a[:, None] + (1 - w[None, :, None, None]) * b[:, None]
+    out: dict[str, Any] = {"pairs": len(idx), "steps": steps}
+    for name, c in (("latent", latent), ("pointwise", pointwise)):
+        flat = c.reshape(-1, *curves.shape[1:])
+        s = smoothness(flat)
+        out[name] = {
+            "self_intersecting": float(self_intersects(flat).mean()),
+            **{k: float(v.mean()) for k, v in s.items()},
+        }
+    return out
+
+
+# ---------------------------------------------------------------------------------- figures
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig: Any, path: Path) -> None:
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
+    _plt().close(fig)
+
+
+def plot_reconstructions(curves: np.ndarray, recon: np.ndarray, path: Path, *, n: int = 8) -> None:
+    """Targets (dashed blue) and reconstructions (red) with per-curve MSE (paper Fig. 6)."""
+    plt = _plt()
+    mse = mse_per_curve(curves[:n], recon[:n])
+    cols = min(4, n)
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 3.2 * rows), squeeze=False)
+    for i, ax in enumerate(axes.flat):
+        ax.set_axis_off()
+        if i >= n:
+            continue
+        ax.plot(*curves[i].T, "b--", lw=1.2, label="target")
+        ax.plot(*recon[i].T, "r-", lw=1.0, label="reconstruction")
+        ax.set_aspect("equal")
+        ax.set_title(f"MSE {mse[i]:.3f}", fontsize=9)
+    axes.flat[0].legend(fontsize=7, loc="lower left")
+    _save(fig, path)
+
+
+def plot_tangents(
+    curves: list[np.ndarray], labels: list[str], path: Path, *, every: int = 4, window: slice = slice(40, 90)
+) -> None:
+    """Unit tangents (paper eq. 8) as arrows on a stretch of each curve (paper Fig. 3)."""
+    plt = _plt()
+    fig, axes = plt.subplots(1, len(curves), figsize=(4 * len(curves), 4), squeeze=False)
+    for ax, c, label in zip(axes.flat, curves, labels):
+        seg = c[window]
+        d = np.diff(seg, axis=0)
+        t = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+        ax.plot(*seg.T, "k-", lw=0.8)
+        ax.quiver(
+            seg[:-1:every, 0],
+            seg[:-1:every, 1],
+            t[::every, 0],
+            t[::every, 1],
+            angles="xy",
+            scale=12,
+            width=0.006,
+            color="tab:red",
+        )
+        rough = smoothness(c[None])["roughness"][0]
+        ax.set_title(f"{label}\nroughness {rough:.3f}°", fontsize=9)
+        ax.set_aspect("equal")
+    _save(fig, path)
+
+
+def plot_training(log_path: Path, path: Path) -> None:
+    """Loss terms and validation MSE per epoch, from a run's log.jsonl."""
+    plt = _plt()
+    rows = [json.loads(line) for line in log_path.read_text().splitlines() if line.strip()]
+    ep = [r["epoch"] for r in rows]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    axes[0].semilogy(ep, [r["train_mse"] for r in rows], label="train MSE")
+    axes[0].semilogy(ep, [r["val_mse"] for r in rows], label="validation MSE")
+    axes[0].axhline(0.099, color="gray", ls=":", label="paper (0.099)")
+    axes[0].set_xlabel("epoch")
+    axes[0].legend()
+    axes[1].plot(ep, [r["train_kl"] for r in rows], label="KL")
+    axes[1].plot(ep, [r["train_lap"] for r in rows], label="Laplacian")
+    axes[1].set_xlabel("epoch")
+    axes[1].legend()
+    axes[2].plot(ep, [r["lr"] for r in rows])
+    axes[2].set_xlabel("epoch")
+    axes[2].set_ylabel("learning rate")
+    _save(fig, path)
+
+
+def run_evaluation(
+    encode: Encoder,
+    decode: Decoder,
+    test_sets: dict[str, np.ndarray],
+    out_dir: str | Path,
+    *,
+    log_path: Path | None = None,
+    figures: bool = True,
+) -> dict[str, Any]:
+    """Evaluate on each named test set; write report.json (and figures) into out_dir."""
+    out = Path(out_dir)
+    report: dict[str, Any] = {"test_sets": {}}
+    for name, curves in test_sets.items():
+        recon = batched(lambda x: decode(encode(x)), curves)
+        report["test_sets"][name] = evaluate_set(curves, recon)
+        if figures:
+            plot_reconstructions(curves, recon, out / f"reconstructions_{name}.png")
+            plot_tangents([curves[0], recon[0]], ["input", "reconstruction"], out / f"tangents_{name}.png")
+    first = next(iter(test_sets.values()))
+    report["interpolation"] = interpolation_report(encode, decode, first)
+    if figures and log_path is not None and log_path.exists():
+        plot_training(log_path, out / "training.png")
+    atomic_write_text(out / "report.json", json.dumps(report, indent=2) + "\n")
+    return report

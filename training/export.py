@@ -1,0 +1,134 @@
+"""Export a trained VAE as two single-file ONNX graphs and a manifest (the service's input).
+
+encoder.onnx: curves (B, n_points, 2) in the 128×128 plane → mean, log_var (B, latent_dim)
+decoder.onnx: latent (B, latent_dim) → curves (B, n_points, 2) in the 128×128 plane
+manifest.json: names, dims, sha256 of each file, the frame convention, config and metrics.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import platform
+import time
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from training.io import atomic_path, atomic_write_text
+from training.model import VAE
+
+MANIFEST_VERSION = 1
+OPSET = 18
+
+
+class _EncoderGraph(nn.Module):
+    def __init__(self, vae: VAE) -> None:
+        super().__init__()
+        self.encoder = vae.encoder
+
+    def forward(self, curves: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        return self.encoder(curves)
+
+
+def sha256(path: str | Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _export(module: nn.Module, example: torch.Tensor, path: Path, in_name: str, out_names: list[str]) -> None:
+    batch = torch.export.Dim("batch", min=1, max=1 << 20)
+    with atomic_path(path) as tmp:
+        program = torch.onnx.export(
+            module,
+            (example,),
+            dynamo=True,
+            input_names=[in_name],
+            output_names=out_names,
+            dynamic_shapes=({0: batch},),
+            opset_version=OPSET,
+            external_data=False,
+            verbose=False,
+        )
+        program.save(str(tmp), external_data=False)
+
+
+def model_size_of(curves: np.ndarray) -> float:
+    """The bounding-box size (larger side) the model is used to: median over the data set.
+
+    Curves in the caller's frame are scaled to this size before encoding (frame "auto").
+    """
+    ext = curves.max(axis=1) - curves.min(axis=1)  # (N, 2)
+    return float(np.median(ext.max(axis=1)))
+
+
+def export(
+    model: VAE,
+    out_dir: str | Path,
+    *,
+    name: str = "curve-vae",
+    version: str = "0.0.0",
+    model_size: float,
+    extra: dict[str, Any] | None = None,
+    weights: bool = True,
+) -> dict[str, Any]:
+    """Write encoder.onnx, decoder.onnx, (vae.pt,) and manifest.json into out_dir; return the manifest."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    model = model.float().cpu().eval()
+    cfg = model.cfg
+    _export(
+        _EncoderGraph(model),
+        torch.zeros(2, cfg.n_points, 2) + 64.0,
+        out / "encoder.onnx",
+        "curves",
+        ["mean", "log_var"],
+    )
+    _export(model.decoder, torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", "latent", ["curves"])
+    files = ["encoder.onnx", "decoder.onnx"]
+    if weights:
+        with atomic_path(out / "vae.pt") as tmp:
+            torch.save({"model_config": asdict(cfg), "model": model.state_dict()}, tmp)
+        files.append("vae.pt")
+    manifest = {
+        "manifest_version": MANIFEST_VERSION,
+        "name": name,
+        "version": version,
+        "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "variant": cfg.variant,
+        "n_points": cfg.n_points,
+        "latent_dim": cfg.latent_dim,
+        "files": {f: {"sha256": sha256(out / f), "bytes": (out / f).stat().st_size} for f in files},
+        "graphs": {
+            "encoder": {
+                "file": "encoder.onnx",
+                "inputs": {"curves": ["batch", cfg.n_points, 2]},
+                "outputs": {"mean": ["batch", cfg.latent_dim], "log_var": ["batch", cfg.latent_dim]},
+            },
+            "decoder": {
+                "file": "decoder.onnx",
+                "inputs": {"latent": ["batch", cfg.latent_dim]},
+                "outputs": {"curves": ["batch", cfg.n_points, 2]},
+            },
+        },
+        "frame": {
+            "plane": [128.0, 128.0],
+            "center": [cfg.center, cfg.center],
+            "model_size": model_size,
+            "normalisation": f"inside the graphs: (x - {cfg.center}) / {cfg.scale}; I/O in plane pixels",
+            "sampling": f"{cfg.n_points} points evenly spaced in the B-spline parameter",
+        },
+        "model_config": asdict(cfg),
+        "opset": OPSET,
+        "exported_with": {"torch": torch.__version__, "python": platform.python_version()},
+        **(extra or {}),
+    }
+    atomic_write_text(out / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+    return manifest

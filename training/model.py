@@ -1,0 +1,149 @@
+"""The Inception VAE of the paper (§3.5, Fig. 5) and the ablation networks of Table 1.
+
+Curves enter and leave in the paper's 128×128 plane as (B, n_points, 2); inside, the
+network works on (B, 2, n_points) scaled to about [-1, 1], so the exported ONNX graphs
+take and return plain pixel coordinates and carry their own normalisation.
+"""
+
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+from training.config import CONV_VARIANTS, VARIANTS, ModelConfig
+
+__all__ = ["VAE", "Encoder", "Decoder", "Inception", "ModelConfig", "VARIANTS", "count_parameters"]
+
+
+class Inception(nn.Module):
+    """Four parallel branches, 'same' length, concatenated to 4·f channels (paper Fig. 4).
+
+    1×1 | 1×1 → 3 | 1×1 → 5 | maxpool 3 → 1×1, each conv followed by ReLU. The decoder's
+    variant (transposed=True) uses transposed convolutions, as the reference code does.
+    """
+
+    def __init__(self, c_in: int, f: int, *, transposed: bool = False) -> None:
+        super().__init__()
+        conv = nn.ConvTranspose1d if transposed else nn.Conv1d
+
+        def unit(ci: int, k: int) -> nn.Sequential:
+            return nn.Sequential(conv(ci, f, k, padding=k // 2), nn.ReLU())
+
+        self.b1 = unit(c_in, 1)
+        self.b3 = nn.Sequential(unit(c_in, 1), unit(f, 3))
+        self.b5 = nn.Sequential(unit(c_in, 1), unit(f, 5))
+        self.bp = nn.Sequential(nn.MaxPool1d(3, stride=1, padding=1), unit(c_in, 1))
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:  # (B, c_in, L) → (B, 4f, L)
+        return torch.cat([self.b1(x), self.b3(x), self.b5(x), self.bp(x)], dim=1)
+
+
+def conv_block(c_in: int, c_out: int, k: int, *, transposed: bool = False) -> nn.Sequential:
+    """Valid-padded conv → ReLU (lengths shrink by k-1, or grow by k-1 when transposed)."""
+    conv = nn.ConvTranspose1d if transposed else nn.Conv1d
+    return nn.Sequential(conv(c_in, c_out, k), nn.ReLU())
+
+
+def _out_len(module: nn.Module, c_in: int, length: int) -> tuple[int, int]:
+    with torch.no_grad():
+        y = module(torch.zeros(1, c_in, length))
+    return y.shape[1], y.shape[2]
+
+
+class Encoder(nn.Module):
+    """(B, n_points, 2) curves in the plane → mean, log-variance, each (B, latent_dim)."""
+
+    def __init__(self, cfg: ModelConfig) -> None:
+        super().__init__()
+        self.cfg = cfg
+        if cfg.variant == "inception":
+            self.features = nn.Sequential(
+                conv_block(2, 64, 5),
+                Inception(64, 64),
+                conv_block(256, 128, 3),
+                nn.BatchNorm1d(128),
+                nn.MaxPool1d(3),
+                Inception(128, 128),
+                conv_block(512, 256, 3),
+                nn.BatchNorm1d(256),
+                nn.MaxPool1d(3),
+            )
+        else:
+            layers: list[nn.Module] = []
+            c = 2
+            for f, k in CONV_VARIANTS[cfg.variant]:
+                layers += [conv_block(c, f, k), nn.BatchNorm1d(f), nn.MaxPool1d(3)]
+                c = f
+            self.features = nn.Sequential(*layers)
+        self.feat_channels, self.feat_len = _out_len(self.features, 2, cfg.n_points)
+        flat = self.feat_channels * self.feat_len
+        self.mean = nn.Linear(flat, cfg.latent_dim)
+        self.log_var = nn.Linear(flat, cfg.latent_dim)
+
+    def forward(self, curves: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        x = (curves.transpose(1, 2) - self.cfg.center) / self.cfg.scale  # (B, 2, N)
+        h = self.features(x).flatten(1)  # (B, C·L)
+        return self.mean(h), self.log_var(h)  # (B, Z), (B, Z)
+
+
+class Decoder(nn.Module):
+    """(B, latent_dim) → (B, n_points, 2) curves in the plane; no output activation."""
+
+    def __init__(self, cfg: ModelConfig, feat_channels: int, feat_len: int) -> None:
+        super().__init__()
+        self.cfg = cfg
+        self.feat_shape = (feat_channels, feat_len)
+        self.dense = nn.Sequential(nn.Linear(cfg.latent_dim, feat_channels * feat_len), nn.ReLU())
+        up = nn.Upsample(scale_factor=3, mode="nearest")
+        if cfg.variant == "inception":
+            self.features = nn.Sequential(
+                conv_block(256, 256, 3, transposed=True),
+                nn.BatchNorm1d(256),
+                up,
+                Inception(256, 128, transposed=True),
+                conv_block(512, 128, 3, transposed=True),
+                nn.BatchNorm1d(128),
+                up,
+                Inception(128, 64, transposed=True),
+                conv_block(256, 64, 5, transposed=True),
+                nn.BatchNorm1d(64),
+                up,
+                nn.ConvTranspose1d(64, 2, 3),
+            )
+        else:
+            layers: list[nn.Module] = []
+            c = feat_channels
+            for f, k in reversed(CONV_VARIANTS[cfg.variant]):
+                layers += [conv_block(c, f, k, transposed=True), nn.BatchNorm1d(f), up]
+                c = f
+            layers.append(nn.ConvTranspose1d(c, 2, 3))
+            self.features = nn.Sequential(*layers)
+        _, out_len = _out_len(self.features, feat_channels, feat_len)
+        if out_len < cfg.n_points:
+            raise ValueError(f"decoder of {cfg.variant} yields {out_len} < {cfg.n_points} points")
+
+    def forward(self, z: torch.Tensor) -> torch.Tensor:
+        h = self.dense(z).view(-1, *self.feat_shape)  # (B, C, L)
+        x = self.features(h)[:, :, : self.cfg.n_points]  # (B, 2, N): crop the surplus tail
+        return x.transpose(1, 2) * self.cfg.scale + self.cfg.center  # (B, N, 2)
+
+
+class VAE(nn.Module):
+    """Encoder + decoder. forward samples z = μ + σ·ε in training and decodes μ in eval."""
+
+    def __init__(self, cfg: ModelConfig) -> None:
+        super().__init__()
+        self.cfg = cfg
+        self.encoder = Encoder(cfg)
+        self.decoder = Decoder(cfg, self.encoder.feat_channels, self.encoder.feat_len)
+
+    def forward(self, curves: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        mean, log_var = self.encoder(curves)
+        z = mean
+        if self.training:
+            z = mean + torch.randn_like(mean) * torch.exp(0.5 * log_var)  # paper eq. 1
+        return self.decoder(z), mean, log_var
+
+
+def count_parameters(model: nn.Module) -> int:
+    return sum(p.numel() for p in model.parameters())

@@ -1,0 +1,309 @@
+"""Trainer: loop, optimiser, schedule, checkpoints, resume, early stopping, DDP.
+
+Knows nothing about curves beyond "a (N, n_points, 2) float array": the model owns the
+architecture, `losses` owns the objective. Run under `torchrun --nproc-per-node K` for
+data-parallel training (gloo on CPU, nccl on GPU); a single process needs no launcher.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import random
+import time
+from contextlib import nullcontext
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+import torch.distributed as dist
+from torch import nn
+from tqdm import tqdm
+
+from training.config import SCHEDULES, ModelConfig, TrainConfig
+from training.data import DataConfig, load_or_generate
+from training.io import atomic_path
+from training.losses import vae_loss
+from training.model import VAE
+
+__all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch", "load_checkpoint", "model_from_checkpoint"]
+
+CHECKPOINT_VERSION = 1
+
+
+@dataclass
+class RunState:
+    """Everything that changes during a run and must survive a restart."""
+
+    epoch: int = 0  # epochs completed
+    best_val: float = math.inf
+    best_epoch: int = -1
+    history: list[dict[str, float]] = field(default_factory=list)
+
+
+def atomic_save(obj: Any, path: Path) -> None:
+    """torch.save through a temporary file, renamed over `path` once complete."""
+    with atomic_path(path) as tmp:
+        torch.save(obj, tmp)
+
+
+def load_checkpoint(path: str | Path) -> dict[str, Any]:
+    ckpt = torch.load(path, map_location="cpu", weights_only=True)
+    if ckpt.get("version") != CHECKPOINT_VERSION:
+        raise ValueError(f"{path}: checkpoint version {ckpt.get('version')}, expected {CHECKPOINT_VERSION}")
+    return ckpt
+
+
+def model_from_checkpoint(path: str | Path) -> VAE:
+    """Rebuild the model from a checkpoint alone (its stored config), in eval mode."""
+    ckpt = load_checkpoint(path)
+    model = VAE(ModelConfig(**ckpt["model_config"]))
+    model.load_state_dict(ckpt["model"])
+    return model.eval()
+
+
+def pick_device(name: str) -> torch.device:
+    if name == "auto":
+        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    if name == "cuda" and not torch.cuda.is_available():
+        raise RuntimeError("--device cuda asked for, but torch sees no CUDA device")
+    return torch.device(name)
+
+
+def autocast(device: torch.device, bf16: bool):
+    return torch.autocast(device.type, dtype=torch.bfloat16) if bf16 else nullcontext()
+
+
+def train_one_epoch(
+    model: nn.Module,
+    data: torch.Tensor,
+    order: torch.Tensor,
+    opt: torch.optim.Optimizer,
+    sched: Any,
+    cfg: TrainConfig,
+    device: torch.device,
+    *,
+    bar: tqdm | None = None,
+) -> dict[str, float]:
+    """One pass over `data[order]` in batches; returns the mean of each loss term."""
+    model.train()
+    sums: dict[str, float] = {}
+    n_batches = 0
+    per_step = cfg.batch_size // max(1, dist.get_world_size() if dist.is_initialized() else 1)
+    for i in range(0, len(order) - per_step + 1, per_step):  # drop the ragged last batch
+        x = data[order[i : i + per_step]].to(device, non_blocking=True)
+        with autocast(device, cfg.bf16):
+            pred, mean, log_var = model(x)
+        terms = vae_loss(x, pred, mean, log_var, beta=cfg.beta, lap_weight=cfg.lap_weight)
+        opt.zero_grad(set_to_none=True)
+        terms["loss"].backward()
+        if cfg.grad_clip > 0:
+            nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)
+        opt.step()
+        if sched is not None and cfg.schedule != "plateau":
+            sched.step()
+        n_batches += 1
+        for k, v in terms.items():
+            sums[k] = sums.get(k, 0.0) + float(v.detach())
+        if bar is not None:
+            bar.update(len(x))
+            if n_batches % 10 == 0:
+                bar.set_postfix({k: f"{sums[k] / n_batches:.4g}" for k in ("loss", "mse", "kl", "lap")})
+    return {k: v / max(1, n_batches) for k, v in sums.items()}
+
+
+@torch.no_grad()
+def reconstruct(
+    model: nn.Module, curves: np.ndarray | torch.Tensor, *, batch: int = 1000, device: torch.device | None = None
+) -> np.ndarray:
+    """Decode the latent mean of each curve (paper: reconstruction at inference), float32."""
+    device = device or next(model.parameters()).device
+    model.eval()
+    x = torch.as_tensor(curves, dtype=torch.float32)
+    out = [model(x[i : i + batch].to(device))[0].float().cpu() for i in range(0, len(x), batch)]
+    return torch.cat(out).numpy()
+
+
+def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch: int):
+    total = cfg.epochs * steps_per_epoch
+    if cfg.schedule == "onecycle":
+        return torch.optim.lr_scheduler.OneCycleLR(
+            opt,
+            max_lr=cfg.lr,
+            total_steps=total,
+            pct_start=cfg.warmup,
+            div_factor=25.0,
+            final_div_factor=1e3,
+        )
+    if cfg.schedule == "cosine":
+        return torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=total, eta_min=cfg.lr * 1e-3)
+    if cfg.schedule == "plateau":
+        return torch.optim.lr_scheduler.ReduceLROnPlateau(opt, factor=0.5, patience=5)
+    return None
+
+
+def _rng_state(gen: np.random.Generator) -> dict[str, Any]:
+    return {"torch": torch.get_rng_state(), "numpy": json.dumps(gen.bit_generator.state)}
+
+
+def train(
+    run_dir: str | Path,
+    model_cfg: ModelConfig,
+    data_cfg: DataConfig,
+    cfg: TrainConfig,
+    *,
+    data_cache: str | Path | None = None,
+    resume: bool = False,
+    progress: bool = True,
+    stop_after: int = 0,
+) -> RunState:
+    """Train into `run_dir` (last.pt, best.pt, log.jsonl); resume from last.pt if asked.
+
+    stop_after: leave after this many epochs of this call (0: run to cfg.epochs), so a long
+    schedule can be run in time-boxed slices and continued with resume=True.
+    """
+    run_dir = Path(run_dir)
+    distributed = int(os.environ.get("WORLD_SIZE", "1")) > 1
+    device = pick_device(cfg.device)
+    if distributed:
+        if device.type == "cuda":
+            device = torch.device("cuda", int(os.environ.get("LOCAL_RANK", "0")))
+            torch.cuda.set_device(device)
+        dist.init_process_group("nccl" if device.type == "cuda" else "gloo")
+    rank = dist.get_rank() if distributed else 0
+    world = dist.get_world_size() if distributed else 1
+    if cfg.threads > 0:
+        torch.set_num_threads(cfg.threads)
+
+    try:
+        torch.manual_seed(cfg.seed)
+        random.seed(cfg.seed)
+        ds = load_or_generate(data_cfg, data_cache) if rank == 0 else None
+        if distributed:  # rank 0 generates or loads (and writes the cache) first
+            dist.barrier()
+            if rank != 0:
+                ds = load_or_generate(data_cfg, data_cache)
+        assert ds is not None
+        train_np = ds.train[: cfg.train_limit] if cfg.train_limit else ds.train
+        data = torch.from_numpy(np.ascontiguousarray(train_np))
+        val = torch.from_numpy(np.ascontiguousarray(ds.val))
+
+        model = VAE(model_cfg).to(device)
+        opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
+        steps_per_epoch = len(data) // world // (cfg.batch_size // world)
+        if steps_per_epoch < 1:
+            raise ValueError(f"{len(data)} training curves are fewer than one batch of {cfg.batch_size}")
+        sched = _make_schedule(opt, cfg, steps_per_epoch)
+        gen = np.random.default_rng(cfg.seed)
+        state = RunState()
+
+        last = run_dir / "last.pt"
+        if resume and last.exists():
+            ckpt = load_checkpoint(last)
+            if (
+                sched is not None
+                and cfg.schedule in ("onecycle", "cosine")
+                and (ckpt["train_config"]["epochs"] != cfg.epochs)
+            ):
+                raise ValueError(
+                    f"{last} was trained for a {ckpt['train_config']['epochs']}-epoch {cfg.schedule} "
+                    f"schedule; resume it with --epochs {ckpt['train_config']['epochs']}, or start a "
+                    "new run directory (use --init-from to start from its weights)"
+                )
+            model.load_state_dict(ckpt["model"])
+            opt.load_state_dict(ckpt["optimizer"])
+            if sched is not None and ckpt.get("scheduler") is not None:
+                sched.load_state_dict(ckpt["scheduler"])
+            state = RunState(**ckpt["state"])
+            torch.set_rng_state(ckpt["rng"]["torch"])
+            gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
+            if rank == 0:
+                print(f"resumed {last} at epoch {state.epoch}/{cfg.epochs}", flush=True)
+        elif resume and rank == 0:
+            print(f"no checkpoint at {last}: starting a new run", flush=True)
+
+        net: nn.Module = model
+        if distributed:
+            net = nn.parallel.DistributedDataParallel(
+                model, device_ids=[device.index] if device.type == "cuda" else None
+            )
+        if cfg.compile:
+            net = torch.compile(net)
+
+        if rank == 0:
+            run_dir.mkdir(parents=True, exist_ok=True)
+            (run_dir / "config.json").write_text(
+                json.dumps({"model": asdict(model_cfg), "data": asdict(data_cfg), "train": asdict(cfg)}, indent=2)
+            )
+
+        end = cfg.epochs if not stop_after else min(cfg.epochs, state.epoch + stop_after)
+        while state.epoch < end:
+            t0 = time.perf_counter()
+            perm = torch.from_numpy(gen.permutation(len(data)))  # same on every rank
+            order = perm[rank::world][: steps_per_epoch * (cfg.batch_size // world)]
+            bar = tqdm(
+                total=len(order),
+                desc=f"epoch {state.epoch + 1}/{cfg.epochs}",
+                unit="curve",
+                disable=not progress or rank != 0,
+                leave=False,
+                dynamic_ncols=True,
+            )
+            terms = train_one_epoch(net, data, order, opt, sched, cfg, device, bar=bar)
+            bar.close()
+            train_time = time.perf_counter() - t0
+            val_mse = float(np.mean((reconstruct(model, val, device=device) - val.numpy()) ** 2))
+            if distributed:  # decide on rank 0's number so every rank stops together
+                v = torch.tensor([val_mse], dtype=torch.float64)
+                dist.broadcast(v, 0)
+                val_mse = float(v)
+            if sched is not None and cfg.schedule == "plateau":
+                sched.step(val_mse)
+            state.epoch += 1
+            row = {
+                "epoch": state.epoch,
+                **{f"train_{k}": v for k, v in terms.items()},
+                "val_mse": val_mse,
+                "lr": opt.param_groups[0]["lr"],
+                "seconds": train_time,
+                "curves_per_s": len(order) * world / train_time,
+            }
+            state.history.append(row)
+            improved = val_mse < state.best_val
+            if improved:
+                state.best_val, state.best_epoch = val_mse, state.epoch
+            if rank == 0:
+                ckpt = {
+                    "version": CHECKPOINT_VERSION,
+                    "model_config": asdict(model_cfg),
+                    "data_config": asdict(data_cfg),
+                    "train_config": asdict(cfg),
+                    "model": model.state_dict(),
+                    "optimizer": opt.state_dict(),
+                    "scheduler": sched.state_dict() if sched is not None else None,
+                    "state": asdict(state),
+                    "rng": _rng_state(gen),
+                }
+                if improved:
+                    atomic_save(ckpt, run_dir / "best.pt")
+                atomic_save(ckpt, last)
+                with open(run_dir / "log.jsonl", "a") as f:
+                    f.write(json.dumps(row) + "\n")
+                if progress:
+                    print(
+                        f"epoch {state.epoch}/{cfg.epochs}  loss {terms['loss']:.4g}  mse {terms['mse']:.4g}  "
+                        f"kl {terms['kl']:.4g}  lap {terms['lap']:.4g}  val_mse {val_mse:.4g}"
+                        f"{' *' if improved else ''}  {row['curves_per_s']:.0f} curves/s",
+                        flush=True,
+                    )
+            if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
+                if rank == 0:
+                    print(f"early stop: no better validation MSE for {cfg.patience} epochs", flush=True)
+                break
+        return state
+    finally:
+        if distributed and dist.is_initialized():
+            dist.destroy_process_group()
