@@ -13,6 +13,7 @@ from geometry.bspline import (
     sample_bspline,
 )
 from geometry.frame import Frame, blend_frames, fit_frame, resample
+from geometry.mesh import Mesh, revolve
 from geometry.metrics import (
     curve_length,
     mse_per_curve,
@@ -24,6 +25,7 @@ from geometry.metrics import (
 __all__ = [
     "BSplineFit",
     "Frame",
+    "Mesh",
     "blend_frames",
     "clamped_uniform_knots",
     "curve_length",
@@ -32,6 +34,7 @@ __all__ = [
     "mse_per_curve",
     "random_control_points",
     "resample",
+    "revolve",
     "sample_bspline",
     "self_intersects",
     "smoothness",
