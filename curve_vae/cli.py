@@ -236,6 +236,55 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
     return 0
 
 
+# ------------------------------------------------------------------------ fit, revolve
+
+
+def cmd_fit(a: argparse.Namespace) -> int:
+    from curve_vae.files import read_curves, write_output
+    from geometry import fit_bspline
+
+    fits = [fit_bspline(c, a.n_ctrl, param=a.param) for c in read_curves(a.input)]
+    write_output(
+        a.output,
+        {
+            "fits": [
+                {
+                    "control_points": f.control_points.tolist(),
+                    "knots": f.knots.tolist(),
+                    "degree": f.degree,
+                    "rms_error": f.rms_error,
+                    "max_error": f.max_error,
+                }
+                for f in fits
+            ]
+        },
+    )
+    for i, f in enumerate(fits):
+        print(
+            f"curve {i}: {a.n_ctrl} control points, rms error {f.rms_error:.4g}, max {f.max_error:.4g}", file=sys.stderr
+        )
+    return 0
+
+
+def cmd_revolve(a: argparse.Namespace) -> int:
+    from curve_vae.files import read_curves
+    from geometry import revolve
+    from training.io import atomic_path
+
+    curves = read_curves(a.input)
+    if len(curves) != 1:
+        raise ValueError(f"{a.input}: revolve takes one profile curve, got {len(curves)}")
+    mesh = revolve(curves[0], segments=a.segments, axis=a.axis, axis_position=a.axis_position)
+    fmt = a.format or ("stl" if a.output.endswith(".stl") else "obj")
+    with atomic_path(a.output) as tmp:
+        if fmt == "stl":
+            tmp.write_bytes(mesh.to_stl())
+        else:
+            tmp.write_text(mesh.to_obj(comment=f"curve-vae revolve: {len(curves[0])}-point profile"))
+    print(f"{a.output}: {len(mesh.vertices)} vertices, {len(mesh.faces)} triangles ({fmt})", file=sys.stderr)
+    return 0
+
+
 # -------------------------------------------------------------------------------- main
 
 
@@ -313,6 +362,35 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--no-figures", action="store_true", help="write only report.json")
     s.set_defaults(func=cmd_evaluate)
+
+    s = sub.add_parser("fit", help="least-squares cubic B-spline of each curve (no model needed)")
+    s.add_argument("input", help="curves: .json ([[x, y], …], a list of curves, or {curves: …}), .npy, or - (stdin)")
+    s.add_argument("-o", "--output", default="-", help="JSON output file (default: - = stdout)")
+    s.add_argument("--n-ctrl", type=int, default=10, help="control points (default: 10, as the training data)")
+    s.add_argument(
+        "--param",
+        choices=["uniform", "chord"],
+        default="chord",
+        help="parameter of each point: chord length (any curve) or uniform (the "
+        "data set's sampling; recovers its B-splines exactly) (default: chord)",
+    )
+    s.set_defaults(func=cmd_fit)
+
+    s = sub.add_parser("revolve", help="surface of revolution of a profile curve, as OBJ or STL (paper Fig. 12)")
+    s.add_argument("input", help="one profile curve: .json, .npy, or - (stdin)")
+    s.add_argument("-o", "--output", required=True, help="mesh file (.obj or .stl)")
+    s.add_argument("--format", choices=["obj", "stl"], default="", help="default: from the file name")
+    s.add_argument("--segments", type=int, default=64, help="angular resolution (default: 64)")
+    s.add_argument(
+        "--axis", choices=["x", "y"], default="y", help="revolve about a vertical (y) or horizontal (x) line"
+    )
+    s.add_argument(
+        "--axis-position",
+        type=float,
+        default=None,
+        help="where that line is (default: through the profile's nearest point)",
+    )
+    s.set_defaults(func=cmd_revolve)
 
     s = sub.add_parser("serve", help="run the REST service on a model directory")
     try:

@@ -1,0 +1,56 @@
+"""Curve files for the offline commands: JSON (as the REST API speaks it) or NPY."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+def read_curves(path: str) -> list[np.ndarray]:
+    """Curves from a .npy array (n, 2) or (N, n, 2), or JSON: [[x, y], …], [curve, …] or {"curves": […]}.
+
+    "-" reads JSON from standard input.
+    """
+    if path.endswith(".npy"):
+        arr = np.load(path, allow_pickle=False)
+        data: Any = arr[None] if arr.ndim == 2 else arr
+    else:
+        text = sys.stdin.read() if path == "-" else Path(path).read_text()
+        data = json.loads(text)
+        if isinstance(data, dict):
+            if "curves" not in data:
+                raise ValueError(f"{path}: a JSON object needs a 'curves' field")
+            data = data["curves"]
+        if data and isinstance(data[0], list | tuple) and data[0] and not isinstance(data[0][0], list | tuple):
+            data = [data]  # a single curve
+    curves = [np.asarray(c, dtype=np.float64) for c in data]
+    for i, c in enumerate(curves):
+        if c.ndim != 2 or c.shape[1] != 2:
+            raise ValueError(f"{path}: curve {i} must be a list of [x, y] pairs, got shape {c.shape}")
+        if not np.isfinite(c).all():
+            j = int(np.argwhere(~np.isfinite(c))[0][0])
+            raise ValueError(f"{path}: curve {i} point {j} is not finite")
+    return curves
+
+
+def write_output(path: str, payload: dict[str, Any], array_key: str | None = None) -> None:
+    """JSON to `path` ("-": standard output); a .npy path gets payload[array_key] as an array."""
+    if path.endswith(".npy"):
+        if array_key is None:
+            raise ValueError("this command writes JSON only; give a .json path")
+        tmp = Path(path).with_suffix(".npy.tmp")
+        with open(tmp, "wb") as f:
+            np.save(f, np.asarray(payload[array_key], dtype=np.float32))
+        tmp.replace(path)
+        return
+    text = json.dumps(payload, indent=None, separators=(",", ":")) + "\n"
+    if path == "-":
+        sys.stdout.write(text)
+    else:
+        tmp = Path(path + ".tmp")
+        tmp.write_text(text)
+        tmp.replace(path)

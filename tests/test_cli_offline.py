@@ -1,0 +1,57 @@
+"""Offline commands that need no model: fit and revolve, on real files."""
+
+import json
+
+import numpy as np
+import pytest
+
+from curve_vae.cli import main
+from geometry import random_control_points, sample_bspline
+
+
+@pytest.fixture
+def curve_file(tmp_path):
+    ctrl = random_control_points(np.random.default_rng(0), 2)
+    path = tmp_path / "curves.json"
+    path.write_text(json.dumps({"curves": sample_bspline(ctrl).tolist()}))
+    return path, ctrl
+
+
+def test_fit_recovers_control_points(curve_file, tmp_path):
+    path, ctrl = curve_file
+    out = tmp_path / "fit.json"
+    assert main(["fit", str(path), "-o", str(out), "--param", "uniform"]) == 0
+    fits = json.loads(out.read_text())["fits"]
+    assert len(fits) == 2
+    np.testing.assert_allclose(np.array(fits[1]["control_points"]), ctrl[1], atol=1e-6)
+    assert len(fits[0]["knots"]) == 14
+
+
+def test_fit_reads_npy_and_reports_bad_input(tmp_path, capsys):
+    np.save(tmp_path / "c.npy", np.array([[0, 0], [1, 2], [2, 1], [3, 3.0]] * 3))
+    assert main(["fit", str(tmp_path / "c.npy"), "--n-ctrl", "4"]) == 0
+    bad = tmp_path / "bad.json"
+    bad.write_text('[[0, 0], [1, "x"]]')
+    assert main(["fit", str(bad)]) == 2
+    assert "curve-vae fit: error" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("fmt", ["obj", "stl"])
+def test_revolve_writes_mesh(tmp_path, fmt):
+    prof = tmp_path / "p.json"
+    prof.write_text(json.dumps([[0, 0], [2, 0], [3, 1], [2, 3]]))
+    out = tmp_path / f"vase.{fmt}"
+    assert main(["revolve", str(prof), "-o", str(out), "--segments", "10", "--axis-position", "0"]) == 0
+    if fmt == "obj":
+        lines = out.read_text().splitlines()
+        assert sum(line.startswith("v ") for line in lines) == 1 + 3 * 10
+        assert sum(line.startswith("f ") for line in lines) == 10 + 2 * 2 * 10
+    else:
+        data = out.read_bytes()
+        assert int.from_bytes(data[80:84], "little") == 50 and len(data) == 84 + 50 * 50
+
+
+def test_revolve_rejects_several_profiles(curve_file, tmp_path, capsys):
+    path, _ = curve_file
+    assert main(["revolve", str(path), "-o", str(tmp_path / "x.obj")]) == 2
+    assert "one profile curve" in capsys.readouterr().err
