@@ -1,0 +1,601 @@
+"""The REST service: `create_app(settings)` builds a FastAPI app serving the VAE (v1 contract, DESIGN.md).
+
+Routes are thin: the schema validates, `_check_*` applies the limits that depend on the
+settings or the model, the `CurveRuntime` on `app.state` computes in a worker thread, and
+the route shapes the JSON. The model is loaded in the lifespan, once per worker process,
+never at import time. Every rejected request gets the same JSON error body:
+`{"detail": "curves[2][17][1]: not a finite number", "errors": [{"loc": ..., "msg": ...}]}`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import AsyncIterator, Callable, Sequence
+from contextlib import asynccontextmanager
+from functools import partial
+from typing import Annotated, Any, TypeVar
+
+import anyio
+import numpy as np
+import onnxruntime as ort
+from fastapi import APIRouter, Body, Depends, FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.middleware.cors import CORSMiddleware
+from fastapi.responses import JSONResponse, Response
+from starlette.exceptions import HTTPException
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from geometry import Frame
+from service import schemas as s
+from service.metrics import Metrics, MetricsMiddleware
+from service.runtime import CurveRuntime, InputError, ModelLoadError, format_loc, simplex_grid, simplex_grid_size
+from service.settings import Settings, get_settings
+
+log = logging.getLogger("service")
+T = TypeVar("T")
+
+DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
+WEIGHT_SUM_TOLERANCE = 1e-6
+MAX_ERRORS_SHOWN = 20
+
+# --------------------------------------------------------------------------- errors
+
+
+def error_response(
+    status: int, errors: Sequence[tuple[str, str]], *, detail: str | None = None, headers: dict[str, str] | None = None
+) -> JSONResponse:
+    """The one error body of the API: a line naming the first problem, and the list of all of them."""
+    items = [{"loc": loc, "msg": msg} for loc, msg in errors[:MAX_ERRORS_SHOWN]]
+    if detail is None:
+        loc, msg = errors[0]
+        detail = f"{loc}: {msg}" if loc else msg
+    return JSONResponse({"detail": detail, "errors": items}, status_code=status, headers=headers)
+
+
+def _validation_message(err: dict[str, Any], request: Request) -> tuple[str, str]:
+    loc = list(err["loc"])
+    if loc[:1] == ["body"]:
+        loc = loc[1:]
+    kind, ctx = err["type"], err.get("ctx") or {}
+    if kind == "json_invalid":
+        return "body", f"invalid JSON ({ctx.get('error', 'cannot parse')}) at position {loc[0] if loc else 0}"
+    if kind in ("model_attributes_type", "dict_type", "model_type") and not loc:
+        hint = ""
+        if "json" not in request.headers.get("content-type", "json"):
+            hint = "; send it with the header Content-Type: application/json"
+        return "body", "expected a JSON object" + hint
+    messages = {
+        "finite_number": "not a finite number",
+        "float_parsing": "not a number",
+        "float_type": "not a number",
+        "int_parsing": "not an integer",
+        "int_type": "not an integer",
+        "int_from_float": "not an integer",
+        "missing": "field required",
+        "extra_forbidden": "unknown field",
+    }
+    msg = messages.get(kind, err["msg"])
+    if kind == "too_short" and len(loc) == 2 and loc[0] == "curves" and isinstance(loc[1], int):
+        msg = f"a curve needs at least 4 points, got {ctx.get('actual_length')}"
+    elif kind in ("too_short", "too_long") and len(loc) == 3 and loc[0] == "curves":
+        msg = f"a point is [x, y]: exactly 2 numbers, got {ctx.get('actual_length')}"
+    elif kind == "tuple_type" or (kind == "list_type" and len(loc) == 3 and loc[0] == "curves"):
+        msg = "a point is [x, y]: exactly 2 numbers"
+    return format_loc(loc), msg
+
+
+async def _on_validation_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, RequestValidationError)
+    return error_response(422, [_validation_message(e, request) for e in exc.errors()])
+
+
+async def _on_input_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, InputError)
+    return error_response(422, [(format_loc(exc.loc), exc.msg)])
+
+
+async def _on_http_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, HTTPException)
+    return error_response(exc.status_code, [], detail=str(exc.detail), headers=exc.headers)
+
+
+# --------------------------------------------------------------------------- body size limit
+
+
+class BodyLimitMiddleware:
+    """413 for bodies over the limit: by Content-Length before reading, or once a streamed body passes it."""
+
+    def __init__(self, app: ASGIApp, *, max_body_bytes: int) -> None:
+        self.app, self.limit = app, max_body_bytes
+
+    def _too_large(self, size: str) -> JSONResponse:
+        return error_response(
+            413, [("body", f"{size} exceeds the limit of {self.limit} bytes (CURVE_VAE_MAX_BODY_BYTES)")]
+        )
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        declared = dict(scope["headers"]).get(b"content-length", b"")
+        if declared.isdigit() and int(declared) > self.limit:  # refuse before reading a byte of it
+            await self._too_large(f"a body of {int(declared)} bytes")(scope, receive, send)
+            return
+        # Read the whole body (it is small: bounded by the limit) and replay it to the app.
+        chunks, size, more = [], 0, True
+        while more:
+            message = await receive()
+            if message["type"] != "http.request":  # client went away
+                await self.app(scope, _replay([message], receive), send)
+                return
+            chunks.append(message.get("body", b""))
+            size += len(chunks[-1])
+            more = message.get("more_body", False)
+            if size > self.limit:
+                await self._too_large(f"a streamed body of more than {size} bytes")(scope, receive, send)
+                return
+        await self.app(
+            scope, _replay([{"type": "http.request", "body": b"".join(chunks), "more_body": False}], receive), send
+        )
+
+
+def _replay(messages: list[Message], receive: Receive) -> Receive:
+    async def replayed() -> Message:
+        return messages.pop(0) if messages else await receive()
+
+    return replayed
+
+
+# --------------------------------------------------------------------------- dependencies and checks
+
+
+def settings_of(request: Request) -> Settings:
+    return request.app.state.settings
+
+
+def runtime_of(request: Request) -> CurveRuntime:
+    if not request.app.state.ready or request.app.state.runtime is None:
+        raise HTTPException(503, "the model is not loaded yet; GET /ready answers 200 once it is")
+    return request.app.state.runtime
+
+
+SettingsDep = Annotated[Settings, Depends(settings_of)]
+RuntimeDep = Annotated[CurveRuntime, Depends(runtime_of)]
+
+
+def _check_curves(curves: list[list[tuple[float, float]]], settings: Settings) -> list[np.ndarray]:
+    if len(curves) > settings.max_curves:
+        raise InputError(("curves",), f"at most {settings.max_curves} curves per request, got {len(curves)}")
+    for i, curve in enumerate(curves):
+        if len(curve) > settings.max_points:
+            raise InputError(("curves", i), f"at most {settings.max_points} points per curve, got {len(curve)}")
+    return [np.asarray(c, dtype=np.float64) for c in curves]
+
+
+def _check_n_points(n_points: int | None, settings: Settings) -> None:
+    if n_points is not None and n_points > settings.max_points:
+        raise InputError(("n_points",), f"at most {settings.max_points}, got {n_points}")
+
+
+def _check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
+    n = len(req.curves)
+    if req.weights is None:
+        steps = req.steps if req.steps is not None else DEFAULT_STEPS
+        rows = simplex_grid_size(n, steps)
+        if rows > settings.max_curves:
+            raise InputError(
+                ("steps",),
+                f"{steps} steps over {n} curves make {rows} curves; at most {settings.max_curves} per response",
+            )
+        return simplex_grid(n, steps)
+    if len(req.weights) > settings.max_curves:
+        raise InputError(("weights",), f"at most {settings.max_curves} rows, got {len(req.weights)}")
+    for r, row in enumerate(req.weights):
+        if len(row) != n:
+            raise InputError(("weights", r), f"expected {n} numbers, one per input curve, got {len(row)}")
+        total = math.fsum(row)
+        if not abs(total - 1.0) <= WEIGHT_SUM_TOLERANCE:
+            raise InputError(("weights", r), f"weights must sum to 1, got {total:.9g}")
+    return np.array(req.weights, dtype=np.float64)
+
+
+def _frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
+    if not frames or frames[0] is None:
+        return None
+    return [{"center": list(f.center), "size": f.size} for f in frames if f is not None]
+
+
+async def _infer(request: Request, route: str, batch: int, fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
+    """Run `fn` in a worker thread (never on the event loop), timed, at most `inference_concurrency` at once."""
+    metrics: Metrics = request.app.state.metrics
+    metrics.batch_size.labels(route).observe(batch)
+    start = time.perf_counter()
+    try:
+        return await anyio.to_thread.run_sync(partial(fn, *args, **kwargs), limiter=request.app.state.limiter)
+    finally:
+        metrics.inference.labels(route).observe(time.perf_counter() - start)
+
+
+# --------------------------------------------------------------------------- OpenAPI documentation
+
+_ERR_EXAMPLES = {
+    413: (
+        "Request body over CURVE_VAE_MAX_BODY_BYTES.",
+        "body: a body of 9000000 bytes exceeds the limit of 8388608 bytes (CURVE_VAE_MAX_BODY_BYTES)",
+        "body",
+    ),
+    422: (
+        "Invalid input; the message names the field, curve and point.",
+        "curves[0][3][1]: not a finite number",
+        "curves[0][3][1]",
+    ),
+    503: (
+        "The model is not loaded yet (see GET /ready).",
+        "the model is not loaded yet; GET /ready answers 200 once it is",
+        None,
+    ),
+}
+
+
+def _errors(*codes: int) -> dict[int | str, dict[str, Any]]:
+    out: dict[int | str, dict[str, Any]] = {}
+    for code in codes:
+        description, detail, loc = _ERR_EXAMPLES[code]
+        errors = [{"loc": loc, "msg": detail.split(": ", 1)[1]}] if loc else []
+        out[code] = {
+            "model": s.ErrorResponse,
+            "description": description,
+            "content": {"application/json": {"example": {"detail": detail, "errors": errors}}},
+        }
+    return out
+
+
+def _curl(path: str, body: str | None = None) -> dict[str, Any]:
+    source = f"curl -s http://127.0.0.1:8000{path}"
+    if body is not None:
+        source += f" -H 'Content-Type: application/json' -d '{body}'"
+    return {"x-codeSamples": [{"lang": "Shell", "label": "curl", "source": source}]}
+
+
+def _example(summary: str, value: dict[str, Any]) -> dict[str, Any]:
+    return {"summary": summary, "value": value}
+
+
+_C1, _C2, _C3 = s.EXAMPLE_CURVE, s.EXAMPLE_CURVE_2, s.EXAMPLE_CURVE_3
+_POST_ERRORS = _errors(413, 422, 503)
+
+# --------------------------------------------------------------------------- routes
+
+curves_router = APIRouter(tags=["curves"])
+ops_router = APIRouter(tags=["operations"])
+
+
+@curves_router.post(
+    "/encode",
+    response_model=s.EncodeResponse,
+    responses=_POST_ERRORS,
+    summary="Latent mean and log-variance of each curve",
+    openapi_extra=_curl("/encode", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'),
+)
+async def encode(
+    request: Request,
+    runtime: RuntimeDep,
+    settings: SettingsDep,
+    req: Annotated[
+        s.EncodeRequest,
+        Body(
+            openapi_examples={
+                "one curve": _example("A curve in its own frame", {"curves": [_C1]}),
+                "model frame": _example(
+                    "Already in the 128×128 plane",
+                    {"curves": [[[14, 64], [40, 100], [64, 110], [90, 95], [114, 64]]], "frame": "model"},
+                ),
+            }
+        ),
+    ],
+) -> Response:
+    """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance)."""
+    curves = _check_curves(req.curves, settings)
+    mean, log_var, frames = await _infer(request, "/encode", len(curves), runtime.encode, curves, frame=req.frame)
+    return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": _frames_json(frames)})
+
+
+@curves_router.post(
+    "/decode",
+    response_model=s.CurvesResponse,
+    responses=_POST_ERRORS,
+    summary="Curves for latent vectors",
+    openapi_extra=_curl("/decode", '{"latents": [[' + ",".join(["0"] * 32) + ']], "n_points": 50}'),
+)
+async def decode(
+    request: Request,
+    runtime: RuntimeDep,
+    settings: SettingsDep,
+    req: Annotated[
+        s.DecodeRequest,
+        Body(
+            openapi_examples={
+                "origin": _example(
+                    "The centre of the latent space, 50 points", {"latents": [[0.0] * 32], "n_points": 50}
+                ),
+                "in a frame": _example(
+                    "Mapped into a frame from /encode",
+                    {"latents": [[0.0] * 32], "frames": [{"center": [4.0, 1.75], "size": 8.0}]},
+                ),
+            }
+        ),
+    ],
+) -> Response:
+    """Decode latent vectors (length latent_dim, see GET /model) into curves: the model's 128×128 plane, or `frames`."""
+    if len(req.latents) > settings.max_curves:
+        raise InputError(("latents",), f"at most {settings.max_curves} latents per request, got {len(req.latents)}")
+    for i, z in enumerate(req.latents):
+        if len(z) != runtime.latent_dim:
+            raise InputError(
+                ("latents", i), f"expected {runtime.latent_dim} numbers (the model's latent_dim), got {len(z)}"
+            )
+    if req.frames is not None and len(req.frames) != len(req.latents):
+        raise InputError(("frames",), f"expected one frame per latent ({len(req.latents)}), got {len(req.frames)}")
+    _check_n_points(req.n_points, settings)
+    frames = [Frame(center=f.center, size=f.size) for f in req.frames] if req.frames else None
+    curves = await _infer(
+        request,
+        "/decode",
+        len(req.latents),
+        runtime.decode,
+        np.array(req.latents, np.float64),
+        n_points=req.n_points,
+        frames=frames,
+    )
+    return JSONResponse({"curves": curves.tolist()})
+
+
+@curves_router.post(
+    "/reconstruct",
+    response_model=s.ReconstructResponse,
+    responses=_POST_ERRORS,
+    summary="Pass curves through the VAE",
+    openapi_extra=_curl("/reconstruct", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'),
+)
+async def reconstruct(
+    request: Request,
+    runtime: RuntimeDep,
+    settings: SettingsDep,
+    req: Annotated[
+        s.ReconstructRequest,
+        Body(
+            openapi_examples={
+                "one curve": _example("A curve in its own frame, back at its own 7 points", {"curves": [_C1]}),
+                "resampled": _example(
+                    "Two curves, returned at 100 points each", {"curves": [_C1, _C2], "n_points": 100}
+                ),
+            }
+        ),
+    ],
+) -> Response:
+    """Encode each curve's latent mean and decode it: the reconstruction in the caller's frame, and its MSE there."""
+    curves = _check_curves(req.curves, settings)
+    _check_n_points(req.n_points, settings)
+    out, mse = await _infer(
+        request, "/reconstruct", len(curves), runtime.reconstruct, curves, frame=req.frame, n_points=req.n_points
+    )
+    return JSONResponse({"curves": [c.tolist() for c in out], "mse": mse.tolist()})
+
+
+@curves_router.post(
+    "/interpolate",
+    response_model=s.InterpolateResponse,
+    responses=_POST_ERRORS,
+    summary="Curves between curves, by mixing latent means",
+    openapi_extra=_curl(
+        "/interpolate",
+        '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]], '
+        '[[0,0],[1.5,0.5],[3,2],[4,4],[5,6.5],[6.5,8],[8,8.5]]], "steps": 5}',
+    ),
+)
+async def interpolate(
+    request: Request,
+    runtime: RuntimeDep,
+    settings: SettingsDep,
+    req: Annotated[
+        s.InterpolateRequest,
+        Body(
+            openapi_examples={
+                "pair": _example(
+                    "Pair, 5 curves from the first to the second (paper eq. 9)", {"curves": [_C1, _C2], "steps": 5}
+                ),
+                "triplet": _example(
+                    "Triplet, barycentric grid of 6 curves (paper eq. 10)", {"curves": [_C1, _C2, _C3], "steps": 3}
+                ),
+                "weights": _example(
+                    "Explicit weights, one entry per curve", {"curves": [_C1, _C2], "weights": [[0.25, 0.75]]}
+                ),
+            }
+        ),
+    ],
+) -> Response:
+    """Decode affine combinations of the curves' latent means; with frame "auto" each result is mapped
+    into the same blend of the inputs' frames."""
+    curves = _check_curves(req.curves, settings)
+    _check_n_points(req.n_points, settings)
+    weights = _check_weights(req, settings)
+    out, frames = await _infer(
+        request,
+        "/interpolate",
+        len(weights),
+        runtime.interpolate,
+        curves,
+        weights,
+        frame=req.frame,
+        n_points=req.n_points,
+    )
+    return JSONResponse({"weights": weights.tolist(), "curves": out.tolist(), "frames": _frames_json(frames)})
+
+
+@ops_router.get("/health", response_model=s.StatusResponse, summary="Liveness", openapi_extra=_curl("/health"))
+async def health() -> dict[str, str]:
+    """200 while the process serves requests, model loaded or not."""
+    return {"status": "ok"}
+
+
+@ops_router.get(
+    "/ready",
+    response_model=s.StatusResponse,
+    responses=_errors(503),
+    summary="Readiness",
+    openapi_extra=_curl("/ready"),
+)
+async def ready(request: Request) -> dict[str, str]:
+    """200 once the model is loaded and a warm-up inference succeeded; 503 before that and while shutting down."""
+    runtime_of(request)
+    return {"status": "ready"}
+
+
+@ops_router.get(
+    "/model",
+    response_model=s.ModelInfo,
+    responses=_errors(503),
+    summary="The model being served",
+    openapi_extra=_curl("/model"),
+)
+async def model_info(runtime: RuntimeDep, settings: SettingsDep) -> dict[str, Any]:
+    """Name, version, dimensions and checksums from the manifest, and the providers the sessions actually use."""
+    m = runtime.manifest
+    return {
+        "name": m.get("name", "curve-vae"),
+        "version": str(m.get("version", "")),
+        "created": m.get("created"),
+        "variant": m.get("variant"),
+        "n_points": runtime.n_points,
+        "latent_dim": runtime.latent_dim,
+        "model_size": runtime.model_size,
+        "files": {k: {"sha256": v["sha256"], "bytes": v.get("bytes", 0)} for k, v in m["files"].items()},
+        "providers": runtime.providers,
+        "requested_providers": runtime.requested_providers,
+        "onnxruntime": ort.__version__,
+        "metrics": m.get("metrics"),
+        "limits": {
+            "max_curves": settings.max_curves,
+            "max_points": settings.max_points,
+            "max_body_bytes": settings.max_body_bytes,
+        },
+    }
+
+
+@ops_router.get(
+    "/metrics",
+    summary="Prometheus metrics",
+    response_class=Response,
+    openapi_extra=_curl("/metrics"),
+    responses={
+        200: {
+            "content": {
+                "text/plain": {
+                    "example": 'curve_vae_http_requests_total{method="POST",route="/encode",status="200"} 3.0\n'
+                }
+            },
+            "description": "Prometheus text exposition format.",
+        }
+    },
+)
+async def metrics(request: Request) -> Response:
+    """Request counts by route and status, request and inference latency histograms, batch sizes."""
+    body, content_type = request.app.state.metrics.render()
+    return Response(body, media_type=content_type)
+
+
+# --------------------------------------------------------------------------- the app
+
+
+@asynccontextmanager
+async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
+    settings: Settings = app.state.settings
+    owned = app.state.runtime is None
+    if owned:
+        try:
+            app.state.runtime = await anyio.to_thread.run_sync(
+                partial(
+                    CurveRuntime.load,
+                    settings.model_dir,
+                    providers=settings.providers,
+                    intra_op_threads=settings.intra_op_threads,
+                    batch_size=settings.batch_size,
+                )
+            )
+        except ModelLoadError as e:
+            log.error("cannot serve the model: %s", e)
+            raise
+    runtime: CurveRuntime = app.state.runtime
+    app.state.limiter = anyio.CapacityLimiter(settings.inference_concurrency)
+    app.state.ready = True
+    app.state.metrics.ready.set(1)
+    log.info(
+        "serving %s %s from %s on %s",
+        runtime.manifest.get("name"),
+        runtime.manifest.get("version"),
+        settings.model_dir,
+        runtime.providers,
+    )
+    try:
+        yield
+    finally:
+        app.state.ready = False
+        app.state.metrics.ready.set(0)
+        if owned:
+            app.state.runtime = None
+
+
+DESCRIPTION = """\
+An Inception VAE for 2D curves (Barzegar Khalilsaraei & Augsdörfer, WSCG 2025) behind REST.
+
+A curve is a JSON array of `[x, y]` points: any frame, any order of magnitude, any length ≥ 4.
+Every endpoint takes a batch. With `frame: "auto"` (the default) each curve is shifted and
+uniformly scaled into the model's frame and results are mapped back; curves whose length
+differs from the model's 161 points are resampled by arc length and come back at their own
+length, or `n_points`. Errors are JSON: `detail` names the field, curve and point.
+"""
+
+
+def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None = None) -> FastAPI:
+    """The app for `settings` (default: the environment). Pass a loaded `runtime` to share one between apps."""
+    from curve_vae import __version__
+
+    settings = settings or get_settings()
+    app = FastAPI(
+        title="curve-vae",
+        version=__version__,
+        description=DESCRIPTION,
+        lifespan=_lifespan,
+        generate_unique_id_function=lambda route: route.name,  # operationId "encode", not "encode_encode_post"
+        openapi_tags=[
+            {"name": "curves", "description": "Encode, decode, reconstruct and interpolate curves."},
+            {"name": "operations", "description": "Health, readiness, model metadata and metrics."},
+        ],
+    )
+    app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
+    app.state.metrics = Metrics()
+    app.include_router(curves_router)
+    app.include_router(ops_router)
+    app.add_exception_handler(RequestValidationError, _on_validation_error)
+    app.add_exception_handler(InputError, _on_input_error)
+    app.add_exception_handler(HTTPException, _on_http_error)
+    # Added last = outermost: metrics see everything, CORS headers reach 413s too.
+    app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes)
+    if settings.cors_origins:
+        app.add_middleware(
+            CORSMiddleware,
+            allow_origins=settings.cors_origins,
+            allow_methods=["GET", "POST"],
+            allow_headers=["Content-Type"],
+            max_age=600,
+        )
+    paths = [r.path for r in (*curves_router.routes, *ops_router.routes, *app.routes) if hasattr(r, "path")]
+    app.add_middleware(MetricsMiddleware, metrics=app.state.metrics, known_paths=paths)
+    return app
+
+
+def create_app_from_env() -> FastAPI:
+    """uvicorn factory for worker processes: settings from CURVE_VAE_* variables."""
+    return create_app(Settings())

@@ -1,0 +1,128 @@
+"""`curve-vae serve`: run the REST service under uvicorn.
+
+`configure_parser` adds the options to the `serve` subcommand and `run` starts the server.
+Every option falls back to its CURVE_VAE_* environment variable, then to the default in
+`service.settings.Settings`; a flag given on the command line wins over the environment.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import os
+import sys
+from typing import Any
+
+from pydantic import ValidationError
+
+from service.runtime import ModelLoadError, read_manifest, resolve_providers
+from service.settings import Settings
+
+# (flag, settings field, type, help); the default and variable are appended from Settings.
+_OPTIONS: list[tuple[str, str, Any, str]] = [
+    ("--host", "host", str, "interface to listen on; 0.0.0.0 for every interface"),
+    ("--port", "port", int, "TCP port; 0 picks a free one"),
+    ("--model-dir", "model_dir", str, "directory with encoder.onnx, decoder.onnx and manifest.json"),
+    ("--providers", "providers", str, "onnxruntime providers: cpu, cuda (an error where CUDA cannot load) or auto"),
+    ("--workers", "workers", int, "worker processes, each loading its own ONNX sessions"),
+    ("--log-level", "log_level", str, "uvicorn and service log level"),
+    ("--cors-origins", "cors_origins", str, "comma-separated origins allowed to call from a browser; empty: CORS off"),
+    ("--max-curves", "max_curves", int, "most curves, latents or interpolants per request"),
+    ("--max-points", "max_points", int, "most points per curve, in and out"),
+    ("--max-body-bytes", "max_body_bytes", int, "larger request bodies are answered 413"),
+    ("--batch-size", "batch_size", int, "curves per ONNX run"),
+    ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0 lets it choose"),
+    ("--inference-concurrency", "inference_concurrency", int, "inferences running at once"),
+]
+_CHOICES = {
+    "providers": ["cpu", "cuda", "auto"],
+    "log_level": ["critical", "error", "warning", "info", "debug", "trace"],
+}
+
+
+def configure_parser(parser: argparse.ArgumentParser) -> None:
+    """Add the serve options to `parser` (the `serve` subcommand's parser)."""
+    fields = Settings.model_fields
+    for flag, name, kind, text in _OPTIONS:
+        field = fields[name]
+        default = field.default_factory() if field.default_factory is not None else field.default  # type: ignore[call-arg]
+        default_text = ",".join(default) if isinstance(default, list) else default
+        parser.add_argument(
+            flag,
+            dest=name,
+            type=kind,
+            default=None,
+            choices=_CHOICES.get(name),
+            help=f"{text} (default: {default_text or 'none'}; env CURVE_VAE_{name.upper()})",
+        )
+
+
+def settings_from_args(args: argparse.Namespace) -> Settings:
+    """Settings from the environment, overridden by the flags that were given."""
+    overrides = {name: getattr(args, name) for _, name, _, _ in _OPTIONS if getattr(args, name, None) is not None}
+    return Settings(**overrides)
+
+
+def _as_env(settings: Settings) -> dict[str, str]:
+    out = {}
+    for name, value in settings.model_dump().items():
+        out[f"CURVE_VAE_{name.upper()}"] = json.dumps(value) if isinstance(value, list) else str(value)
+    return out
+
+
+def _log_config(level: str) -> dict[str, Any]:
+    """uvicorn's logging, with the service's own logger printed like uvicorn's."""
+    from uvicorn.config import LOGGING_CONFIG
+
+    config = copy.deepcopy(LOGGING_CONFIG)
+    config["loggers"]["service"] = {
+        "handlers": ["default"],
+        "level": level.upper() if level != "trace" else "DEBUG",
+        "propagate": False,
+    }
+    return config
+
+
+def run(args: argparse.Namespace) -> int:
+    """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
+    import uvicorn
+
+    try:
+        settings = settings_from_args(args)
+    except ValidationError as e:
+        problems = "; ".join(f"{'.'.join(map(str, err['loc']))}: {err['msg']}" for err in e.errors())
+        print(f"curve-vae serve: error: {problems}", file=sys.stderr)
+        return 2
+    try:  # the clear, early form of the errors the workers would hit at startup
+        read_manifest(settings.model_dir)
+        resolve_providers(settings.providers)
+    except ModelLoadError as e:
+        print(f"curve-vae serve: error: {e}", file=sys.stderr)
+        return 2
+    common = dict(
+        host=settings.host, port=settings.port, log_level=settings.log_level, log_config=_log_config(settings.log_level)
+    )
+    try:
+        if settings.workers == 1:
+            from service.app import create_app
+
+            uvicorn.run(create_app(settings), **common)  # type: ignore[arg-type]
+        else:
+            # Workers are fresh processes: they rebuild the same settings from the environment.
+            os.environ.update(_as_env(settings))
+            uvicorn.run("service.app:create_app_from_env", factory=True, workers=settings.workers, **common)  # type: ignore[arg-type]
+    except SystemExit as e:  # uvicorn exits 3 when the app fails to start
+        return e.code if isinstance(e.code, int) else 1
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """`python -m service.cli`: the same as `curve-vae serve`."""
+    parser = argparse.ArgumentParser(prog="curve-vae serve", description="Serve the curve VAE over REST.")
+    configure_parser(parser)
+    return run(parser.parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,86 @@
+"""Prometheus metrics of one app: request counts by route and status, latencies, batch sizes.
+
+Each app owns a CollectorRegistry, so several apps (tests, one per worker) never share or
+collide. With `--workers N` every worker answers /metrics with its own counts.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable
+
+from prometheus_client import CONTENT_TYPE_LATEST, CollectorRegistry, Counter, Gauge, Histogram, generate_latest
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+LATENCY_BUCKETS = (0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0)
+BATCH_BUCKETS = (1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 4096)
+UNMATCHED = "unmatched"  # route label of paths no route serves, so scanners cannot blow up the label set
+
+
+class Metrics:
+    """The app's collectors; `render()` gives the Prometheus text exposition."""
+
+    def __init__(self) -> None:
+        self.registry = CollectorRegistry()
+        self.requests = Counter(
+            "curve_vae_http_requests",
+            "HTTP requests answered, by route template and status.",
+            ["method", "route", "status"],
+            registry=self.registry,
+        )
+        self.latency = Histogram(
+            "curve_vae_http_request_duration_seconds",
+            "Time from request to the end of the response.",
+            ["method", "route"],
+            buckets=LATENCY_BUCKETS,
+            registry=self.registry,
+        )
+        self.batch_size = Histogram(
+            "curve_vae_batch_size",
+            "Curves (or latents) in each inference request; for /interpolate, curves returned.",
+            ["route"],
+            buckets=BATCH_BUCKETS,
+            registry=self.registry,
+        )
+        self.inference = Histogram(
+            "curve_vae_inference_duration_seconds",
+            "Time spent in pre-processing, ONNX runs and post-processing.",
+            ["route"],
+            buckets=LATENCY_BUCKETS,
+            registry=self.registry,
+        )
+        self.ready = Gauge("curve_vae_ready", "1 once the model is loaded and warmed up.", registry=self.registry)
+
+    def render(self) -> tuple[bytes, str]:
+        return generate_latest(self.registry), CONTENT_TYPE_LATEST
+
+
+class MetricsMiddleware:
+    """Counts and times every HTTP request, 413s and 404s included (pure ASGI, so streaming stays intact)."""
+
+    def __init__(self, app: ASGIApp, *, metrics: Metrics, known_paths: Iterable[str]) -> None:
+        self.app, self.metrics = app, metrics
+        self.known_paths = frozenset(known_paths)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        start = time.perf_counter()
+        status = 500  # what the client gets if the app raises before answering
+
+        async def send_wrapper(message: Message) -> None:
+            nonlocal status
+            if message["type"] == "http.response.start":
+                status = message["status"]
+            await send(message)
+
+        try:
+            await self.app(scope, receive, send_wrapper)
+        finally:
+            # The matched route's template; a request stopped before routing (413) is labelled by its path.
+            path = getattr(scope.get("route"), "path", None) or scope["path"]
+            label = path if path in self.known_paths else UNMATCHED
+            method = scope["method"]
+            self.metrics.requests.labels(method, label, str(status)).inc()
+            self.metrics.latency.labels(method, label).observe(time.perf_counter() - start)

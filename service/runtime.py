@@ -1,0 +1,459 @@
+"""The VAE at inference time: ONNX sessions plus the geometry that brings any curve to them and back.
+
+`CurveRuntime.load(model_dir)` checks the manifest and the sha256 of both graphs, opens
+one onnxruntime session per graph on the requested providers and runs a warm-up. Its
+methods take and return numpy arrays, so everything the service does can be tested
+without HTTP:
+
+    caller's curve (n, 2)  --fit_frame/to_model-->  model plane  --resample-->  (161, 2)
+        --encoder--> mean, log_var --(affine mix)--> decoder --> (161, 2) in the model plane
+        --back to n points, same spacing--> --from_model--> caller's frame
+
+With frame "model" the frame steps are skipped. Nothing here imports torch.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import onnxruntime as ort
+
+from geometry import Frame, blend_frames, fit_frame, mse_per_curve, resample
+
+log = logging.getLogger(__name__)
+
+FrameMode = Literal["auto", "model"]
+CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
+_F32_MAX = float(np.finfo(np.float32).max)
+_ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
+
+
+class ModelLoadError(RuntimeError):
+    """The model directory or the providers cannot serve: raised at startup, never per request."""
+
+
+class InputError(ValueError):
+    """A well-formed request the model cannot process; `loc` names the field, curve and point."""
+
+    def __init__(self, loc: Sequence[str | int], msg: str) -> None:
+        super().__init__(f"{format_loc(loc)}: {msg}")
+        self.loc = tuple(loc)
+        self.msg = msg
+
+
+def format_loc(loc: Sequence[str | int]) -> str:
+    """("curves", 2, 17, 1) -> "curves[2][17][1]"."""
+    out = ""
+    for part in loc:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out or "body"
+
+
+# --------------------------------------------------------------------------- model files
+
+
+def file_sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def read_manifest(model_dir: str | Path) -> dict[str, Any]:
+    """manifest.json of an exported model, after checking the fields and graph checksums the service uses."""
+    root = Path(model_dir)
+    path = root / "manifest.json"
+    if not path.is_file():
+        raise ModelLoadError(
+            f"no model in {root}: {path.name} is missing (export one with training/export.py, "
+            "or point --model-dir / CURVE_VAE_MODEL_DIR at a directory holding encoder.onnx, "
+            "decoder.onnx and manifest.json)"
+        )
+    try:
+        manifest = json.loads(path.read_text())
+        n_points, latent_dim = int(manifest["n_points"]), int(manifest["latent_dim"])
+        model_size = float(manifest["frame"]["model_size"])
+        files = manifest["files"]
+    except (ValueError, KeyError, TypeError) as e:
+        raise ModelLoadError(f"{path}: not a usable manifest ({type(e).__name__}: {e})") from e
+    if n_points < 4 or latent_dim < 1 or not (math.isfinite(model_size) and model_size > 0):
+        raise ModelLoadError(
+            f"{path}: implausible n_points={n_points}, latent_dim={latent_dim}, model_size={model_size}"
+        )
+    for graph in ("encoder", "decoder"):
+        name = graph_file(manifest, graph)
+        file = root / name
+        if not file.is_file():
+            raise ModelLoadError(f"{file} is missing (listed in {path})")
+        expected = (files.get(name) or {}).get("sha256")
+        if not expected:
+            raise ModelLoadError(f"{path} carries no sha256 for {name}")
+        actual = file_sha256(file)
+        if actual != expected:
+            raise ModelLoadError(
+                f"{file}: sha256 {actual} does not match the manifest's {expected}; "
+                "the graph was changed or truncated after export: re-export the model or restore the file"
+            )
+    return manifest
+
+
+def graph_file(manifest: dict[str, Any], graph: str) -> str:
+    return str(manifest.get("graphs", {}).get(graph, {}).get("file", f"{graph}.onnx"))
+
+
+def resolve_providers(choice: str) -> list[str]:
+    """onnxruntime provider list for "cpu", "cuda" or "auto"; "cuda" fails loudly when unavailable."""
+    available = ort.get_available_providers()
+    if choice == "cpu":
+        return [CPU]
+    if choice == "cuda":
+        if CUDA not in available:
+            raise ModelLoadError(
+                f"providers=cuda, but this onnxruntime ({ort.__version__}) offers only {available}: "
+                "install the GPU build (pip install 'curve-vae[gpu]', i.e. onnxruntime-gpu, in place of "
+                "onnxruntime) with CUDA 12 and cuDNN 9 libraries, or run with --providers cpu or auto"
+            )
+        return [CUDA, CPU]  # CPU takes any node CUDA has no kernel for
+    if choice == "auto":
+        return [CUDA, CPU] if CUDA in available else [CPU]
+    raise ModelLoadError(f"providers must be cpu, cuda or auto, got {choice!r}")
+
+
+# --------------------------------------------------------------------------- interpolation weights
+
+
+def simplex_grid(n_curves: int, steps: int) -> np.ndarray:
+    """Evenly spaced affine weights, one column per curve: all (i_1, …, i_n)/(steps-1) summing to 1.
+
+    Two curves give the even sweep of paper eq. 9 from [1, 0] to [0, 1] (steps rows); three
+    give the barycentric grid of eq. 10 (steps·(steps+1)/2 rows). First row: all weight on
+    the first curve; last row: all on the last.
+    """
+    if n_curves < 2 or steps < 2:
+        raise ValueError(f"need ≥ 2 curves and ≥ 2 steps, got {n_curves} and {steps}")
+
+    def compositions(total: int, parts: int) -> list[list[int]]:
+        if parts == 1:
+            return [[total]]
+        return [[i, *rest] for i in range(total, -1, -1) for rest in compositions(total - i, parts - 1)]
+
+    return np.array(compositions(steps - 1, n_curves), dtype=np.float64) / (steps - 1)
+
+
+def simplex_grid_size(n_curves: int, steps: int) -> int:
+    """Rows of `simplex_grid(n_curves, steps)`, without building it."""
+    return math.comb(steps - 1 + n_curves - 1, n_curves - 1)
+
+
+# --------------------------------------------------------------------------- curves in and out
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A batch of caller curves brought to the model, and what it takes to bring results back."""
+
+    model: np.ndarray  # (B, n_points, 2) float32 in the model plane
+    frames: list[Frame | None]  # the caller's frame of each curve; None for frame "model"
+    fractions: list[np.ndarray | None]  # arc-length position of each input point in [0, 1]; None if not resampled
+    inputs: list[np.ndarray]  # the caller's curves, float64
+
+
+def _arc_fractions(points: np.ndarray) -> np.ndarray:
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    return s / s[-1]
+
+
+def _at_fractions(curve: np.ndarray, fractions: np.ndarray) -> np.ndarray:
+    """Points of a model curve (m, 2) at the given positions: the inverse of an arc-length resample.
+
+    Model point j stands for the input at arc fraction j/(m-1), so the input's own points
+    come back where fraction·(m-1) falls, interpolated between neighbours.
+    """
+    x = np.clip(fractions, 0.0, 1.0) * (len(curve) - 1)
+    idx = np.arange(len(curve))
+    return np.stack([np.interp(x, idx, curve[:, 0]), np.interp(x, idx, curve[:, 1])], axis=1)
+
+
+class CurveRuntime:
+    """Encoder and decoder sessions of one exported model, with frame and length handling."""
+
+    def __init__(
+        self,
+        encoder: ort.InferenceSession,
+        decoder: ort.InferenceSession,
+        manifest: dict[str, Any],
+        *,
+        batch_size: int = 64,
+        requested_providers: str = "cpu",
+    ) -> None:
+        self.encoder, self.decoder, self.manifest = encoder, decoder, manifest
+        self.batch_size = batch_size
+        self.requested_providers = requested_providers
+        self.n_points = int(manifest["n_points"])
+        self.latent_dim = int(manifest["latent_dim"])
+        self.model_size = float(manifest["frame"]["model_size"])
+        self._enc_in = encoder.get_inputs()[0].name
+        self._dec_in = decoder.get_inputs()[0].name
+        self._check_signature()
+
+    @classmethod
+    def load(
+        cls,
+        model_dir: str | Path,
+        *,
+        providers: str = "auto",
+        intra_op_threads: int = 0,
+        batch_size: int = 64,
+        warm_up: bool = True,
+    ) -> CurveRuntime:
+        """Open a model directory; raises ModelLoadError with what to fix when it cannot serve."""
+        root = Path(model_dir)
+        manifest = read_manifest(root)
+        provider_list = resolve_providers(providers)
+        opts = ort.SessionOptions()
+        opts.intra_op_num_threads = intra_op_threads
+        opts.log_severity_level = 3  # errors only: provider fallbacks are reported by /model instead
+        sessions = []
+        for graph in ("encoder", "decoder"):
+            path = root / graph_file(manifest, graph)
+            try:
+                sessions.append(ort.InferenceSession(str(path), sess_options=opts, providers=provider_list))
+            except Exception as e:  # onnxruntime raises its own exception types
+                raise ModelLoadError(f"{path}: onnxruntime cannot open it on {provider_list}: {e}") from e
+            if providers == "cuda" and CUDA not in sessions[-1].get_providers():
+                raise ModelLoadError(
+                    f"providers=cuda, but the CUDA provider failed to load for {path.name} (session runs on "
+                    f"{sessions[-1].get_providers()}): check that the CUDA 12 and cuDNN 9 libraries of "
+                    "onnxruntime-gpu are installed and a GPU is visible, or run with --providers cpu or auto"
+                )
+        runtime = cls(*sessions, manifest, batch_size=batch_size, requested_providers=providers)
+        if warm_up:
+            runtime.warm_up()
+        return runtime
+
+    def _check_signature(self) -> None:
+        enc_in, dec_in = self.encoder.get_inputs()[0], self.decoder.get_inputs()[0]
+        enc_out = {o.name for o in self.encoder.get_outputs()}
+        problems = []
+        if list(enc_in.shape[1:]) != [self.n_points, 2]:
+            problems.append(
+                f"encoder input {enc_in.name} has shape {enc_in.shape}, expected [batch, {self.n_points}, 2]"
+            )
+        if not {"mean", "log_var"} <= enc_out:
+            problems.append(f"encoder outputs {sorted(enc_out)}, expected mean and log_var")
+        if list(dec_in.shape[1:]) != [self.latent_dim]:
+            problems.append(
+                f"decoder input {dec_in.name} has shape {dec_in.shape}, expected [batch, {self.latent_dim}]"
+            )
+        if problems:
+            raise ModelLoadError("graphs do not match the manifest: " + "; ".join(problems))
+
+    @property
+    def providers(self) -> list[str]:
+        """Providers the sessions actually run on (a fallback shows here)."""
+        return list(self.encoder.get_providers())
+
+    def warm_up(self) -> None:
+        """One full encode → decode round trip; raises ModelLoadError if the graphs misbehave."""
+        t = np.linspace(0.0, np.pi, self.n_points)
+        circle = np.stack([64 + 40 * np.cos(t), 64 + 40 * np.sin(t)], axis=1)[None].astype(np.float32)
+        try:
+            mean, log_var = self.encode_model(circle)
+            out = self.decode_model(mean)
+        except Exception as e:
+            raise ModelLoadError(f"warm-up inference failed: {e}") from e
+        if mean.shape != (1, self.latent_dim) or out.shape != (1, self.n_points, 2):
+            raise ModelLoadError(f"warm-up gave shapes {mean.shape}, {out.shape}")
+        if not (np.isfinite(mean).all() and np.isfinite(log_var).all() and np.isfinite(out).all()):
+            raise ModelLoadError("warm-up inference gave non-finite numbers: the weights are broken")
+
+    # ----------------------------------------------------------------------- raw graphs
+
+    def encode_model(self, curves: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(B, n_points, 2) in the model plane -> mean, log_var (B, latent_dim); split into runs of batch_size."""
+        x = np.ascontiguousarray(curves, dtype=np.float32)
+        means, log_vars = [], []
+        for i in range(0, len(x), self.batch_size):
+            mean, log_var = self.encoder.run(["mean", "log_var"], {self._enc_in: x[i : i + self.batch_size]})
+            means.append(mean)
+            log_vars.append(log_var)
+        if not means:
+            return np.zeros((0, self.latent_dim), np.float32), np.zeros((0, self.latent_dim), np.float32)
+        return np.concatenate(means), np.concatenate(log_vars)
+
+    def decode_model(self, latents: np.ndarray) -> np.ndarray:
+        """(B, latent_dim) -> (B, n_points, 2) in the model plane."""
+        z = np.ascontiguousarray(latents, dtype=np.float32)
+        outs = [
+            self.decoder.run(None, {self._dec_in: z[i : i + self.batch_size]})[0]
+            for i in range(0, len(z), self.batch_size)
+        ]
+        return np.concatenate(outs) if outs else np.zeros((0, self.n_points, 2), np.float32)
+
+    # ----------------------------------------------------------------------- caller's curves
+
+    def prepare(self, curves: Sequence[np.ndarray], frame: FrameMode = "auto", field: str = "curves") -> Prepared:
+        """Bring caller curves (each (n_i, 2), n_i ≥ 4) to the model's frame and point count."""
+        model, frames, fractions, inputs = [], [], [], []
+        with np.errstate(all="ignore"):
+            for i, c in enumerate(curves):
+                pts = np.asarray(c, dtype=np.float64)
+                try:
+                    f = fit_frame(pts) if frame == "auto" else None
+                except ValueError as e:  # all points coincide
+                    raise InputError((field, i), str(e)) from e
+                m = f.to_model(pts, self.model_size) if f is not None else pts
+                fraction = None
+                if len(pts) != self.n_points:
+                    fraction = _arc_fractions(m)
+                    m = resample(m, self.n_points)
+                if not (np.abs(m) <= _F32_MAX).all():  # also false for inf and nan
+                    raise InputError(
+                        (field, i),
+                        "its extent is too small or too large to map to the model's frame"
+                        if f is not None
+                        else 'coordinates beyond float32 range; use frame "auto"',
+                    )
+                model.append(m)
+                frames.append(f)
+                fractions.append(fraction)
+                inputs.append(pts)
+        batch = np.stack(model).astype(np.float32) if model else np.zeros((0, self.n_points, 2), np.float32)
+        return Prepared(batch, frames, fractions, inputs)
+
+    def _to_caller(
+        self,
+        out: np.ndarray,
+        frame: Frame | None,
+        *,
+        n_points: int | None,
+        fractions: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """One model-plane result (n_points_model, 2) -> the caller's frame and length.
+
+        n_points given: that many points, evenly spaced by arc length (the model's own
+        points when it equals the model's count and nothing else was asked). Otherwise the
+        input's positions (`fractions`), or the model's points as they are.
+        """
+        curve = np.asarray(out, np.float64)
+        if n_points is not None and n_points != len(curve):
+            curve = resample(curve, n_points)
+        elif n_points is None and fractions is not None:
+            curve = _at_fractions(curve, fractions)
+        return frame.from_model(curve, self.model_size) if frame is not None else curve
+
+    def encode(
+        self, curves: Sequence[np.ndarray], *, frame: FrameMode = "auto"
+    ) -> tuple[np.ndarray, np.ndarray, list[Frame | None]]:
+        """Latent mean and log-variance of each curve, and the frame each was mapped from."""
+        prep = self.prepare(curves, frame)
+        with np.errstate(all="ignore"):
+            mean, log_var = self.encode_model(prep.model)
+        _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+        _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
+        return mean, log_var, prep.frames
+
+    def decode(
+        self,
+        latents: np.ndarray,
+        *,
+        n_points: int | None = None,
+        frames: Sequence[Frame] | None = None,
+    ) -> np.ndarray:
+        """Curves (B, n, 2) for latents (B, latent_dim): in the model plane, or mapped to `frames`."""
+        z = np.asarray(latents, np.float64)
+        if z.ndim != 2 or z.shape[1] != self.latent_dim:
+            raise InputError(("latents",), f"expected rows of {self.latent_dim} numbers, got shape {list(z.shape)}")
+        _check_range(z, "latents")
+        with np.errstate(all="ignore"):
+            out = self.decode_model(z)
+            _check_finite(
+                out, "latents", "decodes to non-finite coordinates: the latent is far outside the training range"
+            )
+            curves = [self._to_caller(o, frames[i] if frames else None, n_points=n_points) for i, o in enumerate(out)]
+        result = np.stack(curves) if curves else np.zeros((0, n_points or self.n_points, 2))
+        _check_finite(result, "frames" if frames else "latents", "the result does not fit in float64")
+        return result
+
+    def reconstruct(
+        self, curves: Sequence[np.ndarray], *, frame: FrameMode = "auto", n_points: int | None = None
+    ) -> tuple[list[np.ndarray], np.ndarray]:
+        """Encode the means, decode them; the curves in the caller's frame and their MSE (paper eq. 4) there.
+
+        The MSE compares each input with its reconstruction at the input's own points,
+        whatever `n_points` asks for the returned curves.
+        """
+        prep = self.prepare(curves, frame)
+        with np.errstate(all="ignore"):
+            mean, _ = self.encode_model(prep.model)
+            _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+            out = self.decode_model(mean)
+            results, mse = [], np.empty(len(out))
+            for i, o in enumerate(out):
+                own = self._to_caller(o, prep.frames[i], n_points=None, fractions=prep.fractions[i])
+                mse[i] = mse_per_curve(prep.inputs[i][None], own[None])[0]
+                results.append(own if n_points is None else self._to_caller(o, prep.frames[i], n_points=n_points))
+                if not (np.isfinite(results[-1]).all() and np.isfinite(mse[i])):
+                    raise InputError(("curves", i), "the reconstruction does not fit in float64: scale the curve down")
+        return results, mse
+
+    def interpolate(
+        self,
+        curves: Sequence[np.ndarray],
+        weights: np.ndarray,
+        *,
+        frame: FrameMode = "auto",
+        n_points: int | None = None,
+    ) -> tuple[np.ndarray, list[Frame | None]]:
+        """Decode affine combinations of the curves' latent means (paper eqs. 9, 10), one per weight row.
+
+        weights: (rows, len(curves)), rows summing to 1. With frame "auto" each interpolant
+        comes back in the same blend of the inputs' frames. Length: n_points; else the
+        inputs' common length, keeping the blend of their point spacings; else the model's.
+        """
+        prep = self.prepare(curves, frame)
+        w = np.asarray(weights, np.float64)
+        lengths = {len(c) for c in prep.inputs}
+        with np.errstate(all="ignore"):
+            mean, _ = self.encode_model(prep.model)
+            _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+            z = w @ mean.astype(np.float64)  # (rows, latent_dim)
+            _check_range(z, "weights")
+            out = self.decode_model(z)
+            _check_finite(out, "weights", "the weighted latent decodes to non-finite coordinates: weights too extreme")
+            frames: list[Frame | None] = (
+                list(blend_frames([f for f in prep.frames if f is not None], w)) if frame == "auto" else [None] * len(w)
+            )
+            common = lengths.pop() if len(lengths) == 1 else None
+            results = []
+            for r, o in enumerate(out):
+                if n_points is None and common is not None and common != self.n_points:
+                    spacing = w[r] @ np.stack(prep.fractions)  # type: ignore[arg-type]
+                    spacing = np.maximum.accumulate(np.clip(spacing, 0.0, 1.0))  # extrapolating rows stay ordered
+                    results.append(self._to_caller(o, frames[r], n_points=None, fractions=spacing))
+                else:
+                    results.append(self._to_caller(o, frames[r], n_points=n_points))
+            result = np.stack(results)
+        _check_finite(result, "weights", "the interpolant does not fit in float64")
+        return result, frames
+
+
+def _check_finite(a: np.ndarray, field: str, msg: str) -> None:
+    bad = ~np.isfinite(a).reshape(len(a), -1).all(axis=1)
+    if bad.any():
+        raise InputError((field, int(np.argmax(bad))), msg)
+
+
+def _check_range(a: np.ndarray, field: str) -> None:
+    bad = ~(np.abs(a) <= _F32_MAX).reshape(len(a), -1).all(axis=1)
+    if bad.any():
+        raise InputError((field, int(np.argmax(bad))), "values beyond float32 range")

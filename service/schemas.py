@@ -1,0 +1,192 @@
+"""Request and response bodies of the v1 REST API, with the field docs and examples the OpenAPI page shows.
+
+Only what a schema can check on its own lives here (finite numbers, [x, y] pairs, ≥ 4
+points, ≥ 2 distinct points, either `steps` or `weights`). Limits that come from the
+settings or the loaded model (curves per request, points per curve, latent size, weight
+row length) are checked in `service.app`, with the same error format.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
+from pydantic_core import PydanticCustomError
+
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+Point = Annotated[tuple[FiniteFloat, FiniteFloat], Field(description="[x, y]")]
+
+
+def _distinct(curve: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    first = curve[0]
+    if all(p == first for p in curve):
+        raise PydanticCustomError(
+            "distinct_points", "all {n} points coincide: a curve needs at least 2 distinct points", {"n": len(curve)}
+        )
+    return curve
+
+
+Curve = Annotated[
+    list[Point],
+    Field(min_length=4, description="Ordered [x, y] points of an open curve: ≥ 4 points, ≥ 2 of them distinct."),
+    AfterValidator(_distinct),
+]
+
+FrameMode = Annotated[
+    Literal["auto", "model"],
+    Field(
+        description=(
+            '"auto": each curve is shifted and uniformly scaled into the model\'s frame and results are '
+            'mapped back, so curves may be anywhere at any size. "model": coordinates are already in the '
+            "paper's 128×128 plane (curves about 100 units across, centred on (64, 64)) and pass untouched."
+        )
+    ),
+]
+
+NPoints = Annotated[
+    int | None,
+    Field(
+        ge=4,
+        description=(
+            "Points per returned curve (at most CURVE_VAE_MAX_POINTS). Omitted: each curve keeps its input's "
+            "length and point spacing (the model's 161 points where there is no single input length). Given: the "
+            "model's points as they are when it equals 161, else that many points evenly spaced by arc length."
+        ),
+    ),
+]
+
+# A quarter-ellipse-like arc; any frame, any length ≥ 4: the examples work as pasted.
+EXAMPLE_CURVE = [[0.0, 0.0], [1.0, 2.0], [2.5, 3.2], [4.0, 3.5], [5.5, 3.0], [7.0, 1.5], [8.0, 0.0]]
+EXAMPLE_CURVE_2 = [[0.0, 0.0], [1.5, 0.5], [3.0, 2.0], [4.0, 4.0], [5.0, 6.5], [6.5, 8.0], [8.0, 8.5]]
+EXAMPLE_CURVE_3 = [[0.0, 4.0], [2.0, 5.0], [4.0, 4.0], [6.0, 2.0], [8.0, 1.0], [10.0, 2.0], [12.0, 4.0]]
+
+
+class _Request(BaseModel):
+    model_config = ConfigDict(extra="forbid")  # a misspelt field is an error, not silently ignored
+
+
+class FrameInfo(BaseModel):
+    """Where a curve lives: centre of its bounding box and its larger side."""
+
+    center: tuple[FiniteFloat, FiniteFloat] = Field(description="Bounding-box centre [x, y].")
+    size: Annotated[float, Field(gt=0, allow_inf_nan=False, description="Larger side of the bounding box.")]
+
+
+class EncodeRequest(_Request):
+    """Curves to encode into the latent space."""
+
+    curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
+    frame: FrameMode = "auto"
+
+
+class EncodeResponse(BaseModel):
+    mean: list[list[float]] = Field(description="Latent mean of each curve (batch × latent_dim).")
+    log_var: list[list[float]] = Field(description="Latent log-variance of each curve (batch × latent_dim).")
+    frames: list[FrameInfo] | None = Field(
+        description='The frame each curve was mapped from (frame "auto"); pass them to /decode to map back. '
+        'null for frame "model".'
+    )
+
+
+class DecodeRequest(_Request):
+    """Latent vectors to decode into curves."""
+
+    latents: list[list[FiniteFloat]] = Field(
+        min_length=1, description="One or more latent vectors, each of the model's latent_dim (see GET /model)."
+    )
+    n_points: NPoints = None
+    frames: list[FrameInfo] | None = Field(
+        None,
+        description="Optional frame per latent (as /encode returns them): curves are mapped into it. "
+        "Omitted: curves come back in the model's 128×128 plane.",
+    )
+
+
+class CurvesResponse(BaseModel):
+    curves: list[list[tuple[float, float]]] = Field(description="Curves as arrays of [x, y] points.")
+
+
+class ReconstructRequest(_Request):
+    """Curves to pass through the VAE (encode the latent mean, decode it)."""
+
+    curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
+    frame: FrameMode = "auto"
+    n_points: NPoints = None
+
+
+class ReconstructResponse(CurvesResponse):
+    mse: list[float] = Field(
+        description="Per curve: mean squared error over points and coordinates (paper eq. 4) between the input and "
+        "its reconstruction at the input's own points, in the caller's frame."
+    )
+
+
+class InterpolateRequest(_Request):
+    """Curves whose latent means are mixed (paper eqs. 9 and 10)."""
+
+    curves: list[Curve] = Field(
+        min_length=2, description="Two (pair), three (triplet) or more curves whose latent means are mixed."
+    )
+    steps: int | None = Field(
+        None,
+        ge=2,
+        description="Even grid of weights: for a pair, `steps` curves sweeping from the first curve (weights [1, 0]) "
+        "to the second ([0, 1]) inclusive; for a triplet, the barycentric grid (i, j, k)/(steps−1), "
+        "steps·(steps+1)/2 curves; likewise for more curves. Default 5 when `weights` is omitted too.",
+    )
+    weights: list[list[FiniteFloat]] | None = Field(
+        None,
+        min_length=1,
+        description="Explicit weight rows, one entry per input curve, each row summing to 1 (negative entries "
+        "extrapolate). One interpolant per row.",
+    )
+    frame: FrameMode = "auto"
+    n_points: NPoints = None
+
+    @model_validator(mode="after")
+    def _steps_or_weights(self) -> InterpolateRequest:
+        if self.steps is not None and self.weights is not None:
+            raise PydanticCustomError("steps_and_weights", "give either steps or weights, not both")
+        return self
+
+
+class InterpolateResponse(CurvesResponse):
+    weights: list[list[float]] = Field(description="The weight row of each returned curve, one entry per input curve.")
+    frames: list[FrameInfo] | None = Field(
+        description='Frame "auto": the blend of the inputs\' frames each interpolant was mapped into.'
+    )
+
+
+class ErrorItem(BaseModel):
+    loc: str = Field(description='Where: field, curve and point, e.g. "curves[2][17][1]".')
+    msg: str = Field(description="What is wrong there.")
+
+
+class ErrorResponse(BaseModel):
+    detail: str = Field(description="One line naming the bad field, curve and point, and what is wrong.")
+    errors: list[ErrorItem] = Field(default_factory=list, description="Every problem found, first one first.")
+
+
+class StatusResponse(BaseModel):
+    status: str
+
+
+class FileInfo(BaseModel):
+    sha256: str
+    bytes: int
+
+
+class ModelInfo(BaseModel):
+    name: str
+    version: str
+    created: str | None = None
+    variant: str | None = None
+    n_points: int = Field(description="Points per curve the model sees (161).")
+    latent_dim: int = Field(description="Length of every latent vector.")
+    model_size: float = Field(description='Bounding-box size curves are scaled to by frame "auto".')
+    files: dict[str, FileInfo] = Field(description="sha256 and size of each exported file, from the manifest.")
+    providers: list[str] = Field(description="onnxruntime execution providers the sessions actually run on.")
+    requested_providers: Literal["cpu", "cuda", "auto"]
+    onnxruntime: str
+    metrics: dict[str, Any] | None = Field(None, description="Evaluation results recorded at export, when present.")
+    limits: dict[str, int] = Field(description="Request limits of this server.")

@@ -1,0 +1,59 @@
+"""Service configuration: every option is a field here and an environment variable CURVE_VAE_<FIELD>.
+
+`curve-vae serve` flags override the environment; tests build `Settings(...)` directly and
+hand it to `create_app`. Nothing is read at import time: `get_settings()` reads the
+environment when it is called.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import Field, field_validator
+from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
+
+#: The shipped, trained model: `models/` at the repository root.
+DEFAULT_MODEL_DIR = Path(__file__).resolve().parent.parent / "models"
+
+Providers = Literal["cpu", "cuda", "auto"]
+
+
+class Settings(BaseSettings):
+    """Configuration of one service process (every worker reads the same)."""
+
+    model_config = SettingsConfigDict(env_prefix="CURVE_VAE_", extra="ignore", frozen=True)
+
+    host: str = "127.0.0.1"  # loopback by default; "0.0.0.0" to listen on every interface
+    port: int = Field(8000, ge=0, le=65535)  # 0 picks a free port
+    workers: int = Field(1, ge=1)  # uvicorn worker processes, each with its own ONNX sessions
+    log_level: Literal["critical", "error", "warning", "info", "debug", "trace"] = "info"
+    model_dir: Path = DEFAULT_MODEL_DIR  # encoder.onnx, decoder.onnx and manifest.json
+    providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
+    intra_op_threads: int = Field(0, ge=0)  # onnxruntime threads per inference; 0 lets it choose
+    inference_concurrency: int = Field(2, ge=1)  # inferences running at once; more only queue on a small CPU
+    batch_size: int = Field(64, ge=1)  # curves per ONNX run: large requests are split to bound memory
+    max_curves: int = Field(256, ge=1)  # curves (or latents, or interpolants) in one request or response
+    max_points: int = Field(4096, ge=4)  # points per curve, in and out
+    max_body_bytes: int = Field(8 << 20, ge=1024)  # larger request bodies get 413
+    # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
+    cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)
+
+    @field_validator("cors_origins", mode="before")
+    @classmethod
+    def _split_origins(cls, value: object) -> object:
+        if isinstance(value, str):
+            text = value.strip()
+            if text.startswith("["):
+                import json
+
+                return json.loads(text)
+            return [part.strip() for part in text.split(",") if part.strip()]
+        return value
+
+
+@lru_cache
+def get_settings() -> Settings:
+    """The process's settings, read from the environment once."""
+    return Settings()
