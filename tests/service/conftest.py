@@ -1,0 +1,150 @@
+"""Fixtures of the service tests: real exported ONNX models, loaded runtimes, apps and a live server.
+
+The exported model is untrained (fast to make, same graphs as the shipped one); tests that
+need a model that actually reconstructs use `shipped_runtime`, which skips only when
+models/manifest.json is absent.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import httpx
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from geometry import random_control_points, sample_bspline
+from service.app import create_app
+from service.runtime import CurveRuntime
+from service.settings import Settings
+
+ROOT = Path(__file__).resolve().parents[2]
+SHIPPED = ROOT / "models"
+
+
+@pytest.fixture(scope="session")
+def model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An untrained Inception VAE exported exactly as training/export.py ships one."""
+    from training.export import export
+    from training.model import VAE, ModelConfig
+
+    out = tmp_path_factory.mktemp("model")
+    export(VAE(ModelConfig()).eval(), out, model_size=100.0, weights=False)
+    return out
+
+
+@pytest.fixture(scope="session")
+def runtime(model_dir: Path) -> CurveRuntime:
+    return CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
+
+
+@pytest.fixture(scope="session")
+def shipped_runtime() -> CurveRuntime:
+    if not (SHIPPED / "manifest.json").is_file():
+        pytest.skip("no shipped model: models/manifest.json is absent")
+    return CurveRuntime.load(SHIPPED, providers="cpu", intra_op_threads=1)
+
+
+@pytest.fixture
+def make_client(model_dir: Path, runtime: CurveRuntime) -> Iterator[Callable[..., TestClient]]:
+    """make_client(**settings) -> a started TestClient; the app shares the session's runtime."""
+    clients: list[TestClient] = []
+
+    def make(*, share_runtime: bool = True, **overrides: object) -> TestClient:
+        settings = Settings(**{"model_dir": model_dir, **overrides})
+        client = TestClient(create_app(settings, runtime=runtime if share_runtime else None))
+        client.__enter__()
+        clients.append(client)
+        return client
+
+    yield make
+    for client in clients:
+        client.__exit__(None, None, None)
+
+
+@pytest.fixture
+def client(make_client: Callable[..., TestClient]) -> TestClient:
+    return make_client()
+
+
+def bspline_curves(count: int, n_points: int = 161, *, seed: int = 0) -> np.ndarray:
+    """(count, n_points, 2) curves of the paper's kind, in the 128×128 plane."""
+    return sample_bspline(random_control_points(np.random.default_rng(seed), count), n_points)
+
+
+@pytest.fixture
+def curves() -> Callable[..., np.ndarray]:
+    return bspline_curves
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class LiveServer:
+    """`python -m service.cli` (what `curve-vae serve` runs) in a subprocess on a free loopback port."""
+
+    def __init__(self, *args: str, env: dict[str, str] | None = None) -> None:
+        self.port = free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        cmd = [sys.executable, "-m", "service.cli", "--port", str(self.port), "--log-level", "warning", *args]
+        self.proc = subprocess.Popen(
+            cmd, cwd=ROOT, env={**os.environ, **(env or {})}, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+        )
+
+    def wait_ready(self, timeout: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"server exited with {self.proc.returncode}:\n{self.proc.stdout.read()}")  # type: ignore[union-attr]
+            try:
+                if httpx.get(f"{self.url}/ready", timeout=1.0).status_code == 200:
+                    return
+            except httpx.TransportError:
+                pass
+            time.sleep(0.1)
+        raise TimeoutError(f"{self.url} not ready after {timeout} s")
+
+    def stop(self) -> int:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self.proc.stdout.close()  # type: ignore[union-attr]
+        return self.proc.returncode
+
+
+@pytest.fixture
+def server_factory() -> Iterator[Callable[..., LiveServer]]:
+    """server_factory(*cli_args) -> a LiveServer, stopped at the end of the test."""
+    servers: list[LiveServer] = []
+
+    def start(*args: str, env: dict[str, str] | None = None) -> LiveServer:
+        servers.append(LiveServer(*args, env=env))
+        return servers[-1]
+
+    yield start
+    for server in servers:
+        server.stop()
+
+
+@pytest.fixture(scope="session")
+def live_server(model_dir: Path) -> Iterator[LiveServer]:
+    server = LiveServer("--model-dir", str(model_dir), "--providers", "cpu", "--max-body-bytes", "200000")
+    try:
+        server.wait_ready()
+        yield server
+    finally:
+        server.stop()

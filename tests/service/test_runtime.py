@@ -1,0 +1,236 @@
+"""CurveRuntime without HTTP: loading checks, providers, weight grids, frames and lengths (issue 4, item 3)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import onnxruntime as ort
+import pytest
+
+from geometry import blend_frames, fit_frame, mse_per_curve
+from service.runtime import CurveRuntime, InputError, ModelLoadError, resolve_providers, simplex_grid, simplex_grid_size
+
+# ----------------------------------------------------------------------------- loading
+
+
+def _copy(model_dir: Path, tmp_path: Path) -> Path:
+    out = tmp_path / "model"
+    shutil.copytree(model_dir, out)
+    return out
+
+
+def test_load_reports_cpu_provider(runtime):
+    assert runtime.providers[0] == "CPUExecutionProvider"
+    assert (runtime.n_points, runtime.latent_dim, runtime.model_size) == (161, 32, 100.0)
+
+
+def test_tampered_graph_is_a_startup_error(model_dir, tmp_path):
+    copy = _copy(model_dir, tmp_path)
+    with open(copy / "decoder.onnx", "ab") as f:
+        f.write(b"\0")
+    with pytest.raises(ModelLoadError, match=r"decoder\.onnx: sha256 .* does not match the manifest"):
+        CurveRuntime.load(copy, providers="cpu")
+
+
+def test_missing_manifest_is_a_startup_error(tmp_path):
+    with pytest.raises(ModelLoadError, match=r"manifest\.json is missing"):
+        CurveRuntime.load(tmp_path, providers="cpu")
+
+
+def test_manifest_without_checksum_is_a_startup_error(model_dir, tmp_path):
+    copy = _copy(model_dir, tmp_path)
+    manifest = json.loads((copy / "manifest.json").read_text())
+    del manifest["files"]["encoder.onnx"]
+    (copy / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ModelLoadError, match=r"no sha256 for encoder\.onnx"):
+        CurveRuntime.load(copy, providers="cpu")
+
+
+@pytest.mark.skipif("CUDAExecutionProvider" in ort.get_available_providers(), reason="CUDA is available here")
+def test_cuda_where_it_cannot_load_is_an_error_naming_the_fix():
+    with pytest.raises(ModelLoadError, match="onnxruntime-gpu"):
+        resolve_providers("cuda")
+
+
+def test_auto_takes_cuda_only_when_available():
+    expected = "CUDAExecutionProvider" if "CUDAExecutionProvider" in ort.get_available_providers() else "CPUExecutionProvider"
+    assert resolve_providers("auto")[0] == expected
+    assert resolve_providers("cpu") == ["CPUExecutionProvider"]
+
+
+# ----------------------------------------------------------------------------- weight grids
+
+
+def test_pair_steps_sweep_from_first_to_second_curve():
+    np.testing.assert_allclose(simplex_grid(2, 5), [[1, 0], [0.75, 0.25], [0.5, 0.5], [0.25, 0.75], [0, 1]])
+
+
+@pytest.mark.parametrize("n_curves,steps", [(2, 2), (3, 2), (3, 3), (3, 6), (4, 4)])
+def test_grids_are_barycentric(n_curves, steps):
+    w = simplex_grid(n_curves, steps)
+    assert w.shape == (simplex_grid_size(n_curves, steps), n_curves)
+    np.testing.assert_allclose(w.sum(axis=1), 1.0)
+    assert (w >= 0).all() and len(np.unique(w, axis=0)) == len(w)
+    np.testing.assert_array_equal(w[0], np.eye(n_curves)[0])
+    np.testing.assert_array_equal(w[-1], np.eye(n_curves)[-1])
+    assert set(np.round(w.ravel() * (steps - 1), 9)) <= set(range(steps))  # on the grid
+
+
+def test_triplet_grid_size():
+    assert len(simplex_grid(3, 5)) == 15  # steps·(steps+1)/2
+
+
+# ----------------------------------------------------------------------------- frames and lengths (item 3)
+
+
+@pytest.mark.parametrize(
+    "scale,shift",
+    [
+        pytest.param(1.0, (0.0, 0.0), id="identity"),
+        pytest.param(3.5, (100.0, -7.0), id="small"),
+        pytest.param(1e-3, (0.5, 0.25), id="tiny"),
+        pytest.param(250.0, (-4e4, 9e3), id="large"),
+        pytest.param(1e-9, (1.0, 2.0), id="nano"),
+        pytest.param(1e12, (3e12, -1e12), id="huge"),
+    ],
+)
+@pytest.mark.parametrize("n_points", [161, 50, 500])
+def test_reconstruction_follows_scale_and_shift(runtime, curves, scale, shift, n_points):
+    """reconstruct(c·s + t) == reconstruct(c)·s + t to float precision, at any length."""
+    c = curves(3, n_points, seed=1)
+    t = np.asarray(shift)
+    base, base_mse = runtime.reconstruct(list(c))
+    moved, moved_mse = runtime.reconstruct(list(c * scale + t))
+    for b, m in zip(base, moved, strict=True):
+        assert m.shape == (n_points, 2)
+        # float32 inside the graphs: a relative 1e-6 of the curve's size, plus rounding of the shift itself
+        tol = 1e-6 * 128 * scale + 1e-15 * np.abs(t).max()
+        np.testing.assert_allclose(m, b * scale + t, rtol=0, atol=tol)
+    np.testing.assert_allclose(moved_mse, base_mse * scale**2, rtol=1e-5)
+
+
+def test_model_frame_passes_coordinates_untouched(runtime, curves):
+    c = curves(2)
+    out, mse = runtime.reconstruct(list(c), frame="model")
+    mean, _ = runtime.encode_model(c)
+    direct = runtime.decode_model(mean)
+    np.testing.assert_array_equal(np.stack(out), direct.astype(np.float64))
+    np.testing.assert_allclose(mse, mse_per_curve(c, direct))
+
+
+def test_auto_frame_maps_into_and_out_of_the_model_frame(runtime, curves):
+    c = curves(1)[0] * 0.01 + 5.0
+    frame = fit_frame(c)
+    mean, _, frames = runtime.encode([c])
+    assert frames == [frame]
+    mean_model, _ = runtime.encode_model(frame.to_model(c, runtime.model_size)[None])
+    np.testing.assert_allclose(mean, mean_model, atol=1e-5)
+    out = runtime.decode(mean, frames=frames)
+    np.testing.assert_allclose(out[0], frame.from_model(runtime.decode_model(mean)[0], runtime.model_size))
+
+
+@pytest.mark.parametrize("n_out", [None, 10, 161, 1000])
+def test_lengths_in_and_out(runtime, curves, n_out):
+    inputs = [curves(1, 50)[0], curves(1, 161, seed=2)[0], curves(1, 733, seed=3)[0]]
+    out, mse = runtime.reconstruct(inputs, n_points=n_out)
+    assert [len(o) for o in out] == [n_out or len(c) for c in inputs]
+    assert mse.shape == (3,)
+
+
+def test_mse_is_measured_at_the_inputs_own_points(runtime, curves):
+    c = [curves(1, 50)[0] * 7.0, curves(1, 300, seed=4)[0] - 40.0]
+    own, mse = runtime.reconstruct(c)
+    resized, mse_again = runtime.reconstruct(c, n_points=20)
+    np.testing.assert_allclose(mse, [mse_per_curve(a[None], b[None])[0] for a, b in zip(c, own, strict=True)])
+    np.testing.assert_array_equal(mse, mse_again)
+    assert all(len(r) == 20 for r in resized)
+
+
+def _relative_errors(rt: CurveRuntime, ctrl: np.ndarray, n_points: int) -> np.ndarray:
+    from geometry import sample_bspline
+
+    c = sample_bspline(ctrl, n_points)
+    out, mse = rt.reconstruct(list(c))
+    sizes = np.array([fit_frame(x).size for x in c])
+    return np.sqrt(mse) / sizes
+
+
+def _check_length_independence(rt: CurveRuntime, factor: float) -> dict[int, float]:
+    from geometry import random_control_points
+
+    ctrl = random_control_points(np.random.default_rng(11), 24)
+    err = {n: float(np.median(_relative_errors(rt, ctrl, n))) for n in (50, 161, 500)}
+    assert err[50] <= factor * err[161], err
+    assert err[500] <= factor * err[161], err
+    return err
+
+
+def test_other_lengths_reconstruct_about_as_well(runtime):
+    """50- and 500-point versions of curves: error relative to size within a small factor of 161 points."""
+    _check_length_independence(runtime, factor=1.5)
+
+
+def test_other_lengths_reconstruct_about_as_well_with_the_shipped_model(shipped_runtime):
+    err = _check_length_independence(shipped_runtime, factor=3.0)
+    assert err[161] < 0.02, err  # a trained model: RMS error within 2% of the curve's size
+
+
+# ----------------------------------------------------------------------------- interpolation
+
+
+def test_pair_ends_are_the_reconstructions(runtime, curves):
+    a, b = curves(1, 161)[0] * 2 + 9, curves(1, 161, seed=5)[0] / 3
+    out, frames = runtime.interpolate([a, b], simplex_grid(2, 3))
+    rec, _ = runtime.reconstruct([a, b])
+    np.testing.assert_allclose(out[0], rec[0], atol=1e-9)
+    np.testing.assert_allclose(out[-1], rec[1], atol=1e-9)
+    assert frames[0] == fit_frame(a) and frames[-1] == fit_frame(b)
+    assert frames[1] == blend_frames([fit_frame(a), fit_frame(b)], np.array([[0.5, 0.5]]))[0]
+
+
+def test_interpolants_keep_a_common_input_length(runtime, curves):
+    a, b = curves(1, 60)[0], curves(1, 60, seed=6)[0] + 50
+    out, _ = runtime.interpolate([a, b], simplex_grid(2, 4))
+    rec, _ = runtime.reconstruct([a, b])
+    assert out.shape == (4, 60, 2)
+    np.testing.assert_allclose(out[0], rec[0], atol=1e-9)  # same spacing as the first input's reconstruction
+    mixed, _ = runtime.interpolate([a, curves(1, 70)[0]], simplex_grid(2, 2))
+    assert mixed.shape == (2, 161, 2)  # lengths differ: the model's
+    sized, _ = runtime.interpolate([a, b], simplex_grid(2, 2), n_points=33)
+    assert sized.shape == (2, 33, 2)
+
+
+def test_n_way_weights_mix_latent_means(runtime, curves):
+    c = list(curves(4, 161, seed=7))
+    w = np.array([[0.25, 0.25, 0.25, 0.25], [1.5, -0.5, 0.0, 0.0]])
+    out, frames = runtime.interpolate(c, w, frame="model")
+    mean, _ = runtime.encode_model(np.stack(c))
+    np.testing.assert_allclose(out, runtime.decode_model(w @ mean.astype(np.float64)), atol=1e-5)
+    assert frames == [None, None]
+
+
+# ----------------------------------------------------------------------------- inputs the model cannot take
+
+
+def test_coincident_points_are_an_input_error(runtime):
+    with pytest.raises(InputError, match="coincide") as e:
+        runtime.reconstruct([np.ones((10, 2)) * 3.0])
+    assert e.value.loc == ("curves", 0)
+
+
+@pytest.mark.parametrize("magnitude", [1e-320, 1e200])
+def test_magnitudes_beyond_float64_results_are_input_errors(runtime, curves, magnitude):
+    with pytest.raises(InputError):
+        runtime.reconstruct([curves(1)[0], curves(1)[0] * magnitude])
+
+
+@pytest.mark.parametrize("magnitude", [1e-290, 1e140])
+def test_extreme_but_representable_magnitudes_work(runtime, curves, magnitude):
+    c = curves(1)[0]
+    base, _ = runtime.reconstruct([c])
+    out, mse = runtime.reconstruct([c * magnitude])
+    np.testing.assert_allclose(out[0], base[0] * magnitude, rtol=1e-5, atol=0)
+    assert np.isfinite(mse).all()
