@@ -16,7 +16,6 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from service.runtime import ModelLoadError, read_manifest, resolve_providers
 from service.settings import Settings
 
 # (flag, settings field, type, help); the default and variable are appended from Settings.
@@ -87,6 +86,8 @@ def _log_config(level: str) -> dict[str, Any]:
 def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
+
+    from service.runtime import ModelLoadError, read_manifest, resolve_providers
 
     try:
         settings = settings_from_args(args)

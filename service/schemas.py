@@ -13,7 +13,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import PydanticCustomError
 
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # numbers only: no "1.5", no true
 Point = Annotated[tuple[FiniteFloat, FiniteFloat], Field(description="[x, y]")]
 
 
@@ -47,6 +47,7 @@ NPoints = Annotated[
     int | None,
     Field(
         ge=4,
+        strict=True,
         description=(
             "Points per returned curve (at most CURVE_VAE_MAX_POINTS). Omitted: each curve keeps its input's "
             "length and point spacing (the model's 161 points where there is no single input length). Given: the "
@@ -69,7 +70,9 @@ class FrameInfo(BaseModel):
     """Where a curve lives: centre of its bounding box and its larger side."""
 
     center: tuple[FiniteFloat, FiniteFloat] = Field(description="Bounding-box centre [x, y].")
-    size: Annotated[float, Field(gt=0, allow_inf_nan=False, description="Larger side of the bounding box.")]
+    size: Annotated[
+        float, Field(gt=0, strict=True, allow_inf_nan=False, description="Larger side of the bounding box.")
+    ]
 
 
 class EncodeRequest(_Request):
@@ -130,6 +133,7 @@ class InterpolateRequest(_Request):
     steps: int | None = Field(
         None,
         ge=2,
+        strict=True,
         description="Even grid of weights: for a pair, `steps` curves sweeping from the first curve (weights [1, 0]) "
         "to the second ([0, 1]) inclusive; for a triplet, the barycentric grid (i, j, k)/(steps−1), "
         "steps·(steps+1)/2 curves; likewise for more curves. Default 5 when `weights` is omitted too.",

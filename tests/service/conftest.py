@@ -32,9 +32,12 @@ SHIPPED = ROOT / "models"
 @pytest.fixture(scope="session")
 def model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """An untrained Inception VAE exported exactly as training/export.py ships one."""
+    import torch
+
     from training.export import export
     from training.model import VAE, ModelConfig
 
+    torch.manual_seed(0)  # the same untrained weights every run
     out = tmp_path_factory.mktemp("model")
     export(VAE(ModelConfig()).eval(), out, model_size=100.0, weights=False)
     return out
@@ -98,7 +101,12 @@ class LiveServer:
         self.url = f"http://127.0.0.1:{self.port}"
         cmd = [sys.executable, "-m", "service.cli", "--port", str(self.port), "--log-level", "warning", *args]
         self.proc = subprocess.Popen(
-            cmd, cwd=ROOT, env={**os.environ, **(env or {})}, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+            cmd,
+            cwd=ROOT,
+            env={**os.environ, **(env or {})},
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
         )
 
     def wait_ready(self, timeout: float = 30.0) -> None:

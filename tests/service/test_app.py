@@ -26,7 +26,9 @@ def test_encode(client, curves, runtime):
 
 
 def test_encode_model_frame_has_no_frames(client):
-    r = client.post("/encode", json={"curves": [[[14, 64], [40, 100], [64, 110], [90, 95], [114, 64]]], "frame": "model"})
+    r = client.post(
+        "/encode", json={"curves": [[[14, 64], [40, 100], [64, 110], [90, 95], [114, 64]]], "frame": "model"}
+    )
     assert r.status_code == 200 and r.json()["frames"] is None
 
 
@@ -66,7 +68,9 @@ def test_reconstruct(client, curves):
 def test_reconstruct_follows_scale_and_shift_over_http(client, curves):
     c = curves(1, 80, seed=3)[0]
     base = np.array(client.post("/reconstruct", json={"curves": [c.tolist()]}).json()["curves"][0])
-    moved = np.array(client.post("/reconstruct", json={"curves": [(c * 40 + [1e4, -3e3]).tolist()]}).json()["curves"][0])
+    moved = np.array(
+        client.post("/reconstruct", json={"curves": [(c * 40 + [1e4, -3e3]).tolist()]}).json()["curves"][0]
+    )
     np.testing.assert_allclose(moved, base * 40 + [1e4, -3e3], rtol=0, atol=1e-6 * 128 * 40 + 1e-11)
 
 
@@ -121,7 +125,9 @@ def test_health_ready_model(client, model_dir):
     info = client.get("/model").json()
     assert info["latent_dim"] == 32 and info["n_points"] == 161 and info["model_size"] == 100.0
     assert info["providers"] == ["CPUExecutionProvider"]
-    manifest_sha = __import__("json").loads((model_dir / "manifest.json").read_text())["files"]["encoder.onnx"]["sha256"]
+    manifest_sha = __import__("json").loads((model_dir / "manifest.json").read_text())["files"]["encoder.onnx"][
+        "sha256"
+    ]
     assert info["files"]["encoder.onnx"]["sha256"] == manifest_sha
     assert info["limits"]["max_curves"] == Settings().max_curves
 

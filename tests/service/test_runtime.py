@@ -56,7 +56,9 @@ def test_cuda_where_it_cannot_load_is_an_error_naming_the_fix():
 
 
 def test_auto_takes_cuda_only_when_available():
-    expected = "CUDAExecutionProvider" if "CUDAExecutionProvider" in ort.get_available_providers() else "CPUExecutionProvider"
+    expected = (
+        "CUDAExecutionProvider" if "CUDAExecutionProvider" in ort.get_available_providers() else "CPUExecutionProvider"
+    )
     assert resolve_providers("auto")[0] == expected
     assert resolve_providers("cpu") == ["CPUExecutionProvider"]
 

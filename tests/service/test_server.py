@@ -1,0 +1,159 @@
+"""A real uvicorn process on a loopback port (what `curve-vae serve` starts), called with httpx and curl."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import signal
+import subprocess
+from pathlib import Path
+
+import httpx
+import numpy as np
+import onnxruntime as ort
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+C = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
+
+
+def test_endpoints_over_a_socket(live_server, curves):
+    with httpx.Client(base_url=live_server.url, timeout=30) as http:
+        assert http.get("/health").json() == {"status": "ok"}
+        assert http.get("/model").json()["providers"] == ["CPUExecutionProvider"]
+        c = curves(2, 90) * 0.2 - 3
+        rec = http.post("/reconstruct", json={"curves": c.tolist()})
+        assert rec.status_code == 200 and np.shape(rec.json()["curves"]) == (2, 90, 2)
+        inter = http.post("/interpolate", json={"curves": c.tolist(), "steps": 4, "n_points": 30})
+        assert np.shape(inter.json()["curves"]) == (4, 30, 2)
+        bad = http.post(
+            "/encode",
+            content=b'{"curves": [[[0,0],[1,NaN],[2,3],[3,1]]]}',
+            headers={"Content-Type": "application/json"},
+        )
+        assert bad.status_code == 422 and bad.json()["detail"] == "curves[0][1][1]: not a finite number"
+        big = http.post("/encode", json={"curves": [np.linspace(0, 1, 8000).reshape(-1, 2).tolist()] * 10})
+        assert big.status_code == 413  # the server was started with --max-body-bytes 200000
+        metrics = http.get("/metrics").text
+        assert 'curve_vae_http_requests_total{method="POST",route="/encode",status="413"} 1.0' in metrics
+        assert 'curve_vae_http_requests_total{method="POST",route="/reconstruct",status="200"} 1.0' in metrics
+
+
+def test_concurrent_requests(live_server, curves):
+    """Inference runs off the event loop: /health answers while requests are in flight."""
+    import concurrent.futures as cf
+
+    body = {"curves": curves(16, 161).tolist()}  # under the server's 200 kB body limit
+    with httpx.Client(base_url=live_server.url, timeout=60) as http, cf.ThreadPoolExecutor(4) as pool:
+        futures = [pool.submit(http.post, "/reconstruct", json=body) for _ in range(3)]
+        assert http.get("/health", timeout=5).status_code == 200
+        assert all(f.result().status_code == 200 for f in futures)
+
+
+def _curl_blocks() -> list[str]:
+    text = (ROOT / "service" / "CURL.md").read_text()
+    return re.findall(r"```sh\n(.*?)```", text, flags=re.S)
+
+
+@pytest.mark.skipif(shutil.which("curl") is None, reason="curl is not installed")
+@pytest.mark.parametrize("block", _curl_blocks(), ids=lambda b: b.split("http://127.0.0.1:8000")[1].split()[0])
+def test_curl_examples_work_as_pasted(live_server, block):
+    if "| jq" in block and shutil.which("jq") is None:
+        pytest.skip("jq is not installed")
+    command = block.replace("http://127.0.0.1:8000", live_server.url)
+    out = subprocess.run(["bash", "-c", f"set -o pipefail\n{command}"], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    body = out.stdout.strip()
+    assert body
+    if "/metrics" in block:
+        assert "curve_vae_http_requests_total" in body
+        return
+    if "%{http_code}" in block:
+        body, status = body.rsplit("\n", 1)
+        assert status == "422" and json.loads(body)["detail"]
+        return
+    answer = json.loads(body)
+    assert "detail" not in answer, answer
+
+
+def test_two_workers(server_factory, model_dir):
+    """Workers are separate processes that rebuild the settings from the environment."""
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2", "--max-curves", "3")
+    server.wait_ready(timeout=60)
+    r = httpx.post(f"{server.url}/encode", json={"curves": [C] * 4}, timeout=30)
+    assert r.status_code == 422 and "at most 3 curves" in r.json()["detail"]
+    assert server.stop() == 0
+
+
+def test_sigterm_shuts_down_cleanly(server_factory, model_dir):
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--log-level", "info")
+    server.wait_ready()
+    server.proc.terminate()
+    # uvicorn shuts down gracefully, then re-raises the signal so the exit status tells it was terminated
+    assert server.proc.wait(timeout=20) in (0, -signal.SIGTERM)
+    log = server.proc.stdout.read()  # type: ignore[union-attr]
+    assert "Application shutdown complete" in log and "Traceback" not in log
+
+
+def test_a_model_that_fails_at_startup_stops_the_server(server_factory, model_dir, tmp_path):
+    broken = tmp_path / "model"
+    shutil.copytree(model_dir, broken)
+    manifest = json.loads((broken / "manifest.json").read_text())
+    manifest["latent_dim"] = 16  # checksums still match; the graphs do not
+    (broken / "manifest.json").write_text(json.dumps(manifest))
+    server = server_factory("--model-dir", str(broken), "--providers", "cpu")
+    assert server.proc.wait(timeout=60) == 3
+    assert "graphs do not match the manifest" in server.proc.stdout.read()  # type: ignore[union-attr]
+
+
+# ----------------------------------------------------------------------------- CLI configuration errors
+
+
+def _serve(*args: str) -> subprocess.CompletedProcess[str]:
+    import sys
+
+    cmd = [sys.executable, "-m", "service.cli", *args]
+    return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=60)
+
+
+@pytest.mark.skipif("CUDAExecutionProvider" in ort.get_available_providers(), reason="CUDA is available here")
+def test_cuda_where_unavailable_is_a_clear_startup_error(model_dir):
+    out = _serve("--model-dir", str(model_dir), "--providers", "cuda")
+    assert out.returncode == 2
+    assert "providers=cuda" in out.stderr and "onnxruntime-gpu" in out.stderr
+
+
+def test_configuration_errors(tmp_path, model_dir, capsys):
+    import argparse
+
+    from service.cli import configure_parser, run
+
+    parser = argparse.ArgumentParser()
+    configure_parser(parser)
+    assert run(parser.parse_args(["--model-dir", str(tmp_path)])) == 2
+    assert "manifest.json is missing" in capsys.readouterr().err
+    assert run(parser.parse_args(["--model-dir", str(model_dir), "--max-points", "2"])) == 2
+    assert "max_points" in capsys.readouterr().err
+
+
+def test_help_names_defaults_and_variables():
+    out = _serve("--help")
+    assert out.returncode == 0
+    for text in ("--providers", "CURVE_VAE_PROVIDERS", "default: auto", "--model-dir", "CURVE_VAE_MAX_BODY_BYTES"):
+        assert text in out.stdout
+
+
+def test_flags_override_the_environment(monkeypatch):
+    import argparse
+
+    from service.cli import configure_parser, settings_from_args
+
+    monkeypatch.setenv("CURVE_VAE_PORT", "9001")
+    monkeypatch.setenv("CURVE_VAE_WORKERS", "3")
+    parser = argparse.ArgumentParser()
+    configure_parser(parser)
+    settings = settings_from_args(
+        parser.parse_args(["--port", "9002", "--cors-origins", "https://a.example,https://b"])
+    )
+    assert (settings.port, settings.workers, settings.cors_origins) == (9002, 3, ["https://a.example", "https://b"])

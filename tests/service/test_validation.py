@@ -1,0 +1,340 @@
+"""Every validation rule gets the bad input it exists for: a 4xx whose message names field, curve and point.
+
+No input may produce a 5xx: the last tests throw malformed and extreme bodies at every endpoint.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+C = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]  # a valid curve
+Z = [0.0] * 32  # a valid latent
+LIMITS = {"max_curves": 4, "max_points": 300, "max_body_bytes": 20_000}
+
+
+def _with(curve_index: int, point_index: int, coord: int, value: object) -> list:
+    curves = [list(map(list, C)) for _ in range(3)]
+    curves[curve_index][point_index][coord] = value
+    return curves
+
+
+@pytest.fixture
+def limited(make_client):
+    return make_client(**LIMITS)
+
+
+# (path, JSON body or raw text, expected status, expected start of "detail")
+CASES = [
+    # --- numbers
+    pytest.param(
+        "/encode", '{"curves": [[[0,0],[1,2],[2,3],[3,NaN]]]}', 422, "curves[0][3][1]: not a finite number", id="nan"
+    ),
+    pytest.param(
+        "/encode",
+        '{"curves": [[[0,0],[1,2],[Infinity,3],[3,1]]]}',
+        422,
+        "curves[0][2][0]: not a finite number",
+        id="infinity",
+    ),
+    pytest.param(
+        "/encode",
+        '{"curves": [[[0,0],[1,2],[2,3],[3,1]], [[0,0],[1,-1e999],[2,3],[3,1]]]}',
+        422,
+        "curves[1][1][1]: not a finite number",
+        id="overflowing-literal",
+    ),
+    pytest.param("/encode", {"curves": _with(2, 5, 0, "x")}, 422, "curves[2][5][0]: not a number", id="string"),
+    pytest.param("/encode", {"curves": _with(1, 6, 1, None)}, 422, "curves[1][6][1]: not a number", id="null"),
+    pytest.param("/encode", {"curves": _with(0, 0, 0, True)}, 422, "curves[0][0][0]: not a number", id="boolean"),
+    # --- points and curves
+    pytest.param(
+        "/encode",
+        {"curves": [[[0, 0], [1, 2, 3], [2, 3], [3, 1]]]},
+        422,
+        "curves[0][1]: a point is [x, y]: exactly 2 numbers, got 3",
+        id="three-coordinates",
+    ),
+    pytest.param(
+        "/encode",
+        {"curves": [[[0, 0], [1], [2, 3], [3, 1]]]},
+        422,
+        "curves[0][1][1]: field required",
+        id="one-coordinate",
+    ),
+    pytest.param(
+        "/encode",
+        {"curves": [[[0, 0], 5, [2, 3], [3, 1]]]},
+        422,
+        "curves[0][1]: a point is [x, y]",
+        id="point-not-a-pair",
+    ),
+    pytest.param(
+        "/encode",
+        {"curves": [C, [[0, 0], [1, 1], [2, 0]]]},
+        422,
+        "curves[1]: a curve needs at least 4 points, got 3",
+        id="three-points",
+    ),
+    pytest.param(
+        "/reconstruct",
+        {"curves": [C, C, [[2, 2]] * 9]},
+        422,
+        "curves[2]: all 9 points coincide",
+        id="coincident-points",
+    ),
+    pytest.param("/encode", {"curves": []}, 422, "curves: List should have at least 1 item", id="no-curves"),
+    pytest.param("/encode", {"curves": C}, 422, "curves[0][0]: a point is [x, y]", id="curve-not-nested"),
+    pytest.param(
+        "/encode", {"curves": _with(0, 2, 1, "1.5")}, 422, "curves[0][2][1]: not a number", id="numeric-string"
+    ),
+    pytest.param("/encode", {}, 422, "curves: field required", id="missing-curves"),
+    # --- fields
+    pytest.param(
+        "/encode", {"curves": [C], "frame": "pixels"}, 422, "frame: Input should be 'auto' or 'model'", id="bad-frame"
+    ),
+    pytest.param("/reconstruct", {"curves": [C], "npoints": 50}, 422, "npoints: unknown field", id="misspelt-field"),
+    pytest.param(
+        "/reconstruct",
+        {"curves": [C], "n_points": 3},
+        422,
+        "n_points: Input should be greater than or equal to 4",
+        id="n-points-too-small",
+    ),
+    pytest.param(
+        "/reconstruct", {"curves": [C], "n_points": 2.5}, 422, "n_points: not an integer", id="n-points-fraction"
+    ),
+    pytest.param(
+        "/reconstruct", {"curves": [C], "n_points": "50"}, 422, "n_points: not an integer", id="n-points-string"
+    ),
+    # --- latents
+    pytest.param(
+        "/decode",
+        {"latents": [Z, [0.0] * 31]},
+        422,
+        "latents[1]: expected 32 numbers (the model's latent_dim), got 31",
+        id="latent-too-short",
+    ),
+    pytest.param("/decode", {"latents": [Z + [0.0]]}, 422, "latents[0]: expected 32 numbers", id="latent-too-long"),
+    pytest.param("/decode", {"latents": []}, 422, "latents: List should have at least 1 item", id="no-latents"),
+    pytest.param(
+        "/decode",
+        '{"latents": [[' + ",".join(["0"] * 31) + ",NaN]]}",
+        422,
+        "latents[0][31]: not a finite number",
+        id="latent-nan",
+    ),
+    pytest.param(
+        "/decode",
+        {"latents": [[1e300] * 32]},
+        422,
+        "latents[0]: values beyond float32 range",
+        id="latent-beyond-float32",
+    ),
+    pytest.param(
+        "/decode",
+        {"latents": [Z, Z], "frames": [{"center": [0, 0], "size": 1}]},
+        422,
+        "frames: expected one frame per latent (2), got 1",
+        id="frames-count",
+    ),
+    pytest.param(
+        "/decode",
+        {"latents": [Z], "frames": [{"center": [0, 0], "size": 0}]},
+        422,
+        "frames[0].size: Input should be greater than 0",
+        id="frame-size-zero",
+    ),
+    # --- interpolation
+    pytest.param("/interpolate", {"curves": [C]}, 422, "curves: List should have at least 2 items", id="one-curve"),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C], "steps": 1},
+        422,
+        "steps: Input should be greater than or equal to 2",
+        id="one-step",
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C], "steps": 3, "weights": [[1, 0]]},
+        422,
+        "body: give either steps or weights, not both",
+        id="steps-and-weights",
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C, C], "weights": [[0.5, 0.5, 0], [0.5, 0.5]]},
+        422,
+        "weights[1]: expected 3 numbers, one per input curve, got 2",
+        id="weights-row-length",
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C], "weights": [[0.5, 0.5], [0.6, 0.6]]},
+        422,
+        "weights[1]: weights must sum to 1, got 1.2",
+        id="weights-sum",
+    ),
+    pytest.param(
+        "/interpolate",
+        '{"curves": [[[0,0],[1,2],[2,3],[3,1]], [[0,0],[1,2],[2,3],[3,1]]], "weights": [[NaN, 1]]}',
+        422,
+        "weights[0][0]: not a finite number",
+        id="weights-nan",
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C], "weights": [[1e30, 1 - 1e30]]},
+        422,
+        "weights[0]: weights must sum to 1, got 0",
+        id="weights-cancelling",
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C], "weights": []},
+        422,
+        "weights: List should have at least 1 item",
+        id="no-weights",
+    ),
+    # --- the body
+    pytest.param("/encode", '{"curves": [[[0,0],[1,2]', 422, "body: invalid JSON", id="truncated-json"),
+    pytest.param("/encode", "[1, 2, 3]", 422, "body: expected a JSON object", id="array-body"),
+    pytest.param("/encode", "", 422, "body: field required", id="empty-body"),
+]
+
+
+@pytest.mark.parametrize("path,body,status,detail", CASES)
+def test_bad_input_is_rejected_with_a_message_naming_where(client, path, body, status, detail):
+    if isinstance(body, str):
+        r = client.post(path, content=body, headers={"Content-Type": "application/json"})
+    else:
+        r = client.post(path, json=body)
+    assert r.status_code == status, r.text
+    out = r.json()
+    assert out["detail"].startswith(detail), out["detail"]
+    assert out["errors"] and out["errors"][0]["loc"] == detail.split(":")[0]
+
+
+LIMIT_CASES = [
+    pytest.param("/encode", {"curves": [C] * 5}, "curves: at most 4 curves per request, got 5", id="too-many-curves"),
+    pytest.param(
+        "/reconstruct",
+        {"curves": [C, np.linspace(0, 1, 602).reshape(301, 2).tolist()]},
+        "curves[1]: at most 300 points per curve, got 301",
+        id="too-many-points",
+    ),
+    pytest.param(
+        "/reconstruct", {"curves": [C], "n_points": 301}, "n_points: at most 300, got 301", id="n-points-over-limit"
+    ),
+    pytest.param(
+        "/decode", {"latents": [Z] * 5}, "latents: at most 4 latents per request, got 5", id="too-many-latents"
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C], "steps": 5},
+        "steps: 5 steps over 2 curves make 5 curves; at most 4",
+        id="steps-over-limit",
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C, C], "steps": 3},
+        "steps: 3 steps over 3 curves make 6 curves",
+        id="triplet-grid-over-limit",
+    ),
+    pytest.param(
+        "/interpolate",
+        {"curves": [C, C], "weights": [[1, 0]] * 5},
+        "weights: at most 4 rows, got 5",
+        id="too-many-weight-rows",
+    ),
+]
+
+
+@pytest.mark.parametrize("path,body,detail", LIMIT_CASES)
+def test_configured_limits(limited, path, body, detail):
+    r = limited.post(path, json=body)
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"].startswith(detail), r.json()["detail"]
+
+
+def test_body_over_the_limit_is_413(limited):
+    big = {"curves": [np.linspace(0, 1, 600).reshape(300, 2).tolist()] * 4}
+    r = limited.post("/reconstruct", json=big)
+    assert r.status_code == 413
+    assert r.json()["detail"].startswith("body: a body of") and "20000 bytes" in r.json()["detail"]
+
+
+def test_streamed_body_over_the_limit_is_413(limited):
+    def chunks():  # no Content-Length: the limit must hold while reading
+        yield b'{"curves": ['
+        for _ in range(100):
+            yield json.dumps(C).encode() * 5 + b","
+        yield b"]}"
+
+    r = limited.post("/encode", content=chunks(), headers={"Content-Type": "application/json"})
+    assert r.status_code == 413 and "streamed body" in r.json()["detail"]
+
+
+def test_form_encoded_body_gets_a_hint(client):
+    r = client.post(
+        "/encode", content=json.dumps({"curves": [C]}), headers={"Content-Type": "application/x-www-form-urlencoded"}
+    )
+    assert r.status_code == 422 and "Content-Type: application/json" in r.json()["detail"]
+
+
+@pytest.mark.parametrize(
+    "path,body",
+    [
+        pytest.param("/reconstruct", {"curves": [(np.array(C) * 1e200).tolist()]}, id="huge-coordinates"),
+        pytest.param("/reconstruct", {"curves": [(np.array(C) * 1e-320).tolist()]}, id="subnormal-extent"),
+        pytest.param("/encode", {"curves": [(np.array(C) * 1e300).tolist()], "frame": "model"}, id="huge-model-frame"),
+        pytest.param(
+            "/reconstruct", {"curves": [(np.array(C) * 1e30).tolist()], "frame": "model"}, id="far-model-frame"
+        ),
+        pytest.param("/decode", {"latents": [[3e38] * 32]}, id="latent-near-float32-max"),
+        pytest.param("/interpolate", {"curves": [C, C], "weights": [[1e38, 1 - 1e38 + 1]]}, id="extreme-weights"),
+        pytest.param(
+            "/interpolate",
+            {"curves": [C, (np.array(C) * 1e-6).tolist()], "weights": [[-1e6, 1e6 + 1]]},
+            id="frame-extrapolation",
+        ),
+        pytest.param("/decode", {"latents": [Z], "n_points": 10**12}, id="n-points-huge"),
+        pytest.param(
+            "/decode",
+            {"latents": [Z], "frames": [{"center": [1.7e308, -1.7e308], "size": 1.7e308}]},
+            id="frame-overflow",
+        ),
+        pytest.param("/interpolate", {"curves": [C, C], "steps": 10**40}, id="steps-huge"),
+    ],
+)
+def test_extreme_inputs_never_give_5xx(client, path, body):
+    r = client.post(path, json=body)
+    assert r.status_code < 500, r.text
+    if r.status_code != 200:
+        assert r.json()["errors"][0]["loc"]
+
+
+@pytest.mark.parametrize("path", ["/encode", "/decode", "/reconstruct", "/interpolate"])
+def test_garbage_never_gives_5xx(client, path):
+    bodies = [
+        "null",
+        "0",
+        '"x"',
+        "{}",
+        '{"curves": null}',
+        '{"curves": [[]]}',
+        '{"curves": [[[]]]}',
+        '{"latents": [[]]}',
+        '{"curves": {"a": 1}}',
+        '{"latents": "z"}',
+        "\xff\xfe",
+        "{" * 1000 + "}" * 1000,
+    ]
+    for body in bodies:
+        r = client.post(
+            path, content=body.encode("utf-8", "surrogateescape"), headers={"Content-Type": "application/json"}
+        )
+        assert 400 <= r.status_code < 500, (body[:50], r.status_code, r.text)
+        assert r.json()["detail"]
