@@ -434,6 +434,102 @@ async def interpolate(
     return JSONResponse({"weights": weights.tolist(), "curves": out.tolist(), "frames": _frames_json(frames)})
 
 
+@curves_router.post(
+    "/sample",
+    response_model=s.SampleResponse,
+    responses=_POST_ERRORS,
+    summary="New curves from the latent prior",
+    openapi_extra=_curl("/sample", '{"count": 3, "seed": 7, "n_points": 50}'),
+)
+async def sample(
+    request: Request,
+    runtime: RuntimeDep,
+    settings: SettingsDep,
+    req: Annotated[
+        s.SampleRequest,
+        Body(
+            openapi_examples={
+                "seeded": _example("Three curves, reproducible", {"count": 3, "seed": 7, "n_points": 50}),
+                "tame": _example("Closer to typical shapes", {"count": 2, "seed": 1, "temperature": 0.5}),
+            }
+        ),
+    ],
+) -> Response:
+    """Decode latents drawn from N(0, temperature²·I) into curves in the model's 128×128 plane."""
+    if req.count > settings.max_curves:
+        raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
+    _check_n_points(req.n_points, settings)
+    latents, curves = await _infer(
+        request,
+        "/sample",
+        req.count,
+        runtime.sample,
+        req.count,
+        seed=req.seed,
+        temperature=req.temperature,
+        n_points=req.n_points,
+    )
+    return JSONResponse({"latents": latents.tolist(), "curves": curves.tolist()})
+
+
+@curves_router.post(
+    "/augment",
+    response_model=s.AugmentResponse,
+    responses=_POST_ERRORS,
+    summary="New curves between given curves",
+    openapi_extra=_curl(
+        "/augment",
+        '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]], '
+        "[[0,0],[1.5,0.5],[3,2],[4,4],[5,6.5],[6.5,8],[8,8.5]], "
+        '[[0,4],[2,5],[4,4],[6,2],[8,1],[10,2],[12,4]]], "count": 4, "mode": "triplet", "seed": 1}',
+    ),
+)
+async def augment(
+    request: Request,
+    runtime: RuntimeDep,
+    settings: SettingsDep,
+    req: Annotated[
+        s.AugmentRequest,
+        Body(
+            openapi_examples={
+                "pairs": _example("Four random pair interpolants", {"curves": [_C1, _C2, _C3], "count": 4, "seed": 1}),
+                "triplets": _example(
+                    "Two random triplet interpolants", {"curves": [_C1, _C2, _C3], "count": 2, "mode": "triplet"}
+                ),
+            }
+        ),
+    ],
+) -> Response:
+    """Random interpolants of random pairs or triplets of the curves, each in the blend of its sources' frames:
+    new training data between the given curves."""
+    curves = _check_curves(req.curves, settings)
+    if req.mode == "triplet" and len(curves) < 3:
+        raise InputError(("curves",), f"mode triplet needs at least 3 curves, got {len(curves)}")
+    if req.count > settings.max_curves:
+        raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
+    _check_n_points(req.n_points, settings)
+    out, sources, weights, frames = await _infer(
+        request,
+        "/augment",
+        req.count,
+        runtime.augment,
+        curves,
+        req.count,
+        mode=req.mode,
+        seed=req.seed,
+        frame=req.frame,
+        n_points=req.n_points,
+    )
+    return JSONResponse(
+        {
+            "curves": out.tolist(),
+            "sources": sources.tolist(),
+            "weights": weights.tolist(),
+            "frames": _frames_json(frames),
+        }
+    )
+
+
 @ops_router.get("/health", response_model=s.StatusResponse, summary="Liveness", openapi_extra=_curl("/health"))
 async def health() -> dict[str, str]:
     """200 while the process serves requests, model loaded or not."""
@@ -570,7 +666,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
         lifespan=_lifespan,
         generate_unique_id_function=lambda route: route.name,  # operationId "encode", not "encode_encode_post"
         openapi_tags=[
-            {"name": "curves", "description": "Encode, decode, reconstruct and interpolate curves."},
+            {"name": "curves", "description": "Encode, decode, reconstruct, interpolate, sample and augment curves."},
             {"name": "operations", "description": "Health, readiness, model metadata and metrics."},
         ],
     )

@@ -446,6 +446,41 @@ class CurveRuntime:
         _check_finite(result, "weights", "the interpolant does not fit in float64")
         return result, frames
 
+    def sample(
+        self, count: int, *, seed: int | None = None, temperature: float = 1.0, n_points: int | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """New curves from the prior: latents z ~ N(0, temperature²·I), decoded into the model plane.
+
+        The same seed gives the same latents and curves.
+        """
+        z = np.random.default_rng(seed).standard_normal((count, self.latent_dim)) * temperature
+        return z, self.decode(z, n_points=n_points)
+
+    def augment(
+        self,
+        curves: Sequence[np.ndarray],
+        count: int,
+        *,
+        mode: Literal["pair", "triplet"] = "pair",
+        seed: int | None = None,
+        frame: FrameMode = "auto",
+        n_points: int | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
+        """`count` random interpolants of the curves: data augmentation with the VAE (paper §4).
+
+        Each picks 2 (pair) or 3 (triplet) distinct source curves and weights drawn uniformly
+        from the simplex (a uniform w in [0, 1] for a pair), so every new curve lies between
+        its sources. Returns curves, sources (count, k), weights (count, k) and frames.
+        """
+        k = {"pair": 2, "triplet": 3}[mode]
+        rng = np.random.default_rng(seed)
+        sources = np.stack([rng.choice(len(curves), size=k, replace=False) for _ in range(count)])
+        weights = rng.dirichlet(np.ones(k), size=count)
+        full = np.zeros((count, len(curves)))
+        np.put_along_axis(full, sources, weights, axis=1)
+        out, frames = self.interpolate(curves, full, frame=frame, n_points=n_points)
+        return out, sources, weights, frames
+
 
 def _check_finite(a: np.ndarray, field: str, msg: str) -> None:
     bad = ~np.isfinite(a).reshape(len(a), -1).all(axis=1)

@@ -161,6 +161,59 @@ class InterpolateResponse(CurvesResponse):
     )
 
 
+Seed = Annotated[
+    int | None,
+    Field(
+        ge=0,
+        lt=2**64,
+        strict=True,
+        description="Seed of the random draws: the same request and seed give the "
+        "same answer. Omitted: fresh randomness.",
+    ),
+]
+
+
+class SampleRequest(_Request):
+    """Draw new curves from the latent prior."""
+
+    count: int = Field(ge=1, strict=True, description="How many curves (at most CURVE_VAE_MAX_CURVES).")
+    seed: Seed = None
+    temperature: float = Field(
+        1.0,
+        ge=0,
+        le=100,
+        strict=True,
+        allow_inf_nan=False,
+        description="Standard deviation of the latents, z ~ N(0, temperature²·I): below 1 stays near typical shapes.",
+    )
+    n_points: NPoints = None
+
+
+class SampleResponse(CurvesResponse):
+    latents: list[list[float]] = Field(description="The latent vector each curve was decoded from.")
+
+
+class AugmentRequest(_Request):
+    """Make new curves between given ones: random pair or triplet interpolants."""
+
+    curves: list[Curve] = Field(min_length=2, description="Source curves: ≥ 2 for pairs, ≥ 3 for triplets.")
+    count: int = Field(ge=1, strict=True, description="How many new curves (at most CURVE_VAE_MAX_CURVES).")
+    mode: Literal["pair", "triplet"] = Field(
+        "pair",
+        description="Mix 2 (pair, paper eq. 9) or 3 (triplet, eq. 10) distinct random source curves, "
+        "with weights uniform on the simplex.",
+    )
+    seed: Seed = None
+    frame: FrameMode = "auto"
+    n_points: NPoints = None
+
+
+class AugmentResponse(CurvesResponse):
+    sources: list[list[int]] = Field(description="Indices into `curves` of the sources of each new curve.")
+    weights: list[list[float]] = Field(description="Weight of each source, in the order of `sources`; rows sum to 1.")
+    frames: list[FrameInfo] | None = Field(description='Frame "auto": the blend of the sources\' frames.')
+
+
 class ErrorItem(BaseModel):
     loc: str = Field(description='Where: field, curve and point, e.g. "curves[2][17][1]".')
     msg: str = Field(description="What is wrong there.")

@@ -191,3 +191,31 @@ def test_settings_from_environment(monkeypatch):
     monkeypatch.setenv("CURVE_VAE_MAX_CURVES", "7")
     s = Settings()
     assert (s.port, s.providers, s.cors_origins, s.max_curves) == (9123, "cpu", ["https://a.example"], 7)
+
+
+def test_sample_is_reproducible_with_a_seed(client, runtime):
+    a = client.post("/sample", json={"count": 3, "seed": 5, "n_points": 50}).json()
+    b = client.post("/sample", json={"count": 3, "seed": 5, "n_points": 50}).json()
+    c = client.post("/sample", json={"count": 3, "seed": 6, "n_points": 50}).json()
+    assert a == b and a["latents"] != c["latents"]
+    assert np.shape(a["latents"]) == (3, 32) and np.shape(a["curves"]) == (3, 50, 2)
+    np.testing.assert_allclose(a["curves"], runtime.decode(np.array(a["latents"]), n_points=50), rtol=1e-9)
+    cold = client.post("/sample", json={"count": 2, "temperature": 0}).json()
+    assert np.all(np.array(cold["latents"]) == 0)
+
+
+@pytest.mark.parametrize("mode,k", [("pair", 2), ("triplet", 3)])
+def test_augment(client, curves, runtime, mode, k):
+    c = [x * (i + 1) + 10 * i for i, x in enumerate(curves(4, 161))]
+    body = {"curves": [x.tolist() for x in c], "count": 6, "mode": mode, "seed": 3}
+    out = client.post("/augment", json=body).json()
+    assert out == client.post("/augment", json=body).json()  # same seed, same answer
+    sources, weights = np.array(out["sources"]), np.array(out["weights"])
+    assert sources.shape == weights.shape == (6, k)
+    assert all(len(set(row)) == k for row in sources.tolist()) and sources.min() >= 0 and sources.max() < 4
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0)
+    assert (weights >= 0).all()
+    full = np.zeros((6, 4))
+    np.put_along_axis(full, sources, weights, axis=1)
+    expected, _ = runtime.interpolate(c, full)
+    np.testing.assert_allclose(out["curves"], expected, rtol=1e-9, atol=1e-9)

@@ -21,7 +21,7 @@ def test_openapi_yaml_is_in_sync_with_the_app():
 def test_every_status_is_documented_with_an_example():
     spec = yaml.safe_load(ROOT_FILE.read_text())
     paths = spec["paths"]
-    for path in ("/encode", "/decode", "/reconstruct", "/interpolate"):
+    for path in ("/encode", "/decode", "/reconstruct", "/interpolate", "/sample", "/augment"):
         op = paths[path]["post"]
         assert {"200", "413", "422", "503"} <= set(op["responses"]), path
         assert op["requestBody"]["content"]["application/json"]["examples"], path

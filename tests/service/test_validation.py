@@ -198,6 +198,54 @@ CASES = [
         "weights: List should have at least 1 item",
         id="no-weights",
     ),
+    # --- sample and augment
+    pytest.param(
+        "/sample", {"count": 0}, 422, "count: Input should be greater than or equal to 1", id="sample-count-zero"
+    ),
+    pytest.param(
+        "/sample",
+        {"count": 2, "temperature": -1},
+        422,
+        "temperature: Input should be greater than or equal to 0",
+        id="sample-negative-temperature",
+    ),
+    pytest.param(
+        "/sample",
+        {"count": 2, "seed": -3},
+        422,
+        "seed: Input should be greater than or equal to 0",
+        id="sample-negative-seed",
+    ),
+    pytest.param("/sample", {"count": 2, "seed": 1.5}, 422, "seed: not an integer", id="sample-fractional-seed"),
+    pytest.param("/sample", {"count": 300}, 422, "count: at most 256, got 300", id="sample-count-over-limit"),
+    pytest.param(
+        "/augment",
+        {"curves": [C, C], "count": 2, "mode": "triplet"},
+        422,
+        "curves: mode triplet needs at least 3 curves, got 2",
+        id="augment-triplet-of-two",
+    ),
+    pytest.param(
+        "/augment",
+        {"curves": [C, C], "count": 2, "mode": "quad"},
+        422,
+        "mode: Input should be 'pair' or 'triplet'",
+        id="augment-bad-mode",
+    ),
+    pytest.param(
+        "/augment",
+        {"curves": [C], "count": 2},
+        422,
+        "curves: List should have at least 2 items",
+        id="augment-one-curve",
+    ),
+    pytest.param(
+        "/augment",
+        {"curves": [C, C], "count": 1000},
+        422,
+        "count: at most 256, got 1000",
+        id="augment-count-over-limit",
+    ),
     # --- the body
     pytest.param("/encode", '{"curves": [[[0,0],[1,2]', 422, "body: invalid JSON", id="truncated-json"),
     pytest.param("/encode", "[1, 2, 3]", 422, "body: expected a JSON object", id="array-body"),
@@ -316,7 +364,7 @@ def test_extreme_inputs_never_give_5xx(client, path, body):
         assert r.json()["errors"][0]["loc"]
 
 
-@pytest.mark.parametrize("path", ["/encode", "/decode", "/reconstruct", "/interpolate"])
+@pytest.mark.parametrize("path", ["/encode", "/decode", "/reconstruct", "/interpolate", "/sample", "/augment"])
 def test_garbage_never_gives_5xx(client, path):
     bodies = [
         "null",
