@@ -77,6 +77,8 @@ def _validation_message(err: dict[str, Any], request: Request) -> tuple[str, str
         "extra_forbidden": "unknown field",
     }
     msg = messages.get(kind, err["msg"])
+    if kind == "float_type" and isinstance(err.get("input"), int) and not isinstance(err.get("input"), bool):
+        msg = "not a finite number: too large for a float"
     if kind == "too_short" and len(loc) == 2 and loc[0] == "curves" and isinstance(loc[1], int):
         msg = f"a curve needs at least 4 points, got {ctx.get('actual_length')}"
     elif kind in ("too_short", "too_long") and len(loc) == 3 and loc[0] == "curves":
@@ -98,6 +100,10 @@ async def _on_input_error(request: Request, exc: Exception) -> Response:
 
 async def _on_http_error(request: Request, exc: Exception) -> Response:
     assert isinstance(exc, HTTPException)
+    if exc.status_code == 400 and exc.detail == "There was an error parsing the body":
+        # FastAPI's answer to bodies json.loads rejects with something other than a syntax error
+        # (an integer of over 4300 digits): the same 422 as any other unreadable JSON.
+        return error_response(422, [("body", "invalid JSON (cannot parse the body)")])
     return error_response(exc.status_code, [], detail=str(exc.detail), headers=exc.headers)
 
 
@@ -195,7 +201,10 @@ def _check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
     for r, row in enumerate(req.weights):
         if len(row) != n:
             raise InputError(("weights", r), f"expected {n} numbers, one per input curve, got {len(row)}")
-        total = math.fsum(row)
+        try:
+            total = math.fsum(row)
+        except OverflowError:  # terms near the float limit
+            total = math.inf
         if not abs(total - 1.0) <= WEIGHT_SUM_TOLERANCE:
             raise InputError(("weights", r), f"weights must sum to 1, got {total:.9g}")
     return np.array(req.weights, dtype=np.float64)

@@ -246,10 +246,31 @@ CASES = [
         "count: at most 256, got 1000",
         id="augment-count-over-limit",
     ),
+    pytest.param(
+        "/interpolate",
+        '{"curves": [[[0,0],[1,2],[2,3],[3,1]], [[0,0],[1,2],[2,3],[3,1]]], "weights": [[1e308, 1e308]]}',
+        422,
+        "weights[0]: weights must sum to 1, got inf",
+        id="weights-overflowing-sum",
+    ),
+    pytest.param(
+        "/encode",
+        '{"curves": [[[0,0],[1,%s],[2,3],[3,1]]]}' % ("9" * 400),
+        422,
+        "curves[0][1][1]: not a finite number",
+        id="integer-beyond-float",
+    ),
     # --- the body
     pytest.param("/encode", '{"curves": [[[0,0],[1,2]', 422, "body: invalid JSON", id="truncated-json"),
     pytest.param("/encode", "[1, 2, 3]", 422, "body: expected a JSON object", id="array-body"),
     pytest.param("/encode", "", 422, "body: field required", id="empty-body"),
+    pytest.param(
+        "/encode",
+        '{"curves": [[[0,0],[1,%s],[2,3],[3,1]]]}' % ("9" * 5000),
+        422,
+        "body: invalid JSON",
+        id="integer-of-5000-digits",
+    ),
 ]
 
 
