@@ -292,13 +292,12 @@ def train(
                 atomic_save(ckpt, last)
                 with open(run_dir / "log.jsonl", "a") as f:
                     f.write(json.dumps(row) + "\n")
-                if progress:
-                    print(
-                        f"epoch {state.epoch}/{cfg.epochs}  loss {terms['loss']:.4g}  mse {terms['mse']:.4g}  "
-                        f"kl {terms['kl']:.4g}  lap {terms['lap']:.4g}  val_mse {val_mse:.4g}"
-                        f"{' *' if improved else ''}  {row['curves_per_s']:.0f} curves/s",
-                        flush=True,
-                    )
+                print(  # one line per epoch, with or without the progress bar
+                    f"epoch {state.epoch}/{cfg.epochs}  loss {terms['loss']:.4g}  mse {terms['mse']:.4g}  "
+                    f"kl {terms['kl']:.4g}  lap {terms['lap']:.4g}  val_mse {val_mse:.4g}"
+                    f"{' *' if improved else ''}  {row['curves_per_s']:.0f} curves/s",
+                    flush=True,
+                )
             if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
                 if rank == 0:
                     print(f"early stop: no better validation MSE for {cfg.patience} epochs", flush=True)
