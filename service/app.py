@@ -307,7 +307,9 @@ async def encode(
 ) -> Response:
     """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance)."""
     curves = _check_curves(req.curves, settings)
-    mean, log_var, frames = await _infer(request, "/encode", len(curves), runtime.encode, curves, frame=req.frame)
+    mean, log_var, frames = await _infer(
+        request, "/encode", len(curves), runtime.encode, curves, frame=req.frame, spacing=req.spacing
+    )
     return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": _frames_json(frames)})
 
 
@@ -356,6 +358,7 @@ async def decode(
         runtime.decode,
         np.array(req.latents, np.float64),
         n_points=req.n_points,
+        spacing=req.spacing,
         frames=frames,
     )
     return JSONResponse({"curves": curves.tolist()})
@@ -388,7 +391,14 @@ async def reconstruct(
     curves = _check_curves(req.curves, settings)
     _check_n_points(req.n_points, settings)
     out, mse = await _infer(
-        request, "/reconstruct", len(curves), runtime.reconstruct, curves, frame=req.frame, n_points=req.n_points
+        request,
+        "/reconstruct",
+        len(curves),
+        runtime.reconstruct,
+        curves,
+        frame=req.frame,
+        n_points=req.n_points,
+        spacing=req.spacing,
     )
     return JSONResponse({"curves": [c.tolist() for c in out], "mse": mse.tolist()})
 
@@ -439,6 +449,7 @@ async def interpolate(
         weights,
         frame=req.frame,
         n_points=req.n_points,
+        spacing=req.spacing,
     )
     return JSONResponse({"weights": weights.tolist(), "curves": out.tolist(), "frames": _frames_json(frames)})
 
@@ -477,6 +488,7 @@ async def sample(
         seed=req.seed,
         temperature=req.temperature,
         n_points=req.n_points,
+        spacing=req.spacing,
     )
     return JSONResponse({"latents": latents.tolist(), "curves": curves.tolist()})
 
@@ -528,6 +540,7 @@ async def augment(
         seed=req.seed,
         frame=req.frame,
         n_points=req.n_points,
+        spacing=req.spacing,
     )
     return JSONResponse(
         {
@@ -657,9 +670,10 @@ An Inception VAE for 2D curves (Barzegar Khalilsaraei & Augsdörfer, WSCG 2025) 
 
 A curve is a JSON array of `[x, y]` points: any frame, any order of magnitude, any length ≥ 4.
 Every endpoint takes a batch. With `frame: "auto"` (the default) each curve is shifted and
-uniformly scaled into the model's frame and results are mapped back; curves whose length
-differs from the model's 161 points are resampled by arc length and come back at their own
-length, or `n_points`. Errors are JSON: `detail` names the field, curve and point.
+uniformly scaled into the model's frame and results are mapped back. Curves of any length are
+resampled to the model's 161 points (`spacing`: along their parameter, like the training
+data, or by arc length) and come back at their own length, or `n_points`. Errors are JSON:
+`detail` names the field, curve and point.
 """
 
 

@@ -9,7 +9,12 @@ without HTTP:
         --encoder--> mean, log_var --(affine mix)--> decoder --> (161, 2) in the model plane
         --back to n points, same spacing--> --from_model--> caller's frame
 
-With frame "model" the frame steps are skipped. Nothing here imports torch.
+With frame "model" the frame steps are skipped. Resampling ("spacing"): the model was
+trained on points evenly spaced in the B-spline parameter, so by default a curve's points
+are taken to be spaced that way and are interpolated along the index ("parameter"); a
+161-point curve then passes untouched and 50, 160 or 500 points of the same curve give
+the same model input. "arc_length" resamples evenly by arc length instead, for points
+spaced arbitrarily (hand-drawn strokes). Nothing here imports torch.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from geometry import Frame, blend_frames, fit_frame, mse_per_curve, resample
 log = logging.getLogger(__name__)
 
 FrameMode = Literal["auto", "model"]
+Spacing = Literal["parameter", "arc_length"]
 CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
 _F32_MAX = float(np.finfo(np.float32).max)
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -163,7 +169,9 @@ class Prepared:
 
     model: np.ndarray  # (B, n_points, 2) float32 in the model plane
     frames: list[Frame | None]  # the caller's frame of each curve; None for frame "model"
-    fractions: list[np.ndarray | None]  # arc-length position of each input point in [0, 1]; None if not resampled
+    fractions: list[
+        np.ndarray | None
+    ]  # where each input point sits along the model's points, in [0, 1]; None: same points
     inputs: list[np.ndarray]  # the caller's curves, float64
 
 
@@ -173,14 +181,21 @@ def _arc_fractions(points: np.ndarray) -> np.ndarray:
 
 
 def _at_fractions(curve: np.ndarray, fractions: np.ndarray) -> np.ndarray:
-    """Points of a model curve (m, 2) at the given positions: the inverse of an arc-length resample.
+    """Points of a model curve (m, 2) at the given positions: the inverse of the input's resampling.
 
-    Model point j stands for the input at arc fraction j/(m-1), so the input's own points
-    come back where fraction·(m-1) falls, interpolated between neighbours.
+    Model point j stands for the input at fraction j/(m-1) (of its index or its arc length),
+    so the input's own points come back where fraction·(m-1) falls, between neighbours.
     """
     x = np.clip(fractions, 0.0, 1.0) * (len(curve) - 1)
     idx = np.arange(len(curve))
     return np.stack([np.interp(x, idx, curve[:, 0]), np.interp(x, idx, curve[:, 1])], axis=1)
+
+
+def _to_length(curve: np.ndarray, n_points: int, spacing: Spacing) -> np.ndarray:
+    """n_points of a polyline: evenly along its index (its parameter) or by arc length."""
+    if spacing == "arc_length":
+        return resample(curve, n_points)
+    return curve.copy() if len(curve) == n_points else _at_fractions(curve, np.linspace(0.0, 1.0, n_points))
 
 
 class CurveRuntime:
@@ -301,8 +316,11 @@ class CurveRuntime:
 
     # ----------------------------------------------------------------------- caller's curves
 
-    def prepare(self, curves: Sequence[np.ndarray], frame: FrameMode = "auto", field: str = "curves") -> Prepared:
+    def prepare(
+        self, curves: Sequence[np.ndarray], frame: FrameMode = "auto", spacing: Spacing = "parameter"
+    ) -> Prepared:
         """Bring caller curves (each (n_i, 2), n_i ≥ 4) to the model's frame and point count."""
+        field = "curves"
         model, frames, fractions, inputs = [], [], [], []
         with np.errstate(all="ignore"):
             for i, c in enumerate(curves):
@@ -313,9 +331,12 @@ class CurveRuntime:
                     raise InputError((field, i), str(e)) from e
                 m = f.to_model(pts, self.model_size) if f is not None else pts
                 fraction = None
-                if len(pts) != self.n_points:
+                if spacing == "arc_length":
                     fraction = _arc_fractions(m)
                     m = resample(m, self.n_points)
+                elif len(pts) != self.n_points:
+                    fraction = np.linspace(0.0, 1.0, len(pts))
+                    m = _to_length(m, self.n_points, spacing)
                 if not (np.abs(m) <= _F32_MAX).all():  # also false for inf and nan
                     raise InputError(
                         (field, i),
@@ -336,26 +357,27 @@ class CurveRuntime:
         frame: Frame | None,
         *,
         n_points: int | None,
+        spacing: Spacing = "parameter",
         fractions: np.ndarray | None = None,
     ) -> np.ndarray:
         """One model-plane result (n_points_model, 2) -> the caller's frame and length.
 
-        n_points given: that many points, evenly spaced by arc length (the model's own
-        points when it equals the model's count and nothing else was asked). Otherwise the
-        input's positions (`fractions`), or the model's points as they are.
+        n_points given: that many points, spaced as `spacing` says (with "parameter" and the
+        model's count, the model's own points). Otherwise at the input's positions
+        (`fractions`), or the model's points as they are.
         """
         curve = np.asarray(out, np.float64)
-        if n_points is not None and n_points != len(curve):
-            curve = resample(curve, n_points)
+        if n_points is not None:
+            curve = _to_length(curve, n_points, spacing)
         elif n_points is None and fractions is not None:
             curve = _at_fractions(curve, fractions)
         return frame.from_model(curve, self.model_size) if frame is not None else curve
 
     def encode(
-        self, curves: Sequence[np.ndarray], *, frame: FrameMode = "auto"
+        self, curves: Sequence[np.ndarray], *, frame: FrameMode = "auto", spacing: Spacing = "parameter"
     ) -> tuple[np.ndarray, np.ndarray, list[Frame | None]]:
         """Latent mean and log-variance of each curve, and the frame each was mapped from."""
-        prep = self.prepare(curves, frame)
+        prep = self.prepare(curves, frame, spacing)
         with np.errstate(all="ignore"):
             mean, log_var = self.encode_model(prep.model)
         _check_finite(mean, "curves", _ENCODE_OVERFLOW)
@@ -368,6 +390,7 @@ class CurveRuntime:
         *,
         n_points: int | None = None,
         frames: Sequence[Frame] | None = None,
+        spacing: Spacing = "parameter",
     ) -> np.ndarray:
         """Curves (B, n, 2) for latents (B, latent_dim): in the model plane, or mapped to `frames`."""
         z = np.asarray(latents, np.float64)
@@ -379,20 +402,28 @@ class CurveRuntime:
             _check_finite(
                 out, "latents", "decodes to non-finite coordinates: the latent is far outside the training range"
             )
-            curves = [self._to_caller(o, frames[i] if frames else None, n_points=n_points) for i, o in enumerate(out)]
+            curves = [
+                self._to_caller(o, frames[i] if frames else None, n_points=n_points, spacing=spacing)
+                for i, o in enumerate(out)
+            ]
         result = np.stack(curves) if curves else np.zeros((0, n_points or self.n_points, 2))
         _check_finite(result, "frames" if frames else "latents", "the result does not fit in float64")
         return result
 
     def reconstruct(
-        self, curves: Sequence[np.ndarray], *, frame: FrameMode = "auto", n_points: int | None = None
+        self,
+        curves: Sequence[np.ndarray],
+        *,
+        frame: FrameMode = "auto",
+        n_points: int | None = None,
+        spacing: Spacing = "parameter",
     ) -> tuple[list[np.ndarray], np.ndarray]:
         """Encode the means, decode them; the curves in the caller's frame and their MSE (paper eq. 4) there.
 
         The MSE compares each input with its reconstruction at the input's own points,
         whatever `n_points` asks for the returned curves.
         """
-        prep = self.prepare(curves, frame)
+        prep = self.prepare(curves, frame, spacing)
         with np.errstate(all="ignore"):
             mean, _ = self.encode_model(prep.model)
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
@@ -401,7 +432,9 @@ class CurveRuntime:
             for i, o in enumerate(out):
                 own = self._to_caller(o, prep.frames[i], n_points=None, fractions=prep.fractions[i])
                 mse[i] = mse_per_curve(prep.inputs[i][None], own[None])[0]
-                results.append(own if n_points is None else self._to_caller(o, prep.frames[i], n_points=n_points))
+                if n_points is not None:
+                    own = self._to_caller(o, prep.frames[i], n_points=n_points, spacing=spacing)
+                results.append(own)
                 if not (np.isfinite(results[-1]).all() and np.isfinite(mse[i])):
                     raise InputError(("curves", i), "the reconstruction does not fit in float64: scale the curve down")
         return results, mse
@@ -413,14 +446,15 @@ class CurveRuntime:
         *,
         frame: FrameMode = "auto",
         n_points: int | None = None,
+        spacing: Spacing = "parameter",
     ) -> tuple[np.ndarray, list[Frame | None]]:
         """Decode affine combinations of the curves' latent means (paper eqs. 9, 10), one per weight row.
 
         weights: (rows, len(curves)), rows summing to 1. With frame "auto" each interpolant
         comes back in the same blend of the inputs' frames. Length: n_points; else the
-        inputs' common length, keeping the blend of their point spacings; else the model's.
+        inputs' common length, at the blend of their points' positions; else the model's.
         """
-        prep = self.prepare(curves, frame)
+        prep = self.prepare(curves, frame, spacing)
         w = np.asarray(weights, np.float64)
         lengths = {len(c) for c in prep.inputs}
         with np.errstate(all="ignore"):
@@ -434,27 +468,36 @@ class CurveRuntime:
                 list(blend_frames([f for f in prep.frames if f is not None], w)) if frame == "auto" else [None] * len(w)
             )
             common = lengths.pop() if len(lengths) == 1 else None
+            blend = n_points is None and common is not None and all(f is not None for f in prep.fractions)
+            if n_points is None and common is None:
+                n_points = self.n_points
             results = []
             for r, o in enumerate(out):
-                if n_points is None and common is not None and common != self.n_points:
-                    spacing = w[r] @ np.stack(prep.fractions)  # type: ignore[arg-type]
-                    spacing = np.maximum.accumulate(np.clip(spacing, 0.0, 1.0))  # extrapolating rows stay ordered
-                    results.append(self._to_caller(o, frames[r], n_points=None, fractions=spacing))
+                if blend:
+                    positions = w[r] @ np.stack(prep.fractions)  # type: ignore[arg-type]
+                    positions = np.maximum.accumulate(np.clip(positions, 0.0, 1.0))  # extrapolating rows stay ordered
+                    results.append(self._to_caller(o, frames[r], n_points=None, fractions=positions))
                 else:
-                    results.append(self._to_caller(o, frames[r], n_points=n_points))
+                    results.append(self._to_caller(o, frames[r], n_points=n_points, spacing=spacing))
             result = np.stack(results)
         _check_finite(result, "weights", "the interpolant does not fit in float64")
         return result, frames
 
     def sample(
-        self, count: int, *, seed: int | None = None, temperature: float = 1.0, n_points: int | None = None
+        self,
+        count: int,
+        *,
+        seed: int | None = None,
+        temperature: float = 1.0,
+        n_points: int | None = None,
+        spacing: Spacing = "parameter",
     ) -> tuple[np.ndarray, np.ndarray]:
         """New curves from the prior: latents z ~ N(0, temperature²·I), decoded into the model plane.
 
         The same seed gives the same latents and curves.
         """
         z = np.random.default_rng(seed).standard_normal((count, self.latent_dim)) * temperature
-        return z, self.decode(z, n_points=n_points)
+        return z, self.decode(z, n_points=n_points, spacing=spacing)
 
     def augment(
         self,
@@ -465,6 +508,7 @@ class CurveRuntime:
         seed: int | None = None,
         frame: FrameMode = "auto",
         n_points: int | None = None,
+        spacing: Spacing = "parameter",
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
         """`count` random interpolants of the curves: data augmentation with the VAE (paper §4).
 
@@ -478,7 +522,7 @@ class CurveRuntime:
         weights = rng.dirichlet(np.ones(k), size=count)
         full = np.zeros((count, len(curves)))
         np.put_along_axis(full, sources, weights, axis=1)
-        out, frames = self.interpolate(curves, full, frame=frame, n_points=n_points)
+        out, frames = self.interpolate(curves, full, frame=frame, n_points=n_points, spacing=spacing)
         return out, sources, weights, frames
 
 

@@ -43,15 +43,28 @@ FrameMode = Annotated[
     ),
 ]
 
+SpacingMode = Annotated[
+    Literal["parameter", "arc_length"],
+    Field(
+        description=(
+            'How points are spaced along a curve. "parameter" (default): evenly in the curve\'s parameter, like the '
+            "paper's B-spline samples the model was trained on; curves of other lengths are interpolated along their "
+            'points, so 50, 161 or 500 samples of a curve give the same result. "arc_length": evenly by arc length, '
+            "for points spaced any which way (hand-drawn strokes); inputs are resampled by arc length and returned "
+            "curves are spaced so."
+        )
+    ),
+]
+
 NPoints = Annotated[
     int | None,
     Field(
         ge=4,
         strict=True,
         description=(
-            "Points per returned curve (at most CURVE_VAE_MAX_POINTS). Omitted: each curve keeps its input's "
-            "length and point spacing (the model's 161 points where there is no single input length). Given: the "
-            "model's points as they are when it equals 161, else that many points evenly spaced by arc length."
+            "Points per returned curve (at most CURVE_VAE_MAX_POINTS), spaced as `spacing` says. Omitted: each curve "
+            "comes back at its input's length and point positions (the model's 161 points where there is no single "
+            "input length)."
         ),
     ),
 ]
@@ -80,6 +93,7 @@ class EncodeRequest(_Request):
 
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
     frame: FrameMode = "auto"
+    spacing: SpacingMode = "parameter"
 
 
 class EncodeResponse(BaseModel):
@@ -98,6 +112,7 @@ class DecodeRequest(_Request):
         min_length=1, description="One or more latent vectors, each of the model's latent_dim (see GET /model)."
     )
     n_points: NPoints = None
+    spacing: SpacingMode = "parameter"
     frames: list[FrameInfo] | None = Field(
         None,
         description="Optional frame per latent (as /encode returns them): curves are mapped into it. "
@@ -114,6 +129,7 @@ class ReconstructRequest(_Request):
 
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
     frame: FrameMode = "auto"
+    spacing: SpacingMode = "parameter"
     n_points: NPoints = None
 
 
@@ -145,6 +161,7 @@ class InterpolateRequest(_Request):
         "extrapolate). One interpolant per row.",
     )
     frame: FrameMode = "auto"
+    spacing: SpacingMode = "parameter"
     n_points: NPoints = None
 
     @model_validator(mode="after")
@@ -187,6 +204,7 @@ class SampleRequest(_Request):
         description="Standard deviation of the latents, z ~ N(0, temperature²·I): below 1 stays near typical shapes.",
     )
     n_points: NPoints = None
+    spacing: SpacingMode = "parameter"
 
 
 class SampleResponse(CurvesResponse):
@@ -205,6 +223,7 @@ class AugmentRequest(_Request):
     )
     seed: Seed = None
     frame: FrameMode = "auto"
+    spacing: SpacingMode = "parameter"
     n_points: NPoints = None
 
 

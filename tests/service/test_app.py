@@ -219,3 +219,21 @@ def test_augment(client, curves, runtime, mode, k):
     np.put_along_axis(full, sources, weights, axis=1)
     expected, _ = runtime.interpolate(c, full)
     np.testing.assert_allclose(out["curves"], expected, rtol=1e-9, atol=1e-9)
+
+
+def test_the_shipped_model_is_served_by_default(shipped_runtime, curves):
+    """Default settings serve models/; its checksums pass and it keeps the frame behaviour of item 3."""
+    from service.settings import DEFAULT_MODEL_DIR
+
+    with TestClient(create_app(Settings(providers="cpu"))) as client:
+        info = client.get("/model").json()
+        assert (
+            info["name"] == shipped_runtime.manifest["name"] and info["version"] == shipped_runtime.manifest["version"]
+        )
+        assert Settings().model_dir == DEFAULT_MODEL_DIR
+        c = curves(2, 75, seed=4)
+        base = client.post("/reconstruct", json={"curves": c.tolist()}).json()
+        moved = client.post("/reconstruct", json={"curves": (c * 0.01 - 7).tolist()}).json()
+        np.testing.assert_allclose(
+            np.array(moved["curves"]), np.array(base["curves"]) * 0.01 - 7, atol=1e-6 * 128 * 0.01
+        )
