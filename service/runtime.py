@@ -320,7 +320,6 @@ class CurveRuntime:
         self, curves: Sequence[np.ndarray], frame: FrameMode = "auto", spacing: Spacing = "parameter"
     ) -> Prepared:
         """Bring caller curves (each (n_i, 2), n_i ≥ 4) to the model's frame and point count."""
-        field = "curves"
         model, frames, fractions, inputs = [], [], [], []
         with np.errstate(all="ignore"):
             for i, c in enumerate(curves):
@@ -328,7 +327,7 @@ class CurveRuntime:
                 try:
                     f = fit_frame(pts) if frame == "auto" else None
                 except ValueError as e:  # all points coincide
-                    raise InputError((field, i), str(e)) from e
+                    raise InputError(("curves", i), str(e)) from e
                 m = f.to_model(pts, self.model_size) if f is not None else pts
                 fraction = None
                 if spacing == "arc_length":
@@ -339,7 +338,7 @@ class CurveRuntime:
                     m = _to_length(m, self.n_points, spacing)
                 if not (np.abs(m) <= _F32_MAX).all():  # also false for inf and nan
                     raise InputError(
-                        (field, i),
+                        ("curves", i),
                         "its extent is too small or too large to map to the model's frame"
                         if f is not None
                         else 'coordinates beyond float32 range; use frame "auto"',
@@ -369,7 +368,7 @@ class CurveRuntime:
         curve = np.asarray(out, np.float64)
         if n_points is not None:
             curve = _to_length(curve, n_points, spacing)
-        elif n_points is None and fractions is not None:
+        elif fractions is not None:
             curve = _at_fractions(curve, fractions)
         return frame.from_model(curve, self.model_size) if frame is not None else curve
 

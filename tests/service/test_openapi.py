@@ -67,3 +67,8 @@ def test_importing_the_app_loads_no_torch():
     code = "import sys, service.app, service.cli, service.runtime; assert 'torch' not in sys.modules; print('ok')"
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+def test_the_running_app_serves_the_same_schema_and_docs(client):
+    assert client.get("/openapi.json").json() == openapi_spec()
+    assert client.get("/docs").status_code == 200
