@@ -15,7 +15,7 @@ import time
 from collections.abc import AsyncIterator, Callable, Sequence
 from contextlib import asynccontextmanager
 from functools import partial
-from typing import Annotated, Any, TypeVar
+from typing import Annotated, Any
 
 import anyio
 import numpy as np
@@ -34,7 +34,6 @@ from service.runtime import CurveRuntime, InputError, ModelLoadError, format_loc
 from service.settings import Settings, get_settings
 
 log = logging.getLogger("service")
-T = TypeVar("T")
 
 DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
 WEIGHT_SUM_TOLERANCE = 1e-6
@@ -216,13 +215,14 @@ def _frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
     return [{"center": list(f.center), "size": f.size} for f in frames if f is not None]
 
 
-async def _infer(request: Request, route: str, batch: int, fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
-    """Run `fn` in a worker thread (never on the event loop), timed, at most `inference_concurrency` at once."""
+async def _run(request: Request, route: str, batch: int, work: Callable[[], Response]) -> Response:
+    """Run `work` (inference and JSON rendering) in a worker thread, never on the event loop; timed, and at
+    most `inference_concurrency` at once."""
     metrics: Metrics = request.app.state.metrics
     metrics.batch_size.labels(route).observe(batch)
     start = time.perf_counter()
     try:
-        return await anyio.to_thread.run_sync(partial(fn, *args, **kwargs), limiter=request.app.state.limiter)
+        return await anyio.to_thread.run_sync(work, limiter=request.app.state.limiter)
     finally:
         metrics.inference.labels(route).observe(time.perf_counter() - start)
 
@@ -307,10 +307,12 @@ async def encode(
 ) -> Response:
     """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance)."""
     curves = _check_curves(req.curves, settings)
-    mean, log_var, frames = await _infer(
-        request, "/encode", len(curves), runtime.encode, curves, frame=req.frame, spacing=req.spacing
-    )
-    return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": _frames_json(frames)})
+
+    def work() -> Response:
+        mean, log_var, frames = runtime.encode(curves, frame=req.frame, spacing=req.spacing)
+        return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": _frames_json(frames)})
+
+    return await _run(request, "/encode", len(curves), work)
 
 
 @curves_router.post(
@@ -351,17 +353,13 @@ async def decode(
         raise InputError(("frames",), f"expected one frame per latent ({len(req.latents)}), got {len(req.frames)}")
     _check_n_points(req.n_points, settings)
     frames = [Frame(center=f.center, size=f.size) for f in req.frames] if req.frames else None
-    curves = await _infer(
-        request,
-        "/decode",
-        len(req.latents),
-        runtime.decode,
-        np.array(req.latents, np.float64),
-        n_points=req.n_points,
-        spacing=req.spacing,
-        frames=frames,
-    )
-    return JSONResponse({"curves": curves.tolist()})
+
+    def work() -> Response:
+        latents = np.array(req.latents, np.float64)
+        curves = runtime.decode(latents, n_points=req.n_points, spacing=req.spacing, frames=frames)
+        return JSONResponse({"curves": curves.tolist()})
+
+    return await _run(request, "/decode", len(req.latents), work)
 
 
 @curves_router.post(
@@ -390,17 +388,12 @@ async def reconstruct(
     """Encode each curve's latent mean and decode it: the reconstruction in the caller's frame, and its MSE there."""
     curves = _check_curves(req.curves, settings)
     _check_n_points(req.n_points, settings)
-    out, mse = await _infer(
-        request,
-        "/reconstruct",
-        len(curves),
-        runtime.reconstruct,
-        curves,
-        frame=req.frame,
-        n_points=req.n_points,
-        spacing=req.spacing,
-    )
-    return JSONResponse({"curves": [c.tolist() for c in out], "mse": mse.tolist()})
+
+    def work() -> Response:
+        out, mse = runtime.reconstruct(curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing)
+        return JSONResponse({"curves": [c.tolist() for c in out], "mse": mse.tolist()})
+
+    return await _run(request, "/reconstruct", len(curves), work)
 
 
 @curves_router.post(
@@ -440,18 +433,12 @@ async def interpolate(
     curves = _check_curves(req.curves, settings)
     _check_n_points(req.n_points, settings)
     weights = _check_weights(req, settings)
-    out, frames = await _infer(
-        request,
-        "/interpolate",
-        len(weights),
-        runtime.interpolate,
-        curves,
-        weights,
-        frame=req.frame,
-        n_points=req.n_points,
-        spacing=req.spacing,
-    )
-    return JSONResponse({"weights": weights.tolist(), "curves": out.tolist(), "frames": _frames_json(frames)})
+
+    def work() -> Response:
+        out, frames = runtime.interpolate(curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing)
+        return JSONResponse({"weights": weights.tolist(), "curves": out.tolist(), "frames": _frames_json(frames)})
+
+    return await _run(request, "/interpolate", len(weights), work)
 
 
 @curves_router.post(
@@ -479,18 +466,14 @@ async def sample(
     if req.count > settings.max_curves:
         raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
     _check_n_points(req.n_points, settings)
-    latents, curves = await _infer(
-        request,
-        "/sample",
-        req.count,
-        runtime.sample,
-        req.count,
-        seed=req.seed,
-        temperature=req.temperature,
-        n_points=req.n_points,
-        spacing=req.spacing,
-    )
-    return JSONResponse({"latents": latents.tolist(), "curves": curves.tolist()})
+
+    def work() -> Response:
+        latents, curves = runtime.sample(
+            req.count, seed=req.seed, temperature=req.temperature, n_points=req.n_points, spacing=req.spacing
+        )
+        return JSONResponse({"latents": latents.tolist(), "curves": curves.tolist()})
+
+    return await _run(request, "/sample", req.count, work)
 
 
 @curves_router.post(
@@ -529,27 +512,15 @@ async def augment(
     if req.count > settings.max_curves:
         raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
     _check_n_points(req.n_points, settings)
-    out, sources, weights, frames = await _infer(
-        request,
-        "/augment",
-        req.count,
-        runtime.augment,
-        curves,
-        req.count,
-        mode=req.mode,
-        seed=req.seed,
-        frame=req.frame,
-        n_points=req.n_points,
-        spacing=req.spacing,
-    )
-    return JSONResponse(
-        {
-            "curves": out.tolist(),
-            "sources": sources.tolist(),
-            "weights": weights.tolist(),
-            "frames": _frames_json(frames),
-        }
-    )
+
+    def work() -> Response:
+        out, sources, weights, frames = runtime.augment(
+            curves, req.count, mode=req.mode, seed=req.seed, frame=req.frame, n_points=req.n_points, spacing=req.spacing
+        )
+        body = {"curves": out.tolist(), "sources": sources.tolist(), "weights": weights.tolist()}
+        return JSONResponse({**body, "frames": _frames_json(frames)})
+
+    return await _run(request, "/augment", req.count, work)
 
 
 @ops_router.get("/health", response_model=s.StatusResponse, summary="Liveness", openapi_extra=_curl("/health"))

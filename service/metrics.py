@@ -44,7 +44,7 @@ class Metrics:
         )
         self.inference = Histogram(
             "curve_vae_inference_duration_seconds",
-            "Time spent in pre-processing, ONNX runs and post-processing.",
+            "Time in the worker thread: pre-processing, ONNX runs, post-processing and JSON rendering.",
             ["route"],
             buckets=LATENCY_BUCKETS,
             registry=self.registry,
