@@ -250,3 +250,14 @@ def test_extreme_but_representable_magnitudes_work(runtime, curves, magnitude):
     out, mse = runtime.reconstruct([c * magnitude])
     np.testing.assert_allclose(out[0], base[0] * magnitude, rtol=1e-5, atol=0)
     assert np.isfinite(mse).all()
+
+
+def test_cuda_that_falls_back_to_cpu_is_a_startup_error(model_dir, monkeypatch):
+    """onnxruntime-gpu lists CUDA even where its libraries cannot load, then silently runs on CPU: refuse that."""
+    if "CUDAExecutionProvider" in ort.get_available_providers():
+        pytest.skip("CUDA is available here")
+    monkeypatch.setattr(ort, "get_available_providers", lambda: ["CUDAExecutionProvider", "CPUExecutionProvider"])
+    with pytest.raises(ModelLoadError, match="CUDA provider failed to load"):
+        CurveRuntime.load(model_dir, providers="cuda", warm_up=False)
+    auto = CurveRuntime.load(model_dir, providers="auto", warm_up=False)  # auto accepts the fallback ...
+    assert auto.providers == ["CPUExecutionProvider"]  # ... and reports it
