@@ -12,7 +12,7 @@ from geometry.bspline import (
     random_control_points,
     sample_bspline,
 )
-from geometry.frame import Frame, blend_frames, fit_frame, resample
+from geometry.frame import Frame, arc_fractions, at_fractions, blend_frames, fit_frame, resample
 from geometry.mesh import Mesh, revolve
 from geometry.metrics import (
     curve_length,
@@ -23,6 +23,8 @@ from geometry.metrics import (
 )
 
 __all__ = [
+    "arc_fractions",
+    "at_fractions",
     "BSplineFit",
     "Frame",
     "Mesh",

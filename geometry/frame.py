@@ -59,18 +59,40 @@ def blend_frames(frames: list[Frame], weights: np.ndarray) -> list[Frame]:
     return [Frame(center=(float(c[0]), float(c[1])), size=float(s)) for c, s in zip(out_c, out_s)]
 
 
-def resample(points: np.ndarray, n_points: int) -> np.ndarray:
-    """Resample a polyline (n, 2) to n_points evenly spaced along its arc length.
+def arc_fractions(points: np.ndarray) -> np.ndarray:
+    """Where each point of a polyline (n, 2) sits along its arc length, from 0 to 1."""
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    if s[-1] <= 0:
+        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+    return s / s[-1]
 
-    End points are kept; repeated consecutive points are harmless.
+
+def at_fractions(curve: np.ndarray, fractions: np.ndarray) -> np.ndarray:
+    """Points of a polyline (m, 2) at fractions of its index range, linearly between neighbours.
+
+    Point j stands for fraction j/(m-1), so fractions from the same spacing give its own points.
+    """
+    x = np.clip(fractions, 0.0, 1.0) * (len(curve) - 1)
+    idx = np.arange(len(curve))
+    return np.stack([np.interp(x, idx, curve[:, 0]), np.interp(x, idx, curve[:, 1])], axis=1)
+
+
+def resample(points: np.ndarray, n_points: int, *, spacing: str = "arc_length") -> np.ndarray:
+    """Resample a polyline (n, 2) to n_points; end points are kept.
+
+    spacing "arc_length": evenly along the arc (repeated points are harmless); "parameter":
+    evenly along the point index, for points that are already evenly spaced in the curve's
+    parameter — the data set's sampling, which arc-length spacing would move by several
+    pixels where the curve's control points bunch up.
     """
     pts = np.asarray(points, dtype=np.float64)
-    if len(pts) == n_points:
-        seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-        # Already evenly spaced: return untouched so a round trip is exact.
-        if np.ptp(seg) <= 1e-9 * max(seg.mean(), 1e-300):
-            return pts.copy()
+    if spacing == "parameter":
+        return pts.copy() if len(pts) == n_points else at_fractions(pts, np.linspace(0.0, 1.0, n_points))
+    if spacing != "arc_length":
+        raise ValueError(f"spacing must be 'arc_length' or 'parameter', got {spacing!r}")
     seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    if len(pts) == n_points and np.ptp(seg) <= 1e-9 * max(seg.mean(), 1e-300):
+        return pts.copy()  # already evenly spaced: untouched, so a round trip is exact
     s = np.concatenate([[0.0], np.cumsum(seg)])
     if s[-1] <= 0:
         raise ValueError("all points coincide: a curve needs at least 2 distinct points")

@@ -31,7 +31,7 @@ from typing import Any, Literal
 import numpy as np
 import onnxruntime as ort
 
-from geometry import Frame, blend_frames, fit_frame, mse_per_curve, resample
+from geometry import Frame, arc_fractions, at_fractions, blend_frames, fit_frame, mse_per_curve, resample
 
 log = logging.getLogger(__name__)
 
@@ -175,29 +175,6 @@ class Prepared:
     inputs: list[np.ndarray]  # the caller's curves, float64
 
 
-def _arc_fractions(points: np.ndarray) -> np.ndarray:
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
-    return s / s[-1]
-
-
-def _at_fractions(curve: np.ndarray, fractions: np.ndarray) -> np.ndarray:
-    """Points of a model curve (m, 2) at the given positions: the inverse of the input's resampling.
-
-    Model point j stands for the input at fraction j/(m-1) (of its index or its arc length),
-    so the input's own points come back where fraction·(m-1) falls, between neighbours.
-    """
-    x = np.clip(fractions, 0.0, 1.0) * (len(curve) - 1)
-    idx = np.arange(len(curve))
-    return np.stack([np.interp(x, idx, curve[:, 0]), np.interp(x, idx, curve[:, 1])], axis=1)
-
-
-def _to_length(curve: np.ndarray, n_points: int, spacing: Spacing) -> np.ndarray:
-    """n_points of a polyline: evenly along its index (its parameter) or by arc length."""
-    if spacing == "arc_length":
-        return resample(curve, n_points)
-    return curve.copy() if len(curve) == n_points else _at_fractions(curve, np.linspace(0.0, 1.0, n_points))
-
-
 class CurveRuntime:
     """Encoder and decoder sessions of one exported model, with frame and length handling."""
 
@@ -331,11 +308,11 @@ class CurveRuntime:
                 m = f.to_model(pts, self.model_size) if f is not None else pts
                 fraction = None
                 if spacing == "arc_length":
-                    fraction = _arc_fractions(m)
+                    fraction = arc_fractions(m)
                     m = resample(m, self.n_points)
                 elif len(pts) != self.n_points:
                     fraction = np.linspace(0.0, 1.0, len(pts))
-                    m = _to_length(m, self.n_points, spacing)
+                    m = resample(m, self.n_points, spacing=spacing)
                 if not (np.abs(m) <= _F32_MAX).all():  # also false for inf and nan
                     raise InputError(
                         ("curves", i),
@@ -367,9 +344,9 @@ class CurveRuntime:
         """
         curve = np.asarray(out, np.float64)
         if n_points is not None:
-            curve = _to_length(curve, n_points, spacing)
+            curve = resample(curve, n_points, spacing=spacing)
         elif fractions is not None:
-            curve = _at_fractions(curve, fractions)
+            curve = at_fractions(curve, fractions)
         return frame.from_model(curve, self.model_size) if frame is not None else curve
 
     def encode(
