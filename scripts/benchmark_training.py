@@ -53,11 +53,21 @@ def main() -> None:
     for name, bf16, comp in modes:
         model = VAE(ModelConfig(variant=a.variant))
         net = torch.compile(model) if comp else model
-        results[name] = measure(net, bf16=bf16, steps=a.steps if not bf16 else max(2, a.steps // 5),
-                                warmup=3 if comp else 1, batch=a.batch)
+        results[name] = measure(
+            net, bf16=bf16, steps=a.steps if not bf16 else max(2, a.steps // 5), warmup=3 if comp else 1, batch=a.batch
+        )
         print(f"{name:>14}: {results[name]:7.1f} curves/s  ({results[name] / results['fp32']:.2f}× fp32)", flush=True)
-    print(json.dumps({"variant": a.variant, "threads": torch.get_num_threads(), "cpu": platform.processor()
-                      or platform.machine(), "torch": torch.__version__, "curves_per_s": results}))
+    print(
+        json.dumps(
+            {
+                "variant": a.variant,
+                "threads": torch.get_num_threads(),
+                "cpu": platform.processor() or platform.machine(),
+                "torch": torch.__version__,
+                "curves_per_s": results,
+            }
+        )
+    )
 
 
 if __name__ == "__main__":
