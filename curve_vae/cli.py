@@ -105,6 +105,8 @@ def _add_train_options(p: argparse.ArgumentParser) -> None:
         "threads": "torch CPU threads (0: torch's default)",
         "device": "auto | cpu | cuda",
         "train_limit": "use only the first N training curves (0: all)",
+        "time_budget": "seconds of training; the schedule follows elapsed training time and the run "
+        "stops when it is spent, whatever the throughput (0: off; --epochs stays an upper bound)",
     }
     for f in fields(TrainConfig):
         flag = "--" + f.name.replace("_", "-")
@@ -139,11 +141,17 @@ def cmd_train(a: argparse.Namespace) -> int:
         resume=a.resume,
         progress=not a.no_progress,
         stop_after=a.stop_after,
+        init_from=a.init_from or None,
     )
     if int(os.environ.get("RANK", "0")) != 0:
         return 0
     print(f"best validation MSE {state.best_val:.4f} at epoch {state.best_epoch}; checkpoints in {run_dir}")
-    if state.epoch >= cfg.epochs or (cfg.patience and state.epoch - state.best_epoch >= cfg.patience):
+    finished = (
+        state.epoch >= cfg.epochs
+        or (cfg.patience and state.epoch - state.best_epoch >= cfg.patience)
+        or 0 < cfg.time_budget <= state.trained_seconds
+    )
+    if finished:
         from training.data import load_or_generate
 
         ds = load_or_generate(_data_config(a), a.data)
@@ -311,6 +319,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="stop after this many epochs of this call; resume later (default: 0 = run to --epochs)",
     )
     s.add_argument("--no-progress", action="store_true", help="no progress bar; one line per epoch")
+    s.add_argument(
+        "--init-from",
+        default="",
+        help="start a new run from these weights (a checkpoint, or models/vae.pt to continue the shipped model)",
+    )
     _add_data_options(s)
     _add_train_options(s)
     s.set_defaults(func=cmd_train)

@@ -41,6 +41,7 @@ class RunState:
     epoch: int = 0  # epochs completed
     best_val: float = math.inf
     best_epoch: int = -1
+    trained_seconds: float = 0.0  # time spent in training steps, across resumes
     history: list[dict[str, float]] = field(default_factory=list)
 
 
@@ -77,6 +78,43 @@ def autocast(device: torch.device, bf16: bool):
     return torch.autocast(device.type, dtype=torch.bfloat16) if bf16 else nullcontext()
 
 
+class Clock:
+    """Training time spent so far (across resumes) and the fraction of a time budget it is."""
+
+    def __init__(self, budget: float, spent: float) -> None:
+        self.budget, self.spent, self._since = budget, spent, 0.0
+
+    def __enter__(self) -> Clock:
+        self._since = time.perf_counter()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.spent = self.elapsed()
+        self._since = 0.0
+
+    def elapsed(self) -> float:
+        return self.spent + (time.perf_counter() - self._since if self._since else 0.0)
+
+    def progress(self) -> float:
+        return min(1.0, self.elapsed() / self.budget) if self.budget > 0 else 0.0
+
+    def over(self) -> bool:
+        return self.budget > 0 and self.elapsed() >= self.budget
+
+
+def schedule_factor(schedule: str, progress: float, warmup: float) -> float:
+    """Learning-rate multiplier at a fraction of the run, the shape of torch's OneCycleLR/cosine."""
+    if schedule == "onecycle":
+        start, end = 1 / 25, 1 / 25 / 1e3
+        if progress < warmup:
+            return start + (1 - start) * (1 - math.cos(math.pi * progress / warmup)) / 2
+        q = (progress - warmup) / max(1e-12, 1 - warmup)
+        return end + (1 - end) * (1 + math.cos(math.pi * q)) / 2
+    if schedule == "cosine":
+        return 1e-3 + (1 - 1e-3) * (1 + math.cos(math.pi * progress)) / 2
+    return 1.0
+
+
 def train_one_epoch(
     model: nn.Module,
     data: torch.Tensor,
@@ -87,13 +125,20 @@ def train_one_epoch(
     device: torch.device,
     *,
     bar: tqdm | None = None,
+    clock: Clock | None = None,
 ) -> dict[str, float]:
-    """One pass over `data[order]` in batches; returns the mean of each loss term."""
+    """One pass over `data[order]` in batches; returns the mean of each loss term.
+
+    With a clock on a time budget, the pass ends early once the budget is spent (on every
+    DDP process at the same step: rank 0's clock decides).
+    """
     model.train()
     sums: dict[str, float] = {}
     n_batches = 0
     per_step = cfg.batch_size // max(1, dist.get_world_size() if dist.is_initialized() else 1)
     for i in range(0, len(order) - per_step + 1, per_step):  # drop the ragged last batch
+        if clock is not None and clock.budget > 0 and _agree(clock.over()):
+            break
         x = data[order[i : i + per_step]].to(device, non_blocking=True)
         with autocast(device, cfg.bf16):
             pred, mean, log_var = model(x)
@@ -112,7 +157,16 @@ def train_one_epoch(
             bar.update(len(x))
             if n_batches % 10 == 0:
                 bar.set_postfix({k: f"{sums[k] / n_batches:.4g}" for k in ("loss", "mse", "kl", "lap")})
-    return {k: v / max(1, n_batches) for k, v in sums.items()}
+    return {**{k: v / max(1, n_batches) for k, v in sums.items()}, "steps": n_batches}
+
+
+def _agree(flag: bool) -> bool:
+    """Rank 0's flag on every process (a no-op without DDP)."""
+    if not dist.is_initialized():
+        return flag
+    t = torch.tensor([int(flag)])
+    dist.broadcast(t, 0)
+    return bool(t.item())
 
 
 @torch.no_grad()
@@ -127,7 +181,13 @@ def reconstruct(
     return torch.cat(out).numpy()
 
 
-def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch: int):
+def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch: int, clock: Clock):
+    if cfg.time_budget > 0:  # the schedule's clock is training time, whatever the throughput
+        for g in opt.param_groups:
+            g["initial_lr"] = cfg.lr
+        return torch.optim.lr_scheduler.LambdaLR(
+            opt, lambda _step: schedule_factor(cfg.schedule, clock.progress(), cfg.warmup)
+        )
     total = cfg.epochs * steps_per_epoch
     if cfg.schedule == "onecycle":
         return torch.optim.lr_scheduler.OneCycleLR(
@@ -159,11 +219,14 @@ def train(
     resume: bool = False,
     progress: bool = True,
     stop_after: int = 0,
+    init_from: str | Path | None = None,
 ) -> RunState:
     """Train into `run_dir` (last.pt, best.pt, log.jsonl); resume from last.pt if asked.
 
     stop_after: leave after this many epochs of this call (0: run to cfg.epochs), so a long
     schedule can be run in time-boxed slices and continued with resume=True.
+    init_from: a new run starts from these weights (a checkpoint or a shipped vae.pt) with a
+    fresh optimiser and schedule: fine-tuning, or continuing the shipped model on a new machine.
     """
     run_dir = Path(run_dir)
     distributed = int(os.environ.get("WORLD_SIZE", "1")) > 1
@@ -196,7 +259,8 @@ def train(
         steps_per_epoch = len(data) // world // (cfg.batch_size // world)
         if steps_per_epoch < 1:
             raise ValueError(f"{len(data)} training curves are fewer than one batch of {cfg.batch_size}")
-        sched = _make_schedule(opt, cfg, steps_per_epoch)
+        clock = Clock(cfg.time_budget, 0.0)
+        sched = _make_schedule(opt, cfg, steps_per_epoch, clock)
         gen = np.random.default_rng(cfg.seed)
         state = RunState()
 
@@ -218,12 +282,21 @@ def train(
             if sched is not None and ckpt.get("scheduler") is not None:
                 sched.load_state_dict(ckpt["scheduler"])
             state = RunState(**ckpt["state"])
+            clock.spent = state.trained_seconds
             torch.set_rng_state(ckpt["rng"]["torch"])
             gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
             if rank == 0:
                 print(f"resumed {last} at epoch {state.epoch}/{cfg.epochs}", flush=True)
-        elif resume and rank == 0:
-            print(f"no checkpoint at {last}: starting a new run", flush=True)
+        else:
+            if resume and rank == 0:
+                print(f"no checkpoint at {last}: starting a new run", flush=True)
+            if init_from:
+                init = torch.load(init_from, map_location="cpu", weights_only=True)
+                if ModelConfig(**init["model_config"]) != model_cfg:
+                    raise ValueError(f"{init_from} holds a {init['model_config']} model, not {asdict(model_cfg)}")
+                model.load_state_dict(init["model"])
+                if rank == 0:
+                    print(f"initialised from {init_from}", flush=True)
 
         net: nn.Module = model
         if distributed:
@@ -252,9 +325,11 @@ def train(
                 leave=False,
                 dynamic_ncols=True,
             )
-            terms = train_one_epoch(net, data, order, opt, sched, cfg, device, bar=bar)
+            with clock:
+                terms = train_one_epoch(net, data, order, opt, sched, cfg, device, bar=bar, clock=clock)
             bar.close()
             train_time = time.perf_counter() - t0
+            state.trained_seconds = clock.spent
             val_mse = float(np.mean((reconstruct(model, val, device=device) - val.numpy()) ** 2))
             if distributed:  # decide on rank 0's number so every rank stops together
                 v = torch.tensor([val_mse], dtype=torch.float64)
@@ -263,13 +338,15 @@ def train(
             if sched is not None and cfg.schedule == "plateau":
                 sched.step(val_mse)
             state.epoch += 1
+            steps = terms.pop("steps")
             row = {
                 "epoch": state.epoch,
                 **{f"train_{k}": v for k, v in terms.items()},
                 "val_mse": val_mse,
                 "lr": opt.param_groups[0]["lr"],
                 "seconds": train_time,
-                "curves_per_s": len(order) * world / train_time,
+                "curves_per_s": steps * cfg.batch_size / train_time,
+                "trained_seconds": state.trained_seconds,
             }
             state.history.append(row)
             improved = val_mse < state.best_val
@@ -301,6 +378,10 @@ def train(
             if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
                 if rank == 0:
                     print(f"early stop: no better validation MSE for {cfg.patience} epochs", flush=True)
+                break
+            if clock.over():
+                if rank == 0:
+                    print(f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs", flush=True)
                 break
         return state
     finally:

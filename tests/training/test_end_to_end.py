@@ -16,8 +16,7 @@ from training.train import load_checkpoint, model_from_checkpoint
 
 pytestmark = pytest.mark.slow
 
-TINY = ["--n-train", "256", "--n-val", "32", "--n-test", "32", "--batch-size", "32", "--no-progress",
-        "--threads", "2"]
+TINY = ["--n-train", "256", "--n-val", "32", "--n-test", "32", "--batch-size", "32", "--no-progress", "--threads", "2"]
 
 
 def _log(run):
@@ -63,8 +62,10 @@ def test_resume_reproduces_an_uninterrupted_run(trained):
 def test_export_parity_and_manifest(trained):
     tmp, data, cut, _, _ = trained
     out = tmp / "models"
-    assert main(["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data,
-                 "--version", "9.9.9"]) == 0
+    assert (
+        main(["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--version", "9.9.9"])
+        == 0
+    )
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["version"] == "9.9.9" and manifest["latent_dim"] == 32 and manifest["n_points"] == 161
     for name, meta in manifest["files"].items():
@@ -104,12 +105,95 @@ def test_evaluate_exported_model(trained, capsys):
 
 def test_ddp_two_cpu_processes(tmp_path):
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    cmd = [sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc-per-node", "2",
-           "-m", "curve_vae.cli", "train", "--run-dir", str(tmp_path / "run"), "--data",
-           str(tmp_path / "d.npz"), "--epochs", "2", *TINY[:-2], "--threads", "1"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "torch.distributed.run",
+        "--standalone",
+        "--nproc-per-node",
+        "2",
+        "-m",
+        "curve_vae.cli",
+        "train",
+        "--run-dir",
+        str(tmp_path / "run"),
+        "--data",
+        str(tmp_path / "d.npz"),
+        "--epochs",
+        "2",
+        *TINY[:-2],
+        "--threads",
+        "1",
+    ]
     proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
     rows = _log(tmp_path / "run")
     assert [r["epoch"] for r in rows] == [1, 2]  # one writer: rank 0
     # Each of the 2 processes takes half of every global batch: 256 curves → 8 steps of 16 each.
     assert load_checkpoint(tmp_path / "run" / "last.pt")["optimizer"]["state"][0]["step"] == 16
+
+
+def test_init_from_shipped_weights(trained):
+    tmp, data, _, _, _ = trained
+    shipped = torch.load(tmp / "models" / "vae.pt", weights_only=True)  # written by the export test
+    run = tmp / "finetune"
+    args = [
+        "train",
+        "--run-dir",
+        str(run),
+        *TINY,
+        "--data",
+        data,
+        "--epochs",
+        "1",
+        "--lr",
+        "1e-9",
+        "--init-from",
+        str(tmp / "models" / "vae.pt"),
+    ]
+    assert main(args) == 0
+    tuned = load_checkpoint(run / "last.pt")["model"]
+    for k, v in shipped["model"].items():
+        if "running" not in k and "num_batches" not in k:  # BatchNorm statistics keep moving
+            torch.testing.assert_close(tuned[k], v, atol=1e-6, rtol=0, msg=k)
+    bad = [
+        "train",
+        "--run-dir",
+        str(tmp / "bad"),
+        *TINY,
+        "--data",
+        data,
+        "--epochs",
+        "1",
+        "--latent-dim",
+        "8",
+        "--init-from",
+        str(tmp / "models" / "vae.pt"),
+    ]
+    assert main(bad) == 2  # a model of another shape is refused with a message, not a traceback
+
+
+def test_time_budget_anneals_and_stops(tmp_path):
+    run = tmp_path / "budget"
+    args = [
+        "train",
+        "--run-dir",
+        str(run),
+        *TINY,
+        "--data",
+        str(tmp_path / "d.npz"),
+        "--variant",
+        "cnn1",
+        "--epochs",
+        "1000",
+        "--time-budget",
+        "6",
+        "--lr",
+        "1e-3",
+    ]
+    assert main(args) == 0
+    rows = _log(run)
+    assert 1 <= len(rows) < 1000
+    assert rows[-1]["trained_seconds"] >= 6
+    assert rows[-1]["lr"] < 1e-3 * 0.01  # annealed by the end of the budget, not by epoch count
+    assert (run / "report.json").exists()  # a finished run is evaluated
