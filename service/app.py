@@ -23,14 +23,26 @@ import onnxruntime as ort
 from fastapi import APIRouter, Body, Depends, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.middleware.cors import CORSMiddleware
-from fastapi.responses import JSONResponse, Response
+from fastapi.responses import JSONResponse, Response, StreamingResponse
 from starlette.exceptions import HTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from geometry import Frame
+from geometry import Frame, revolve
 from service import schemas as s
 from service.metrics import Metrics, MetricsMiddleware
-from service.runtime import CurveRuntime, InputError, ModelLoadError, format_loc, simplex_grid, simplex_grid_size
+from service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
+from service.npy import chunk_bytes, npy_header, npy_size
+from service.payloads import augment_body, fit_body, frames_json, sample_body, with_metrics
+from service.runtime import (
+    AugmentPlan,
+    CurveRuntime,
+    InputError,
+    ModelLoadError,
+    format_loc,
+    fresh_seed,
+    simplex_grid,
+    simplex_grid_size,
+)
 from service.settings import Settings, get_settings
 
 log = logging.getLogger("service")
@@ -209,10 +221,8 @@ def _check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
     return np.array(req.weights, dtype=np.float64)
 
 
-def _frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
-    if not frames or frames[0] is None:
-        return None
-    return [{"center": list(f.center), "size": f.size} for f in frames if f is not None]
+def _limiter(request: Request) -> anyio.CapacityLimiter | None:
+    return getattr(request.app.state, "limiter", None)  # set by the lifespan; None: anyio's default
 
 
 async def _run(request: Request, route: str, batch: int, work: Callable[[], Response]) -> Response:
@@ -222,7 +232,7 @@ async def _run(request: Request, route: str, batch: int, work: Callable[[], Resp
     metrics.batch_size.labels(route).observe(batch)
     start = time.perf_counter()
     try:
-        return await anyio.to_thread.run_sync(work, limiter=request.app.state.limiter)
+        return await anyio.to_thread.run_sync(work, limiter=_limiter(request))
     finally:
         metrics.inference.labels(route).observe(time.perf_counter() - start)
 
@@ -310,7 +320,7 @@ async def encode(
 
     def work() -> Response:
         mean, log_var, frames = runtime.encode(curves, frame=req.frame, spacing=req.spacing)
-        return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": _frames_json(frames)})
+        return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": frames_json(frames)})
 
     return await _run(request, "/encode", len(curves), work)
 
@@ -357,7 +367,7 @@ async def decode(
     def work() -> Response:
         latents = np.array(req.latents, np.float64)
         curves = runtime.decode(latents, n_points=req.n_points, spacing=req.spacing, frames=frames)
-        return JSONResponse({"curves": curves.tolist()})
+        return JSONResponse(with_metrics({"curves": curves.tolist()}, curves, req.metrics))
 
     return await _run(request, "/decode", len(req.latents), work)
 
@@ -391,7 +401,7 @@ async def reconstruct(
 
     def work() -> Response:
         out, mse = runtime.reconstruct(curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing)
-        return JSONResponse({"curves": [c.tolist() for c in out], "mse": mse.tolist()})
+        return JSONResponse(with_metrics({"curves": [c.tolist() for c in out], "mse": mse.tolist()}, out, req.metrics))
 
     return await _run(request, "/reconstruct", len(curves), work)
 
@@ -436,7 +446,8 @@ async def interpolate(
 
     def work() -> Response:
         out, frames = runtime.interpolate(curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing)
-        return JSONResponse({"weights": weights.tolist(), "curves": out.tolist(), "frames": _frames_json(frames)})
+        body = {"weights": weights.tolist(), "curves": out.tolist(), "frames": frames_json(frames)}
+        return JSONResponse(with_metrics(body, out, req.metrics))
 
     return await _run(request, "/interpolate", len(weights), work)
 
@@ -458,28 +469,49 @@ async def sample(
             openapi_examples={
                 "seeded": _example("Three curves, reproducible", {"count": 3, "seed": 7, "n_points": 50}),
                 "tame": _example("Closer to typical shapes", {"count": 2, "seed": 1, "temperature": 0.5}),
+                "framed": _example(
+                    "In a frame of one's own, with smoothness metrics",
+                    {"count": 2, "seed": 3, "frame": {"center": [0, 0], "size": 2}, "metrics": True},
+                ),
             }
         ),
     ],
 ) -> Response:
-    """Decode latents drawn from N(0, temperature²·I) into curves in the model's 128×128 plane."""
+    """Decode latents drawn from N(0, temperature²·I) into curves in the model's 128×128 plane (or `frame`).
+    The same seed gives the same curves; without one, the response reports the seed drawn."""
     if req.count > settings.max_curves:
         raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
     _check_n_points(req.n_points, settings)
+    seed = fresh_seed() if req.seed is None else req.seed
+    frame = Frame(center=req.frame.center, size=req.frame.size) if req.frame else None
 
     def work() -> Response:
         latents, curves = runtime.sample(
-            req.count, seed=req.seed, temperature=req.temperature, n_points=req.n_points, spacing=req.spacing
+            req.count, seed=seed, temperature=req.temperature, n_points=req.n_points, spacing=req.spacing, frame=frame
         )
-        return JSONResponse({"latents": latents.tolist(), "curves": curves.tolist()})
+        return JSONResponse(sample_body(latents, curves, seed, metrics=req.metrics))
 
     return await _run(request, "/sample", req.count, work)
+
+
+_AUGMENT_NPY = {
+    "description": 'format "json": the curves, their sources and weights (AugmentResponse). format "npy": the '
+    "curves alone as a .npy file, float32 of shape (count, points, 2), streamed with its Content-Length.",
+    "content": {NPY_MEDIA_TYPE: {"schema": {"type": "string", "format": "binary"}}},
+    "headers": {
+        "X-Augment-Seed": {
+            "description": "The seed used (to repeat the batch, or page through it as JSON).",
+            "schema": {"type": "string"},
+        },
+        "Content-Disposition": {"description": 'attachment; filename="augment.npy"', "schema": {"type": "string"}},
+    },
+}
 
 
 @curves_router.post(
     "/augment",
     response_model=s.AugmentResponse,
-    responses=_POST_ERRORS,
+    responses={200: _AUGMENT_NPY, **_POST_ERRORS},
     summary="New curves between given curves",
     openapi_extra=_curl(
         "/augment",
@@ -500,27 +532,222 @@ async def augment(
                 "triplets": _example(
                     "Two random triplet interpolants", {"curves": [_C1, _C2, _C3], "count": 2, "mode": "triplet"}
                 ),
+                "neighbours, second page": _example(
+                    "Pairs of near neighbours only; curves 4 and 5 of the seeded sequence",
+                    {"curves": [_C1, _C2, _C3], "count": 2, "neighbours": 1, "seed": 1, "offset": 4},
+                ),
+                "npy": _example(
+                    "1000 curves as a binary .npy file (curl -o batch.npy)",
+                    {"curves": [_C1, _C2, _C3], "count": 1000, "seed": 1, "n_points": 64, "format": "npy"},
+                ),
             }
         ),
     ],
 ) -> Response:
-    """Random interpolants of random pairs or triplets of the curves, each in the blend of its sources' frames:
-    new training data between the given curves."""
+    """Random interpolants of random pairs or triplets of the curves (optionally near neighbours in latent space),
+    each in the blend of its sources' frames: new training data between the given curves. Item i of the sequence
+    depends only on (seed, i): page with `offset`, or stream any count as .npy with `format` "npy"."""
     curves = _check_curves(req.curves, settings)
-    if req.mode == "triplet" and len(curves) < 3:
-        raise InputError(("curves",), f"mode triplet needs at least 3 curves, got {len(curves)}")
-    if req.count > settings.max_curves:
-        raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
+    limit, setting = (
+        (settings.max_curves, "CURVE_VAE_MAX_CURVES")
+        if req.format == "json"
+        else (settings.max_stream_curves, "CURVE_VAE_MAX_STREAM_CURVES")
+    )
+    if req.count > limit:
+        more = "; page through more with offset, or stream them with format npy" if req.format == "json" else ""
+        raise InputError(("count",), f"at most {limit}, got {req.count} (format {req.format}, {setting}){more}")
+    if req.metrics and req.format == "npy":
+        raise InputError(("metrics",), "only with format json: a .npy body carries the curves alone")
+    _check_n_points(req.n_points, settings)
+    seed = fresh_seed() if req.seed is None else req.seed
+    start, stop = req.offset, req.offset + req.count
+
+    def plan() -> AugmentPlan:
+        return runtime.plan_augment(
+            curves, mode=req.mode, seed=seed, neighbours=req.neighbours, frame=req.frame, spacing=req.spacing
+        )
+
+    if req.format == "npy":
+        return await _stream_augment(request, runtime, plan, req, seed)
+
+    def work() -> Response:
+        out, sources, weights, frames = runtime.augment_batch(
+            plan(), start, stop, n_points=req.n_points, spacing=req.spacing
+        )
+        body = augment_body(out, sources, weights, frames, seed=seed, offset=req.offset, metrics=req.metrics)
+        return JSONResponse(body)
+
+    return await _run(request, "/augment", req.count, work)
+
+
+async def _stream_augment(
+    request: Request, runtime: CurveRuntime, plan: Callable[[], AugmentPlan], req: s.AugmentRequest, seed: int
+) -> Response:
+    """The curves of a planned augmentation as a .npy body, one batch_size chunk per worker-thread call: memory stays
+    bounded by a chunk whatever the count. The seed curves are encoded and the first chunk made before answering, so
+    that their errors are 422s; the inference time is observed once the body is sent."""
+    metrics: Metrics = request.app.state.metrics
+    metrics.batch_size.labels("/augment").observe(req.count)
+    busy = 0.0
+
+    async def in_thread(fn: Callable[..., Any], *args: Any) -> Any:
+        nonlocal busy
+        begin = time.perf_counter()
+        try:
+            return await anyio.to_thread.run_sync(fn, *args, limiter=_limiter(request))
+        finally:
+            busy += time.perf_counter() - begin
+
+    try:
+        planned: AugmentPlan = await in_thread(plan)
+        shape = (req.count, runtime.mix_length(planned.prep, req.n_points), 2)
+        chunks = runtime.augment_chunks(
+            planned, req.offset, req.offset + req.count, n_points=req.n_points, spacing=req.spacing
+        )
+        first = await in_thread(next, chunks, None)
+    except BaseException:
+        metrics.inference.labels("/augment").observe(busy)
+        raise
+
+    async def body() -> AsyncIterator[bytes]:
+        try:
+            yield npy_header(shape)
+            chunk = first
+            while chunk is not None:
+                yield chunk_bytes(chunk, shape)
+                chunk = await in_thread(next, chunks, None)
+        finally:
+            metrics.inference.labels("/augment").observe(busy)
+
+    headers = {
+        "Content-Length": str(npy_size(shape)),
+        "Content-Disposition": 'attachment; filename="augment.npy"',
+        "X-Augment-Seed": str(seed),
+    }
+    return StreamingResponse(body(), media_type=NPY_MEDIA_TYPE, headers=headers)
+
+
+# --------------------------------------------------------------------------- design tools (no model needed)
+
+design_router = APIRouter(tags=["design"])
+
+
+@design_router.post(
+    "/fit",
+    response_model=s.FitResponse,
+    responses=_errors(413, 422),
+    summary="Least-squares cubic B-spline of each curve",
+    openapi_extra=_curl("/fit", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]], "n_ctrl": 5}'),
+)
+async def fit(
+    request: Request,
+    settings: SettingsDep,
+    req: Annotated[
+        s.FitRequest,
+        Body(
+            openapi_examples={
+                "five control points": _example("A 7-point curve, 5 control points", {"curves": [_C1], "n_ctrl": 5}),
+                "with the fitted curve": _example(
+                    "Control polygon and the spline at 20 points", {"curves": [_C1, _C2], "n_ctrl": 6, "n_points": 20}
+                ),
+            }
+        ),
+    ],
+) -> Response:
+    """Clamped uniform cubic B-spline with `n_ctrl` control points (default 10, as the paper's data) fitted to each
+    curve by least squares: control points, knots, and how far the curve is from the spline."""
+    curves = _check_curves(req.curves, settings)
     _check_n_points(req.n_points, settings)
 
     def work() -> Response:
-        out, sources, weights, frames = runtime.augment(
-            curves, req.count, mode=req.mode, seed=req.seed, frame=req.frame, n_points=req.n_points, spacing=req.spacing
-        )
-        body = {"curves": out.tolist(), "sources": sources.tolist(), "weights": weights.tolist()}
-        return JSONResponse({**body, "frames": _frames_json(frames)})
+        return JSONResponse(fit_body(curves, req.n_ctrl, param=req.param, n_points=req.n_points))
 
-    return await _run(request, "/augment", req.count, work)
+    return await _run(request, "/fit", len(curves), work)
+
+
+_MESH_TYPES = {"obj": "model/obj", "stl": "model/stl"}
+
+
+@design_router.post(
+    "/revolve",
+    response_class=Response,
+    responses={
+        200: {
+            "description": "The mesh file: OBJ text or binary STL. Headers X-Mesh-Vertices, X-Mesh-Faces (triangles) "
+            "and X-Mesh-Closed (true when every edge joins two triangles: a watertight surface).",
+            "content": {
+                "model/obj": {"schema": {"type": "string"}, "example": "v 0 0 0\nv 2 0 0\n…\nf 1 3 2\n…\n"},
+                "model/stl": {"schema": {"type": "string", "format": "binary"}},
+            },
+            "headers": {
+                name: {"description": text, "schema": {"type": "string"}}
+                for name, text in [
+                    ("X-Mesh-Vertices", "vertex count"),
+                    ("X-Mesh-Faces", "triangle count"),
+                    ("X-Mesh-Closed", "true: closed and watertight; false: open at the rims of the end rings"),
+                    ("Content-Disposition", 'attachment; filename="surface.obj" (or .stl)'),
+                ]
+            },
+        },
+        **_errors(413, 422),
+    },
+    summary="Surface of revolution of a profile curve (a vase, paper Fig. 12)",
+    openapi_extra=_curl("/revolve", '{"curve": [[0,0],[3,0],[4,1],[3,3],[2.5,5],[3,7],[0,7]], "segments": 32}'),
+)
+async def revolve_profile(
+    request: Request,
+    settings: SettingsDep,
+    req: Annotated[
+        s.RevolveRequest,
+        Body(
+            openapi_examples={
+                "vase": _example(
+                    "A closed vase: the profile's ends lie on the axis x = 0",
+                    {"curve": [[0, 0], [3, 0], [4, 1], [3, 3], [2.5, 5], [3, 7], [0, 7]], "segments": 32},
+                ),
+                "ring, STL": _example(
+                    "An open band about the horizontal line y = -1, binary STL",
+                    {"curve": _C1, "axis": "x", "axis_position": -1, "format": "stl"},
+                ),
+            }
+        ),
+    ],
+) -> Response:
+    """Revolve a profile about a vertical (or horizontal) line of its plane into a triangle mesh, outward-facing;
+    answered as a file (OBJ text by default, or binary STL) with its vertex and triangle counts in headers."""
+    profile = _check_curves([req.curve], settings)[0]
+    triangles = 2 * (len(profile) - 1) * req.segments  # at most: pole bands have half as many
+    if triangles > settings.max_mesh_triangles:
+        raise InputError(
+            ("segments",),
+            f"{req.segments} segments of a {len(profile)}-point profile make up to {triangles} triangles; at most "
+            f"{settings.max_mesh_triangles} (CURVE_VAE_MAX_MESH_TRIANGLES)",
+        )
+
+    def work() -> Response:
+        try:
+            mesh = revolve(profile, segments=req.segments, axis=req.axis, axis_position=req.axis_position)
+        except ValueError as e:
+            raise InputError(("curve",), str(e)) from e
+        if not np.isfinite(mesh.vertices).all():
+            raise InputError(("curve",), "the mesh does not fit in float64: scale the profile down")
+        closed = all(uses == 2 for uses in mesh.edge_use().values())
+        if req.format == "stl":
+            content: bytes | str = mesh.to_stl()
+        else:
+            content = mesh.to_obj(
+                comment=f"curve-vae surface of revolution: {len(profile)}-point profile, "
+                f"{req.segments} segments about the {req.axis} axis"
+            )
+        headers = {
+            "X-Mesh-Vertices": str(len(mesh.vertices)),
+            "X-Mesh-Faces": str(len(mesh.faces)),
+            "X-Mesh-Closed": str(closed).lower(),
+            "Content-Disposition": f'attachment; filename="surface.{req.format}"',
+        }
+        return Response(content, media_type=_MESH_TYPES[req.format], headers=headers)
+
+    return await _run(request, "/revolve", 1, work)
 
 
 @ops_router.get("/health", response_model=s.StatusResponse, summary="Liveness", openapi_extra=_curl("/health"))
@@ -569,6 +796,8 @@ async def model_info(runtime: RuntimeDep, settings: SettingsDep) -> dict[str, An
             "max_curves": settings.max_curves,
             "max_points": settings.max_points,
             "max_body_bytes": settings.max_body_bytes,
+            "max_stream_curves": settings.max_stream_curves,
+            "max_mesh_triangles": settings.max_mesh_triangles,
         },
     }
 
@@ -661,12 +890,14 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
         generate_unique_id_function=lambda route: route.name,  # operationId "encode", not "encode_encode_post"
         openapi_tags=[
             {"name": "curves", "description": "Encode, decode, reconstruct, interpolate, sample and augment curves."},
+            {"name": "design", "description": "B-spline fits and surfaces of revolution: geometry, no model needed."},
             {"name": "operations", "description": "Health, readiness, model metadata and metrics."},
         ],
     )
     app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
     app.state.metrics = Metrics()
     app.include_router(curves_router)
+    app.include_router(design_router)
     app.include_router(ops_router)
     app.add_exception_handler(RequestValidationError, _on_validation_error)
     app.add_exception_handler(InputError, _on_input_error)
@@ -681,7 +912,8 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
             allow_headers=["Content-Type"],
             max_age=600,
         )
-    paths = [r.path for r in (*curves_router.routes, *ops_router.routes, *app.routes) if hasattr(r, "path")]
+    routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *app.routes)
+    paths = [r.path for r in routes if hasattr(r, "path")]
     app.add_middleware(MetricsMiddleware, metrics=app.state.metrics, known_paths=paths)
     return app
 

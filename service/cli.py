@@ -30,6 +30,8 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--max-curves", "max_curves", int, "most curves, latents or interpolants per request"),
     ("--max-points", "max_points", int, "most points per curve, in and out"),
     ("--max-body-bytes", "max_body_bytes", int, "larger request bodies are answered 413"),
+    ("--max-stream-curves", "max_stream_curves", int, "most curves in one streamed .npy (POST /augment format npy)"),
+    ("--max-mesh-triangles", "max_mesh_triangles", int, "most triangles in one POST /revolve mesh"),
     ("--batch-size", "batch_size", int, "curves per ONNX run"),
     ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0 lets it choose"),
     ("--inference-concurrency", "inference_concurrency", int, "inferences running at once"),

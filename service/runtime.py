@@ -23,7 +23,7 @@ import hashlib
 import json
 import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -31,7 +31,18 @@ from typing import Any, Literal
 import numpy as np
 import onnxruntime as ort
 
-from geometry import Frame, arc_fractions, at_fractions, blend_frames, fit_frame, mse_per_curve, resample
+from geometry import (
+    Frame,
+    arc_fractions,
+    at_fractions,
+    blend_frames,
+    curve_length,
+    fit_frame,
+    mse_per_curve,
+    resample,
+    self_intersects,
+    smoothness,
+)
 
 log = logging.getLogger(__name__)
 
@@ -431,19 +442,28 @@ class CurveRuntime:
         inputs' common length, at the blend of their points' positions; else the model's.
         """
         prep = self.prepare(curves, frame, spacing)
-        w = np.asarray(weights, np.float64)
-        lengths = {len(c) for c in prep.inputs}
         with np.errstate(all="ignore"):
             mean, _ = self.encode_model(prep.model)
-            _check_finite(mean, "curves", _ENCODE_OVERFLOW)
-            z = w @ mean.astype(np.float64)  # (rows, latent_dim)
+        _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+        return self._mix(prep, mean.astype(np.float64), np.asarray(weights, np.float64), n_points, spacing)
+
+    def _mix(
+        self, prep: Prepared, mean: np.ndarray, w: np.ndarray, n_points: int | None, spacing: Spacing
+    ) -> tuple[np.ndarray, list[Frame | None]]:
+        """Decode weight rows w (rows, len(prep.inputs)) over the encoded means; see `interpolate`."""
+        auto = prep.frames and prep.frames[0] is not None
+        with np.errstate(all="ignore"):
+            # Row by row, never a matrix product: BLAS sums in an order that depends on the number of rows, and
+            # a curve must not change with the batch or page it is made in.
+            z = (w[:, :, None] * mean[None, :, :]).sum(axis=1)  # (rows, latent_dim)
             _check_range(z, "weights")
             out = self.decode_model(z)
             _check_finite(out, "weights", "the weighted latent decodes to non-finite coordinates: weights too extreme")
+            given = [f for f in prep.frames if f is not None]
             frames: list[Frame | None] = (
-                list(blend_frames([f for f in prep.frames if f is not None], w)) if frame == "auto" else [None] * len(w)
+                [blend_frames(given, w[r : r + 1])[0] for r in range(len(w))] if auto else [None] * len(w)
             )
-            common = lengths.pop() if len(lengths) == 1 else None
+            common = self._common_length(prep)
             blend = n_points is None and common is not None and all(f is not None for f in prep.fractions)
             if n_points is None and common is None:
                 n_points = self.n_points
@@ -455,9 +475,18 @@ class CurveRuntime:
                     results.append(self._to_caller(o, frames[r], n_points=None, fractions=positions))
                 else:
                     results.append(self._to_caller(o, frames[r], n_points=n_points, spacing=spacing))
-            result = np.stack(results)
+            result = np.stack(results) if results else np.zeros((0, self.mix_length(prep, n_points), 2))
         _check_finite(result, "weights", "the interpolant does not fit in float64")
         return result, frames
+
+    @staticmethod
+    def _common_length(prep: Prepared) -> int | None:
+        lengths = {len(c) for c in prep.inputs}
+        return lengths.pop() if len(lengths) == 1 else None
+
+    def mix_length(self, prep: Prepared, n_points: int | None) -> int:
+        """Points per curve that mixing `prep`'s curves returns: n_points, else their common length, else 161."""
+        return n_points or self._common_length(prep) or self.n_points
 
     def sample(
         self,
@@ -467,39 +496,162 @@ class CurveRuntime:
         temperature: float = 1.0,
         n_points: int | None = None,
         spacing: Spacing = "parameter",
+        frame: Frame | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """New curves from the prior: latents z ~ N(0, temperature²·I), decoded into the model plane.
+        """New curves from the prior: latents z ~ N(0, temperature²·I), decoded into the model plane
+        (or mapped into `frame`).
 
-        The same seed gives the same latents and curves.
+        The same seed gives the same latents and curves; the first rows of a larger count
+        are the curves of a smaller one.
         """
         z = np.random.default_rng(seed).standard_normal((count, self.latent_dim)) * temperature
-        return z, self.decode(z, n_points=n_points, spacing=spacing)
+        return z, self.decode(z, n_points=n_points, spacing=spacing, frames=[frame] * count if frame else None)
+
+    def plan_augment(
+        self,
+        curves: Sequence[np.ndarray],
+        *,
+        mode: AugmentMode = "pair",
+        seed: int,
+        neighbours: int | None = None,
+        frame: FrameMode = "auto",
+        spacing: Spacing = "parameter",
+    ) -> AugmentPlan:
+        """Encode the seed curves once and fix who may be mixed with whom; see `AugmentPlan`.
+
+        neighbours: each anchor's partners come from its `neighbours` nearest curves by
+        Euclidean distance between latent means (interpolating near neighbours gives better
+        curves, paper §4); None: from all the other curves.
+        """
+        k = SOURCES_PER_MODE[mode]
+        if len(curves) < k:
+            raise InputError(("curves",), f"mode {mode} needs at least {k} curves, got {len(curves)}")
+        if neighbours is not None and neighbours < k - 1:
+            raise InputError(
+                ("neighbours",), f"mode {mode} mixes each curve with {k - 1} others: at least {k - 1}, got {neighbours}"
+            )
+        prep = self.prepare(curves, frame, spacing)
+        with np.errstate(all="ignore"):
+            mean, _ = self.encode_model(prep.model)
+        _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+        mean = mean.astype(np.float64)
+        n = len(mean)
+        distance = np.linalg.norm(mean[:, None, :] - mean[None, :, :], axis=-1)  # (n, n)
+        np.fill_diagonal(distance, np.inf)  # never one's own partner
+        m = n - 1 if neighbours is None else min(neighbours, n - 1)
+        pools = np.sort(np.argsort(distance, axis=1, kind="stable")[:, :m], axis=1)
+        return AugmentPlan(prep=prep, mean=mean, k=k, seed=seed, pools=pools)
+
+    def augment_batch(
+        self, plan: AugmentPlan, start: int, stop: int, *, n_points: int | None = None, spacing: Spacing = "parameter"
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
+        """Items start … stop-1 of the plan's sequence: curves, sources (m, k), weights (m, k), frames."""
+        sources, weights = plan.draw(start, stop)
+        full = np.zeros((len(sources), len(plan.mean)))
+        np.put_along_axis(full, sources, weights, axis=1)
+        out, frames = self._mix(plan.prep, plan.mean, full, n_points, spacing)
+        return out, sources, weights, frames
+
+    def augment_chunks(
+        self,
+        plan: AugmentPlan,
+        start: int,
+        stop: int,
+        *,
+        n_points: int | None = None,
+        spacing: Spacing = "parameter",
+        chunk: int | None = None,
+    ) -> Iterator[np.ndarray]:
+        """The curves of items start … stop-1, `chunk` at a time (default batch_size): bounded memory for any count."""
+        step = chunk or self.batch_size
+        for i in range(start, stop, step):
+            yield self.augment_batch(plan, i, min(i + step, stop), n_points=n_points, spacing=spacing)[0]
 
     def augment(
         self,
         curves: Sequence[np.ndarray],
         count: int,
         *,
-        mode: Literal["pair", "triplet"] = "pair",
+        mode: AugmentMode = "pair",
         seed: int | None = None,
+        neighbours: int | None = None,
+        offset: int = 0,
         frame: FrameMode = "auto",
         n_points: int | None = None,
         spacing: Spacing = "parameter",
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
-        """`count` random interpolants of the curves: data augmentation with the VAE (paper §4).
+        """`count` random interpolants of the curves, items offset … offset+count-1 of the seeded
+        sequence: data augmentation with the VAE (paper §4).
 
-        Each picks 2 (pair) or 3 (triplet) distinct source curves and weights drawn uniformly
-        from the simplex (a uniform w in [0, 1] for a pair), so every new curve lies between
-        its sources. Returns curves, sources (count, k), weights (count, k) and frames.
+        Each mixes 2 (pair) or 3 (triplet) distinct source curves with weights uniform on the
+        simplex, so every new curve lies between its sources. Returns curves, sources
+        (count, k), weights (count, k) and frames.
         """
-        k = {"pair": 2, "triplet": 3}[mode]
-        rng = np.random.default_rng(seed)
-        sources = np.stack([rng.choice(len(curves), size=k, replace=False) for _ in range(count)])
-        weights = rng.dirichlet(np.ones(k), size=count)
-        full = np.zeros((count, len(curves)))
-        np.put_along_axis(full, sources, weights, axis=1)
-        out, frames = self.interpolate(curves, full, frame=frame, n_points=n_points, spacing=spacing)
-        return out, sources, weights, frames
+        plan = self.plan_augment(
+            curves,
+            mode=mode,
+            seed=fresh_seed() if seed is None else seed,
+            neighbours=neighbours,
+            frame=frame,
+            spacing=spacing,
+        )
+        return self.augment_batch(plan, offset, offset + count, n_points=n_points, spacing=spacing)
+
+
+AugmentMode = Literal["pair", "triplet"]
+SOURCES_PER_MODE: dict[str, int] = {"pair": 2, "triplet": 3}
+
+
+@dataclass(frozen=True)
+class AugmentPlan:
+    """Seed curves encoded once, and the rule that draws item i of a seeded augmentation sequence.
+
+    Item i depends on (seed, i) alone, through its own generator default_rng([seed, i]): a
+    page or chunk of the sequence is the same whatever the page size, and the items can be
+    made in any order. Each item: an anchor curve, uniform; its k-1 partners, distinct and
+    uniform over the anchor's pool; weights from the flat Dirichlet, i.e. uniform on the
+    simplex (each ≥ 0, summing to 1), in the order of the sources.
+    """
+
+    prep: Prepared  # the seed curves brought to the model
+    mean: np.ndarray  # (n_curves, latent_dim) latent means, float64
+    k: int  # sources per new curve: 2 (pair) or 3 (triplet)
+    seed: int
+    pools: np.ndarray  # (n_curves, m) the curves each anchor may be mixed with, ascending
+
+    def draw(self, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+        """Sources (m, k) (anchor first) and weights (m, k) of items start … stop-1."""
+        sources = np.empty((stop - start, self.k), np.int64)
+        weights = np.empty((stop - start, self.k))
+        for row, i in enumerate(range(start, stop)):
+            rng = np.random.default_rng([self.seed, i])
+            anchor = int(rng.integers(len(self.pools)))
+            sources[row, 0] = anchor
+            sources[row, 1:] = rng.choice(self.pools[anchor], size=self.k - 1, replace=False)
+            weights[row] = rng.dirichlet(np.ones(self.k))
+        return sources, weights
+
+
+def fresh_seed() -> int:
+    """A random seed for a request that gave none, reported back so the answer can be repeated."""
+    return int(np.random.SeedSequence().generate_state(1, np.uint64)[0])
+
+
+def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:
+    """Per curve, as the API reports it: smoothness (paper §3.4, degrees), self-intersection, length."""
+    out = []
+    for c in curves:
+        with np.errstate(all="ignore"):
+            smooth = {name: _number(v) for name, v in smoothness(c).items()}
+            length = _number(curve_length(c))
+        out.append({"smoothness": smooth, "self_intersects": bool(self_intersects(c)), "length": length})
+    return out
+
+
+def _number(value: Any) -> float | None:
+    """A JSON number, or null where float64 overflowed (curves near the float limit)."""
+    v = float(value)
+    return v if math.isfinite(v) else None
 
 
 def _check_finite(a: np.ndarray, field: str, msg: str) -> None:

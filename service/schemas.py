@@ -79,6 +79,41 @@ class _Request(BaseModel):
     model_config = ConfigDict(extra="forbid")  # a misspelt field is an error, not silently ignored
 
 
+MetricsFlag = Annotated[
+    bool,
+    Field(
+        strict=True,
+        description="Also report each returned curve's smoothness (paper §3.4), self-intersection and length "
+        "(`metrics` in the response).",
+    ),
+]
+
+
+class Smoothness(BaseModel):
+    """Turning angles between consecutive unit tangents (paper eq. 8), in degrees."""
+
+    mean_turn: float | None = Field(description="Mean turning angle: how much the curve bends.")
+    max_turn: float | None = Field(description="The sharpest corner.")
+    roughness: float | None = Field(
+        description="Mean change of turning angle between neighbouring points: near 0 for a smooth curve, "
+        "large where tangents jitter."
+    )
+
+
+class CurveMetrics(BaseModel):
+    """Quality of one returned curve, measured in the frame it is returned in (null: beyond float64)."""
+
+    smoothness: Smoothness
+    self_intersects: bool = Field(description="Whether the open polyline crosses or touches itself.")
+    length: float | None = Field(description="Polyline length, in the curve's own units.")
+
+
+MetricsOut = Annotated[
+    list[CurveMetrics] | None,
+    Field(description="One entry per returned curve, in order; present only when the request asks for `metrics`."),
+]
+
+
 class FrameInfo(BaseModel):
     """Where a curve lives: centre of its bounding box and its larger side."""
 
@@ -118,10 +153,12 @@ class DecodeRequest(_Request):
         description="Optional frame per latent (as /encode returns them): curves are mapped into it. "
         "Omitted: curves come back in the model's 128×128 plane.",
     )
+    metrics: MetricsFlag = False
 
 
 class CurvesResponse(BaseModel):
     curves: list[list[tuple[float, float]]] = Field(description="Curves as arrays of [x, y] points.")
+    metrics: MetricsOut = None
 
 
 class ReconstructRequest(_Request):
@@ -131,6 +168,7 @@ class ReconstructRequest(_Request):
     frame: FrameMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
+    metrics: MetricsFlag = False
 
 
 class ReconstructResponse(CurvesResponse):
@@ -163,6 +201,7 @@ class InterpolateRequest(_Request):
     frame: FrameMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
+    metrics: MetricsFlag = False
 
     @model_validator(mode="after")
     def _steps_or_weights(self) -> InterpolateRequest:
@@ -184,8 +223,8 @@ Seed = Annotated[
         ge=0,
         lt=2**64,
         strict=True,
-        description="Seed of the random draws: the same request and seed give the "
-        "same answer. Omitted: fresh randomness.",
+        description="Seed of the random draws: the same request and seed give the same answer. Omitted: fresh "
+        "randomness, and the response reports the seed it drew.",
     ),
 ]
 
@@ -205,32 +244,130 @@ class SampleRequest(_Request):
     )
     n_points: NPoints = None
     spacing: SpacingMode = "parameter"
+    frame: FrameInfo | None = Field(
+        None,
+        description="Map every curve into this frame (centre and size, e.g. one /encode returned). Omitted: the "
+        "model's 128×128 plane.",
+    )
+    metrics: MetricsFlag = False
 
 
 class SampleResponse(CurvesResponse):
     latents: list[list[float]] = Field(description="The latent vector each curve was decoded from.")
+    seed: int = Field(description="The seed used: the request's, or the one drawn for it.")
 
 
 class AugmentRequest(_Request):
-    """Make new curves between given ones: random pair or triplet interpolants."""
+    """Make new curves between given ones: random pair or triplet interpolants of their latent means."""
 
-    curves: list[Curve] = Field(min_length=2, description="Source curves: ≥ 2 for pairs, ≥ 3 for triplets.")
-    count: int = Field(ge=1, strict=True, description="How many new curves (at most CURVE_VAE_MAX_CURVES).")
+    curves: list[Curve] = Field(
+        min_length=2, description="Seed curves (at most CURVE_VAE_MAX_CURVES): ≥ 2 for pairs, ≥ 3 for triplets."
+    )
+    count: int = Field(
+        ge=1,
+        strict=True,
+        description="How many new curves: at most CURVE_VAE_MAX_CURVES with format json (page with `offset`), "
+        "CURVE_VAE_MAX_STREAM_CURVES with format npy (streamed).",
+    )
     mode: Literal["pair", "triplet"] = Field(
         "pair",
-        description="Mix 2 (pair, paper eq. 9) or 3 (triplet, eq. 10) distinct random source curves, "
-        "with weights uniform on the simplex.",
+        description="Mix 2 (pair, paper eq. 9) or 3 (triplet, eq. 10) distinct seed curves: a random anchor and "
+        "random partners, with weights uniform on the simplex (each ≥ 0, summing to 1).",
+    )
+    neighbours: int | None = Field(
+        None,
+        ge=1,
+        strict=True,
+        description="Mix each anchor only with its `neighbours` nearest seed curves (Euclidean distance between "
+        "latent means): near neighbours interpolate into better curves (paper §4). At least 1 for pairs, 2 for "
+        "triplets; more than the other curves means all of them. Omitted: any curve with any other.",
     )
     seed: Seed = None
+    offset: int = Field(
+        0,
+        ge=0,
+        lt=2**63,
+        strict=True,
+        description="Index of the first new curve in the seeded sequence. Item i depends only on (seed, i), so "
+        "pages `offset`=0, 100, 200… of `count`=100 are the same curves as one request of `count`=300.",
+    )
+    format: Literal["json", "npy"] = Field(
+        "json",
+        description='"json": curves with their sources and weights. "npy": a binary .npy file of the curves '
+        "alone, float32 of shape (count, points, 2), streamed so that any count stays in bounded memory; "
+        "the same request with format json (paged) gives the sources and weights.",
+    )
     frame: FrameMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
+    metrics: MetricsFlag = False
 
 
 class AugmentResponse(CurvesResponse):
-    sources: list[list[int]] = Field(description="Indices into `curves` of the sources of each new curve.")
-    weights: list[list[float]] = Field(description="Weight of each source, in the order of `sources`; rows sum to 1.")
+    sources: list[list[int]] = Field(
+        description="Indices into the request's `curves` of each new curve's sources: its anchor first."
+    )
+    weights: list[list[float]] = Field(
+        description="Weight of each source, in the order of `sources`: each ≥ 0, each row summing to 1."
+    )
     frames: list[FrameInfo] | None = Field(description='Frame "auto": the blend of the sources\' frames.')
+    seed: int = Field(description="The seed used: the request's, or the one drawn for it (to repeat or page on).")
+    offset: int = Field(description="Index of the first returned curve in the seeded sequence.")
+
+
+class FitRequest(_Request):
+    """Curves to approximate by least-squares cubic B-splines."""
+
+    curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
+    n_ctrl: int = Field(
+        10,
+        ge=4,
+        strict=True,
+        description="Control points of each clamped uniform cubic B-spline (10: the paper's data); at most the "
+        "number of points of the curve.",
+    )
+    param: Literal["chord", "uniform"] = Field(
+        "chord",
+        description='Parameter of each point: "chord" (cumulative chord length; any curve) or "uniform" (i/(n−1): '
+        "samples evenly spaced in the B-spline parameter, like the paper's data, whose control points it recovers "
+        "exactly).",
+    )
+    n_points: int | None = Field(
+        None,
+        ge=2,
+        strict=True,
+        description="Also return each fitted spline sampled at this many points, evenly in its parameter.",
+    )
+
+
+class BSplineOut(BaseModel):
+    control_points: list[tuple[float, float]] = Field(description="n_ctrl control points [x, y].")
+    knots: list[float] = Field(description="Clamped uniform knot vector on [0, 1], n_ctrl + degree + 1 entries.")
+    degree: int = Field(description="3: cubic.")
+    rms_error: float = Field(description="Root mean squared distance of the points from the spline at their parameter.")
+    max_error: float = Field(description="Largest such distance.")
+    curve: list[tuple[float, float]] | None = Field(None, description="The spline at `n_points`, when asked for.")
+
+
+class FitResponse(BaseModel):
+    fits: list[BSplineOut] = Field(description="One fit per input curve, in order.")
+
+
+class RevolveRequest(_Request):
+    """A profile curve to turn into a surface of revolution (paper Fig. 12: a vase)."""
+
+    curve: Curve = Field(description="The profile: ordered [x, y] points, all on one side of the axis.")
+    segments: int = Field(64, ge=3, le=100_000, strict=True, description="Angular resolution: vertices per ring.")
+    axis: Literal["x", "y"] = Field(
+        "y", description='Revolve about a vertical line x = axis_position ("y") or a horizontal one ("x").'
+    )
+    axis_position: FiniteFloat | None = Field(
+        None,
+        description="Where that line is. Omitted: through the profile's nearest point, so the whole profile lies on "
+        "one side. Profile points on the axis become poles: a profile whose ends touch it gives a closed, "
+        "watertight surface.",
+    )
+    format: Literal["obj", "stl"] = Field("obj", description='"obj": Wavefront OBJ text. "stl": binary STL.')
 
 
 class ErrorItem(BaseModel):

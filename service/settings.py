@@ -37,6 +37,8 @@ class Settings(BaseSettings):
     max_curves: int = Field(256, ge=1)  # curves (or latents, or interpolants) in one request or response
     max_points: int = Field(4096, ge=4)  # points per curve, in and out
     max_body_bytes: int = Field(8 << 20, ge=1024)  # larger request bodies get 413
+    max_stream_curves: int = Field(100_000, ge=1)  # curves of one streamed .npy (/augment format npy): ~13 MB per 10k
+    max_mesh_triangles: int = Field(1_000_000, ge=1)  # triangles of one /revolve mesh: 50 MB of STL
     # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
     cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)
 

@@ -1,0 +1,203 @@
+"""Sampling and augmentation (issue 5): seeded, paged and streamed batches; weights in the simplex; metrics."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+
+from geometry import Frame, curve_length, self_intersects, smoothness
+from service.runtime import curve_metrics
+
+CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
+
+
+def _seeds(curves, count: int = 6) -> list[list]:
+    """Seed curves in frames of their own (different places and sizes)."""
+    return [(c * (0.5 + i) + 40 * i).tolist() for i, c in enumerate(curves(count, 161))]
+
+
+# ----------------------------------------------------------------------------- sample
+
+
+def test_sample_same_seed_same_batch_and_seed_reported(client):
+    a = client.post("/sample", json={"count": 4, "seed": 11}).json()
+    assert a == client.post("/sample", json={"count": 4, "seed": 11}).json() and a["seed"] == 11
+    fresh = client.post("/sample", json={"count": 2}).json()
+    again = client.post("/sample", json={"count": 2, "seed": fresh["seed"]}).json()
+    assert again == fresh  # the reported seed repeats an unseeded request
+    first = client.post("/sample", json={"count": 2, "seed": 11}).json()
+    assert first["latents"] == a["latents"][:2]  # a larger count extends a smaller one
+
+
+def test_sample_latents_follow_the_temperature(client):
+    z = np.array(client.post("/sample", json={"count": 256, "seed": 0, "temperature": 0.5}).json()["latents"])
+    assert z.shape == (256, 32) and abs(z.std() - 0.5) < 0.02 and abs(z.mean()) < 0.02
+
+
+def test_sample_into_a_frame(client, runtime):
+    body = {"count": 2, "seed": 4, "n_points": 30}
+    plane = np.array(client.post("/sample", json=body).json()["curves"])
+    framed = np.array(client.post("/sample", json={**body, "frame": {"center": [5, -3], "size": 0.5}}).json()["curves"])
+    expected = [Frame(center=(5.0, -3.0), size=0.5).from_model(c, runtime.model_size) for c in plane]
+    np.testing.assert_allclose(framed, expected, rtol=1e-12, atol=1e-12)
+
+
+# ----------------------------------------------------------------------------- augment
+
+
+@pytest.mark.parametrize("mode,k", [pytest.param("pair", 2, id="pair"), pytest.param("triplet", 3, id="triplet")])
+def test_augment_weights_lie_in_the_simplex_and_are_reported(client, curves, runtime, mode, k):
+    seeds = _seeds(curves)
+    out = client.post("/augment", json={"curves": seeds, "count": 40, "mode": mode, "seed": 2}).json()
+    sources, weights = np.array(out["sources"]), np.array(out["weights"])
+    assert sources.shape == weights.shape == (40, k)
+    assert all(len(set(row)) == k for row in sources.tolist()) and 0 <= sources.min() and sources.max() < len(seeds)
+    assert (weights >= 0).all() and (weights <= 1).all()
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0, rtol=0, atol=1e-12)
+    assert len({tuple(r) for r in weights.round(6).tolist()}) == 40  # drawn, not a grid
+    assert len(set(sources[:, 0].tolist())) > 1  # anchors vary
+    full = np.zeros((40, len(seeds)))
+    np.put_along_axis(full, sources, weights, axis=1)
+    expected, _ = runtime.interpolate([np.array(c) for c in seeds], full)
+    np.testing.assert_allclose(out["curves"], expected, rtol=1e-9, atol=1e-9)  # each curve is its reported mix
+
+
+def test_augment_same_seed_same_batch(client, curves):
+    body = {"curves": _seeds(curves), "count": 8, "mode": "triplet", "seed": 2**64 - 1}
+    a = client.post("/augment", json=body).json()
+    assert a == client.post("/augment", json=body).json() and a["seed"] == 2**64 - 1
+    other = client.post("/augment", json={**body, "seed": 5}).json()
+    assert other["sources"] != a["sources"]
+    fresh = client.post("/augment", json={**body, "seed": None}).json()
+    assert client.post("/augment", json={**body, "seed": fresh["seed"]}).json() == fresh
+
+
+@pytest.mark.parametrize("page", [1, 3, 4, 12])
+def test_pages_are_the_same_whatever_the_page_size(client, curves, page):
+    body = {"curves": _seeds(curves), "count": 12, "seed": 9, "n_points": 20}
+    whole = client.post("/augment", json=body).json()
+    pages = [client.post("/augment", json={**body, "count": page, "offset": o}).json() for o in range(0, 12, page)]
+    assert [p["offset"] for p in pages] == list(range(0, 12, page))
+    for key in ("sources", "weights", "curves", "frames"):
+        assert sum((p[key] for p in pages), []) == whole[key], key
+
+
+def test_neighbours_restricts_partners_to_the_nearest_in_latent_space(client, curves, runtime):
+    seeds = _seeds(curves, 8)
+    mean, _, _ = runtime.encode([np.array(c) for c in seeds])
+    d = np.linalg.norm(mean[:, None] - mean[None], axis=-1)
+    np.fill_diagonal(d, np.inf)
+    for mode, k in (("pair", 1), ("triplet", 2), ("triplet", 3)):
+        out = client.post("/augment", json={"curves": seeds, "count": 60, "mode": mode, "neighbours": k, "seed": 1})
+        nearest = np.argsort(d, axis=1)[:, :k]
+        for anchor, *partners in out.json()["sources"]:
+            assert set(partners) <= set(nearest[anchor].tolist()), (mode, k, anchor, partners)
+    wide = client.post("/augment", json={"curves": seeds, "count": 5, "neighbours": 50, "seed": 1}).json()
+    assert wide == client.post("/augment", json={"curves": seeds, "count": 5, "seed": 1}).json()  # all = no limit
+
+
+def test_npy_output_loads_with_numpy_and_equals_the_json_pages(make_client, curves):
+    client = make_client(max_curves=8, batch_size=5)  # many chunks; more curves than a JSON response may hold
+    body = {"curves": _seeds(curves, 4), "count": 23, "seed": 3, "n_points": 40, "mode": "triplet"}
+    r = client.post("/augment", json={**body, "format": "npy"})
+    assert r.status_code == 200 and r.headers["content-type"] == "application/octet-stream"
+    assert r.headers["content-disposition"] == 'attachment; filename="augment.npy"'
+    assert r.headers["x-augment-seed"] == "3" and int(r.headers["content-length"]) == len(r.content)
+    batch = np.load(io.BytesIO(r.content), allow_pickle=False)
+    assert batch.shape == (23, 40, 2) and batch.dtype == np.float32
+    pages = [client.post("/augment", json={**body, "count": min(8, 23 - o), "offset": o}).json() for o in (0, 8, 16)]
+    np.testing.assert_array_equal(batch, np.array(sum((p["curves"] for p in pages), []), dtype=np.float32))
+
+
+def test_npy_length_follows_the_inputs(client):
+    r = client.post("/augment", json={"curves": [CURVE, CURVE[::-1]], "count": 3, "seed": 0, "format": "npy"})
+    assert np.load(io.BytesIO(r.content)).shape == (3, 7, 2)  # the inputs' common length
+    mixed = [CURVE, CURVE[:5]]
+    r = client.post("/augment", json={"curves": mixed, "count": 3, "seed": 0, "format": "npy"})
+    assert np.load(io.BytesIO(r.content)).shape == (3, 161, 2)  # no common length: the model's
+
+
+def test_count_limits_per_format(make_client):
+    client = make_client(max_curves=4, max_stream_curves=10)
+    body = {"curves": [CURVE, CURVE[::-1]], "seed": 0}
+    r = client.post("/augment", json={**body, "count": 5})
+    assert r.status_code == 422
+    assert r.json()["detail"].startswith("count: at most 4, got 5 (format json, CURVE_VAE_MAX_CURVES)")
+    assert "offset" in r.json()["detail"]
+    assert client.post("/augment", json={**body, "count": 10, "format": "npy"}).status_code == 200
+    r = client.post("/augment", json={**body, "count": 11, "format": "npy"})
+    assert r.status_code == 422 and "CURVE_VAE_MAX_STREAM_CURVES" in r.json()["detail"]
+
+
+def test_the_stream_holds_one_chunk_at_a_time(make_client, runtime, monkeypatch):
+    """Decoding is asked for batch_size rows at a time, never the whole count."""
+    client = make_client(max_stream_curves=10_000)
+    seen: list[int] = []
+    decode = runtime.decode_model
+    monkeypatch.setattr(runtime, "decode_model", lambda z: seen.append(len(z)) or decode(z))
+    r = client.post("/augment", json={"curves": [CURVE, CURVE[::-1]], "count": 1000, "format": "npy", "seed": 1})
+    assert r.status_code == 200 and len(r.content) == 128 + 1000 * 7 * 2 * 4
+    assert max(seen) == runtime.batch_size and sum(seen) == 1000
+
+
+# ----------------------------------------------------------------------------- metrics on request
+
+
+def _expected_metrics(curves) -> list[dict]:
+    out = []
+    for c in curves:
+        c = np.asarray(c)
+        sm = smoothness(c)
+        out.append(
+            {
+                "smoothness": {k: float(v) for k, v in sm.items()},
+                "self_intersects": bool(self_intersects(c)),
+                "length": float(curve_length(c)),
+            }
+        )
+    return out
+
+
+@pytest.mark.parametrize(
+    "path,body",
+    [
+        pytest.param("/decode", {"latents": [[0.0] * 32, [0.5] * 32]}, id="decode"),
+        pytest.param("/reconstruct", {"curves": [CURVE, CURVE[:5]]}, id="reconstruct"),
+        pytest.param("/interpolate", {"curves": [CURVE, CURVE[::-1]], "steps": 3}, id="interpolate"),
+        pytest.param("/sample", {"count": 3, "seed": 1}, id="sample"),
+        pytest.param("/augment", {"curves": [CURVE, CURVE[::-1]], "count": 3, "seed": 1}, id="augment"),
+    ],
+)
+def test_metrics_on_request(client, path, body):
+    plain = client.post(path, json=body).json()
+    assert "metrics" not in plain
+    r = client.post(path, json={**body, "metrics": True})
+    assert r.status_code == 200, r.text
+    out = r.json()
+    assert out["curves"] == plain["curves"]
+    expected = _expected_metrics(out["curves"])
+    assert len(out["metrics"]) == len(expected) == len(out["curves"])
+    for got, want in zip(out["metrics"], expected, strict=True):
+        assert got["self_intersects"] is want["self_intersects"]
+        assert got["length"] == pytest.approx(want["length"], rel=1e-12)
+        assert got["smoothness"] == pytest.approx(want["smoothness"], rel=1e-12)
+
+
+def test_metrics_measure_what_they_say():
+    t = np.linspace(0, np.pi, 50)
+    arc = np.stack([np.cos(t), np.sin(t)], axis=1)
+    loop = np.array([[0, 0], [2, 0], [2, 2], [1, -1]], float)
+    m_arc, m_loop = curve_metrics([arc, loop])
+    assert m_arc["smoothness"]["mean_turn"] == pytest.approx(180 / 49, rel=1e-9)
+    assert m_arc["smoothness"]["roughness"] < 1e-9 and m_arc["self_intersects"] is False
+    assert m_arc["length"] == pytest.approx(np.pi, rel=1e-3)
+    assert m_loop["self_intersects"] is True and m_loop["smoothness"]["max_turn"] == pytest.approx(
+        180 - np.degrees(np.arctan(1 / 3))
+    )
+
+
+def test_metrics_need_json(client):
+    r = client.post("/augment", json={"curves": [CURVE, CURVE], "count": 2, "format": "npy", "metrics": True})
+    assert r.status_code == 422 and r.json()["detail"].startswith("metrics: only with format json")
