@@ -190,6 +190,80 @@ def plot_training(log_path: Path, path: Path) -> None:
     _save(fig, path)
 
 
+def plot_pair_interpolation(
+    encode: Encoder, decode: Decoder, pairs: list[tuple[np.ndarray, np.ndarray]], path: Path, *, steps: int = 5
+) -> None:
+    """Each row: the two inputs, then `steps` decoded curves of eq. 9 from w=1 to w=0 (paper Fig. 11)."""
+    plt = _plt()
+    w = np.linspace(1, 0, steps)
+    fig, axes = plt.subplots(
+        len(pairs), 3, figsize=(11, 3.4 * len(pairs)), squeeze=False, gridspec_kw={"width_ratios": [1, 1, 1.4]}
+    )
+    cmap = plt.get_cmap("viridis")
+    for row, (a, b) in zip(axes, pairs):
+        mu = encode(np.stack([a, b]))
+        out = decode(w[:, None] * mu[0] + (1 - w[:, None]) * mu[1])
+        row[0].plot(*a.T, color=cmap(0.0))
+        row[1].plot(*b.T, color=cmap(1.0))
+        for i, c in enumerate(out):
+            row[2].plot(*c.T, color=cmap(i / (steps - 1)), lw=1.2, label=f"w={w[i]:.2f}")
+        row[0].set_title("curve 1")
+        row[1].set_title("curve 2")
+        row[2].set_title(f"latent interpolation, {steps} steps")
+        for ax in row:
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+    axes[0, 2].legend(fontsize=7, loc="best")
+    _save(fig, path)
+
+
+def plot_triplet(encode: Encoder, decode: Decoder, curves: np.ndarray, path: Path, *, steps: int = 4) -> None:
+    """Three inputs and the barycentric grid of eq. 10 between them (paper Fig. 8)."""
+    plt = _plt()
+    mu = encode(curves[:3])
+    fig, axes = plt.subplots(steps, steps, figsize=(2.6 * steps, 2.6 * steps))
+    for i in range(steps):
+        for j in range(steps):
+            ax = axes[i, j]
+            ax.set_axis_off()
+            if i + j > steps - 1:
+                continue
+            w = np.array([steps - 1 - i - j, i, j]) / (steps - 1)
+            c = decode((w @ mu)[None])[0]
+            corner = np.isclose(w, 1).any()
+            ax.plot(*c.T, color="tab:blue" if corner else "tab:red", lw=1.2)
+            ax.set_title(f"w = ({w[0]:.2f}, {w[1]:.2f}, {w[2]:.2f})", fontsize=7)
+            ax.set_aspect("equal")
+    fig.suptitle("triplet interpolation: inputs decoded at the corners (blue), blends in red")
+    _save(fig, path)
+
+
+def plot_latent_tsne(encode: Encoder, curves: np.ndarray, path: Path, *, examples: int = 6, seed: int = 0) -> None:
+    """t-SNE of the latent means, with a few curves drawn beside their points (paper Fig. 7)."""
+    from sklearn.manifold import TSNE
+
+    plt = _plt()
+    mu = batched(encode, curves)
+    xy = TSNE(n_components=2, random_state=seed, init="pca", perplexity=30).fit_transform(mu)
+    fig = plt.figure(figsize=(12, 6))
+    ax = fig.add_axes((0.05, 0.05, 0.5, 0.9))
+    ax.scatter(*xy.T, s=4, c="lightgray")
+    picks = np.random.default_rng(seed).choice(len(curves), size=examples, replace=False)
+    colors = plt.get_cmap("tab10")
+    for k, i in enumerate(picks):
+        ax.scatter(*xy[i], s=40, color=colors(k), edgecolor="k")
+        sub = fig.add_axes((0.58 + 0.14 * (k % 3), 0.52 - 0.45 * (k // 3), 0.13, 0.4))
+        sub.plot(*curves[i].T, color=colors(k))
+        sub.set_aspect("equal")
+        sub.set_xticks([])
+        sub.set_yticks([])
+    ax.set_title(f"t-SNE of {len(curves)} latent means")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    _save(fig, path)
+
+
 def run_evaluation(
     encode: Encoder,
     decode: Decoder,
@@ -210,6 +284,12 @@ def run_evaluation(
             plot_tangents([curves[0], recon[0]], ["input", "reconstruction"], out / f"tangents_{name}.png")
     first = next(iter(test_sets.values()))
     report["interpolation"] = interpolation_report(encode, decode, first)
+    if figures:
+        plot_pair_interpolation(
+            encode, decode, [(first[0], first[1]), (first[2], first[3])], out / "interpolation_pair.png"
+        )
+        plot_triplet(encode, decode, first[4:7], out / "interpolation_triplet.png")
+        plot_latent_tsne(encode, first, out / "latent_tsne.png")
     if figures and log_path is not None and log_path.exists():
         plot_training(log_path, out / "training.png")
     atomic_write_text(out / "report.json", json.dumps(report, indent=2) + "\n")
