@@ -715,7 +715,9 @@ async def revolve_profile(
 ) -> Response:
     """Revolve a profile about a vertical (or horizontal) line of its plane into a triangle mesh, outward-facing;
     answered as a file (OBJ text by default, or binary STL) with its vertex and triangle counts in headers."""
-    profile = _check_curves([req.curve], settings)[0]
+    if len(req.curve) > settings.max_points:
+        raise InputError(("curve",), f"at most {settings.max_points} points, got {len(req.curve)}")
+    profile = np.asarray(req.curve, dtype=np.float64)
     triangles = 2 * (len(profile) - 1) * req.segments  # at most: pole bands have half as many
     if triangles > settings.max_mesh_triangles:
         raise InputError(
@@ -726,14 +728,18 @@ async def revolve_profile(
 
     def work() -> Response:
         try:
-            mesh = revolve(profile, segments=req.segments, axis=req.axis, axis_position=req.axis_position)
+            with np.errstate(all="ignore"):  # coordinates near the float limit: checked just below
+                mesh = revolve(profile, segments=req.segments, axis=req.axis, axis_position=req.axis_position)
         except ValueError as e:
             raise InputError(("curve",), str(e)) from e
         if not np.isfinite(mesh.vertices).all():
             raise InputError(("curve",), "the mesh does not fit in float64: scale the profile down")
+        if req.format == "stl" and not (np.abs(mesh.vertices) <= np.finfo(np.float32).max).all():
+            raise InputError(("curve",), "the mesh does not fit in STL's float32: scale the profile down")
         closed = all(uses == 2 for uses in mesh.edge_use().values())
         if req.format == "stl":
-            content: bytes | str = mesh.to_stl()
+            with np.errstate(all="ignore"):  # normals of huge triangles: STL readers recompute them
+                content: bytes | str = mesh.to_stl()
         else:
             content = mesh.to_obj(
                 comment=f"curve-vae surface of revolution: {len(profile)}-point profile, "

@@ -28,6 +28,15 @@ def test_every_status_is_documented_with_an_example():
         for code in ("413", "422", "503"):
             assert op["responses"][code]["content"]["application/json"]["example"]["detail"], (path, code)
         assert op["x-codeSamples"][0]["source"].startswith("curl "), path
+    for path in ("/fit", "/revolve"):  # geometry only: no model, so no 503
+        op = paths[path]["post"]
+        assert {"200", "413", "422"} <= set(op["responses"]), path
+        assert op["requestBody"]["content"]["application/json"]["examples"], path
+        assert op["x-codeSamples"][0]["source"].startswith("curl "), path
+    assert {"model/obj", "model/stl"} <= set(paths["/revolve"]["post"]["responses"]["200"]["content"])
+    assert {"application/json", "application/octet-stream"} <= set(
+        paths["/augment"]["post"]["responses"]["200"]["content"]
+    )
     for path in ("/ready", "/model"):
         assert {"200", "503"} <= set(paths[path]["get"]["responses"]), path
     assert {"/health", "/metrics"} <= set(paths)

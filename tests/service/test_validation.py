@@ -247,6 +247,49 @@ CASES = [
         id="augment-count-over-limit",
     ),
     pytest.param(
+        "/augment",
+        {"curves": [C, C], "count": 2, "neighbours": 0},
+        422,
+        "neighbours: Input should be greater than or equal to 1",
+        id="augment-no-neighbours",
+    ),
+    pytest.param(
+        "/augment",
+        {"curves": [C, C, C], "count": 2, "mode": "triplet", "neighbours": 1},
+        422,
+        "neighbours: mode triplet mixes each curve with 2 others: at least 2, got 1",
+        id="augment-triplet-of-one-neighbour",
+    ),
+    pytest.param(
+        "/augment",
+        {"curves": [C, C], "count": 2, "offset": -1},
+        422,
+        "offset: Input should be greater than or equal to 0",
+        id="augment-negative-offset",
+    ),
+    pytest.param(
+        "/augment",
+        {"curves": [C, C], "count": 2, "format": "csv"},
+        422,
+        "format: Input should be 'json' or 'npy'",
+        id="augment-bad-format",
+    ),
+    pytest.param(
+        "/augment",
+        {"curves": [C, C], "count": 300000, "format": "npy"},
+        422,
+        "count: at most 100000, got 300000 (format npy, CURVE_VAE_MAX_STREAM_CURVES)",
+        id="augment-stream-over-limit",
+    ),
+    pytest.param(
+        "/sample",
+        {"count": 2, "frame": {"center": [0, 0], "size": 0}},
+        422,
+        "frame.size: Input should be greater than 0",
+        id="sample-frame-of-size-zero",
+    ),
+    pytest.param("/sample", {"count": 2, "metrics": "yes"}, 422, "metrics: Input should be a valid boolean", id="m"),
+    pytest.param(
         "/interpolate",
         '{"curves": [[[0,0],[1,2],[2,3],[3,1]], [[0,0],[1,2],[2,3],[3,1]]], "weights": [[1e308, 1e308]]}',
         422,
@@ -288,6 +331,21 @@ def test_bad_input_is_rejected_with_a_message_naming_where(client, path, body, s
 
 LIMIT_CASES = [
     pytest.param("/encode", {"curves": [C] * 5}, "curves: at most 4 curves per request, got 5", id="too-many-curves"),
+    pytest.param(
+        "/fit", {"curves": [C] * 5, "n_ctrl": 4}, "curves: at most 4 curves per request, got 5", id="fit-curves"
+    ),
+    pytest.param(
+        "/fit",
+        {"curves": [C], "n_ctrl": 4, "n_points": 301},
+        "n_points: at most 300, got 301",
+        id="fit-n-points-over-limit",
+    ),
+    pytest.param(
+        "/revolve",
+        {"curve": np.linspace(0, 1, 602).reshape(301, 2).tolist()},
+        "curve: at most 300 points, got 301",
+        id="revolve-profile-too-long",
+    ),
     pytest.param(
         "/reconstruct",
         {"curves": [C, np.linspace(0, 1, 602).reshape(301, 2).tolist()]},
@@ -376,6 +434,20 @@ def test_form_encoded_body_gets_a_hint(client):
             id="frame-overflow",
         ),
         pytest.param("/interpolate", {"curves": [C, C], "steps": 10**40}, id="steps-huge"),
+        pytest.param("/fit", {"curves": [(np.array(C) * 1e300).tolist()], "n_ctrl": 5}, id="fit-huge"),
+        pytest.param("/fit", {"curves": [(np.array(C) * 1e-320).tolist()], "n_ctrl": 5}, id="fit-subnormal"),
+        pytest.param("/fit", {"curves": [C], "n_ctrl": 10**30}, id="fit-n-ctrl-huge"),
+        pytest.param("/revolve", {"curve": (np.array(C) * 1e300).tolist()}, id="revolve-huge"),
+        pytest.param("/revolve", {"curve": (np.array(C) * 1e300).tolist(), "format": "stl"}, id="revolve-huge-stl"),
+        pytest.param("/revolve", {"curve": (np.array(C) * 1e38).tolist(), "format": "stl"}, id="revolve-stl-float32"),
+        pytest.param("/revolve", {"curve": (np.array(C) * 1e-320).tolist()}, id="revolve-subnormal"),
+        pytest.param("/revolve", {"curve": C, "segments": 10**30}, id="revolve-segments-huge"),
+        pytest.param("/revolve", {"curve": C, "axis_position": -1.7e308}, id="revolve-axis-far"),
+        pytest.param("/sample", {"count": 2, "frame": {"center": [1e308, 1e308], "size": 1e308}}, id="sample-frame"),
+        pytest.param(
+            "/augment", {"curves": [C, C], "count": 2, "offset": 2**63 - 3, "seed": 2**64 - 1}, id="augment-last-items"
+        ),
+        pytest.param("/augment", {"curves": [C, C], "count": 2, "neighbours": 10**30}, id="augment-neighbours-huge"),
     ],
 )
 def test_extreme_inputs_never_give_5xx(client, path, body):
@@ -385,7 +457,9 @@ def test_extreme_inputs_never_give_5xx(client, path, body):
         assert r.json()["errors"][0]["loc"]
 
 
-@pytest.mark.parametrize("path", ["/encode", "/decode", "/reconstruct", "/interpolate", "/sample", "/augment"])
+@pytest.mark.parametrize(
+    "path", ["/encode", "/decode", "/reconstruct", "/interpolate", "/sample", "/augment", "/fit", "/revolve"]
+)
 def test_garbage_never_gives_5xx(client, path):
     bodies = [
         "null",
