@@ -1,7 +1,7 @@
-"""`curve-vae` command line: dataset, train, export, evaluate, serve.
+"""`curve-vae` command line: dataset, train, export, evaluate, sample, augment, fit, revolve, serve.
 
-Each subcommand imports what it needs when it runs, so `curve-vae serve` works in the
-base install (no torch).
+Each subcommand imports what it needs when it runs, so `curve-vae serve` and the offline
+commands (sample, augment, fit, revolve) work in the base install (no torch).
 """
 
 from __future__ import annotations
@@ -244,32 +244,103 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
     return 0
 
 
+# ------------------------------------------------------------------- sample, augment
+
+
+def _runtime(a: argparse.Namespace):
+    from service.runtime import CurveRuntime
+
+    return CurveRuntime.load(a.model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)
+
+
+def cmd_sample(a: argparse.Namespace) -> int:
+    from curve_vae.files import write_output
+    from service.payloads import sample_body
+    from service.runtime import fresh_seed
+
+    runtime = _runtime(a)
+    seed = fresh_seed() if a.seed is None else a.seed
+    latents, curves = runtime.sample(
+        a.count, seed=seed, temperature=a.temperature, n_points=a.n_points, spacing=a.spacing
+    )
+    write_output(a.output, sample_body(latents, curves, seed, metrics=a.metrics), array_key="curves")
+    print(f"{a.output}: {a.count} curves of {curves.shape[1]} points from the prior, seed {seed}", file=sys.stderr)
+    return 0
+
+
+def cmd_augment(a: argparse.Namespace) -> int:
+    from curve_vae.files import read_curves, write_npy_chunks, write_output
+    from service.payloads import augment_body
+    from service.runtime import fresh_seed
+
+    runtime = _runtime(a)
+    seed = fresh_seed() if a.seed is None else a.seed
+    plan = runtime.plan_augment(
+        read_curves(a.input), mode=a.mode, seed=seed, neighbours=a.neighbours, frame=a.frame, spacing=a.spacing
+    )
+    start, stop = a.offset, a.offset + a.count
+    if a.output.endswith(".npy"):  # streamed chunk by chunk: any count in bounded memory
+        if a.metrics:
+            raise ValueError("--metrics needs a JSON output: a .npy file holds the curves alone")
+        shape = (a.count, runtime.mix_length(plan.prep, a.n_points), 2)
+        write_npy_chunks(
+            a.output, shape, runtime.augment_chunks(plan, start, stop, n_points=a.n_points, spacing=a.spacing)
+        )
+    else:
+        out, sources, weights, frames = runtime.augment_batch(plan, start, stop, n_points=a.n_points, spacing=a.spacing)
+        shape = out.shape
+        write_output(
+            a.output, augment_body(out, sources, weights, frames, seed=seed, offset=a.offset, metrics=a.metrics)
+        )
+    print(f"{a.output}: {a.count} new curves of {shape[1]} points ({a.mode}s), seed {seed}", file=sys.stderr)
+    return 0
+
+
+def _add_model_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("model (offline: onnxruntime on the exported graphs, no server)")
+    g.add_argument("--model-dir", default=DEFAULT_MODELS, help=f"exported model directory (default: {DEFAULT_MODELS})")
+    g.add_argument(
+        "--providers", choices=["cpu", "cuda", "auto"], default="cpu", help="onnxruntime providers (default: cpu)"
+    )
+    g.add_argument("--batch-size", type=int, default=64, help="curves per ONNX run and per .npy chunk (default: 64)")
+
+
+def _add_generate_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "-o",
+        "--output",
+        default="-",
+        help="output: .json (as the REST endpoint answers), .npy (curves only, float32), "
+        "or - for JSON on stdout (default: -)",
+    )
+    p.add_argument("--count", type=int, required=True, help="how many curves")
+    p.add_argument(
+        "--seed", type=int, default=None, help="seed: the same seed gives the same curves (default: fresh, reported)"
+    )
+    p.add_argument(
+        "--n-points", type=int, default=None, help="points per curve (default: the model's 161, or the inputs' length)"
+    )
+    p.add_argument(
+        "--spacing", choices=["parameter", "arc_length"], default="parameter", help="point spacing (default: parameter)"
+    )
+    p.add_argument(
+        "--metrics", action="store_true", help="add smoothness, self-intersection and length per curve (JSON only)"
+    )
+
+
 # ------------------------------------------------------------------------ fit, revolve
 
 
 def cmd_fit(a: argparse.Namespace) -> int:
     from curve_vae.files import read_curves, write_output
-    from geometry import fit_bspline
+    from service.payloads import fit_body
 
-    fits = [fit_bspline(c, a.n_ctrl, param=a.param) for c in read_curves(a.input)]
-    write_output(
-        a.output,
-        {
-            "fits": [
-                {
-                    "control_points": f.control_points.tolist(),
-                    "knots": f.knots.tolist(),
-                    "degree": f.degree,
-                    "rms_error": f.rms_error,
-                    "max_error": f.max_error,
-                }
-                for f in fits
-            ]
-        },
-    )
-    for i, f in enumerate(fits):
+    body = fit_body(read_curves(a.input), a.n_ctrl, param=a.param, n_points=a.n_points)
+    write_output(a.output, body)
+    for i, f in enumerate(body["fits"]):
         print(
-            f"curve {i}: {a.n_ctrl} control points, rms error {f.rms_error:.4g}, max {f.max_error:.4g}", file=sys.stderr
+            f"curve {i}: {a.n_ctrl} control points, rms error {f['rms_error']:.4g}, max {f['max_error']:.4g}",
+            file=sys.stderr,
         )
     return 0
 
@@ -376,6 +447,29 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-figures", action="store_true", help="write only report.json")
     s.set_defaults(func=cmd_evaluate)
 
+    s = sub.add_parser("sample", help="new curves from the latent prior, offline (as POST /sample)")
+    _add_generate_options(s)
+    s.add_argument("--temperature", type=float, default=1.0, help="latent standard deviation (default: 1.0)")
+    _add_model_options(s)
+    s.set_defaults(func=cmd_sample)
+
+    s = sub.add_parser("augment", help="new curves between given curves, offline (as POST /augment)")
+    s.add_argument("input", help="seed curves: .json ([curve, …] or {curves: …}), .npy (N, n, 2), or - (stdin)")
+    _add_generate_options(s)
+    s.add_argument("--mode", choices=["pair", "triplet"], default="pair", help="sources per new curve (default: pair)")
+    s.add_argument(
+        "--neighbours",
+        type=int,
+        default=None,
+        help="mix each curve only with its k nearest in latent space (default: any)",
+    )
+    s.add_argument("--offset", type=int, default=0, help="index of the first curve in the seeded sequence (default: 0)")
+    s.add_argument(
+        "--frame", choices=["auto", "model"], default="auto", help="frame of the seed curves (default: auto)"
+    )
+    _add_model_options(s)
+    s.set_defaults(func=cmd_augment)
+
     s = sub.add_parser("fit", help="least-squares cubic B-spline of each curve (no model needed)")
     s.add_argument("input", help="curves: .json ([[x, y], …], a list of curves, or {curves: …}), .npy, or - (stdin)")
     s.add_argument("-o", "--output", default="-", help="JSON output file (default: - = stdout)")
@@ -387,6 +481,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="parameter of each point: chord length (any curve) or uniform (the "
         "data set's sampling; recovers its B-splines exactly) (default: chord)",
     )
+    s.add_argument("--n-points", type=int, default=None, help="also write each fitted spline at this many points")
     s.set_defaults(func=cmd_fit)
 
     s = sub.add_parser("revolve", help="surface of revolution of a profile curve, as OBJ or STL (paper Fig. 12)")

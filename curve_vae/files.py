@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -54,3 +55,17 @@ def write_output(path: str, payload: dict[str, Any], array_key: str | None = Non
         tmp = Path(path + ".tmp")
         tmp.write_text(text)
         tmp.replace(path)
+
+
+def write_npy_chunks(path: str, shape: tuple[int, ...], chunks: Iterable[np.ndarray]) -> None:
+    """A float32 .npy of `shape` written chunk by chunk (memory bounded by one chunk), in place when complete."""
+    from service.npy import npy_chunks
+
+    tmp = Path(path + ".tmp")
+    try:
+        with open(tmp, "wb") as f:
+            for block in npy_chunks(shape, chunks):
+                f.write(block)
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
