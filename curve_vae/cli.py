@@ -249,8 +249,10 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
 
 def _runtime(a: argparse.Namespace):
     from service.runtime import CurveRuntime
+    from service.settings import DEFAULT_MODEL_DIR
 
-    return CurveRuntime.load(a.model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)
+    model_dir = a.model_dir or DEFAULT_MODEL_DIR
+    return CurveRuntime.load(model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)
 
 
 def cmd_sample(a: argparse.Namespace) -> int:
@@ -298,7 +300,7 @@ def cmd_augment(a: argparse.Namespace) -> int:
 
 def _add_model_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("model (offline: onnxruntime on the exported graphs, no server)")
-    g.add_argument("--model-dir", default=DEFAULT_MODELS, help=f"exported model directory (default: {DEFAULT_MODELS})")
+    g.add_argument("--model-dir", default="", help="exported model directory (default: the shipped model, models/)")
     g.add_argument(
         "--providers", choices=["cpu", "cuda", "auto"], default="cpu", help="onnxruntime providers (default: cpu)"
     )
