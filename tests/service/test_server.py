@@ -56,15 +56,38 @@ def _curl_blocks() -> list[str]:
     return re.findall(r"```sh\n(.*?)```", text, flags=re.S)
 
 
+def _check_saved(path: Path) -> None:
+    """A file an example saved with `-o`: loadable as what its name says."""
+    assert path.is_file(), path
+    if path.suffix == ".npy":
+        batch = np.load(path, allow_pickle=False)
+        assert batch.dtype == np.float32 and batch.ndim == 3 and batch.shape[2] == 2
+    elif path.suffix == ".obj":
+        lines = path.read_text().splitlines()
+        assert any(line.startswith("v ") for line in lines) and any(line.startswith("f ") for line in lines)
+    elif path.suffix == ".stl":
+        data = path.read_bytes()
+        assert len(data) == 84 + 50 * int.from_bytes(data[80:84], "little")
+
+
 @pytest.mark.skipif(shutil.which("curl") is None, reason="curl is not installed")
 @pytest.mark.parametrize("block", _curl_blocks(), ids=lambda b: b.split("http://127.0.0.1:8000")[1].split()[0])
-def test_curl_examples_work_as_pasted(live_server, block):
+def test_curl_examples_work_as_pasted(live_server, block, tmp_path):
     if "| jq" in block and shutil.which("jq") is None:
         pytest.skip("jq is not installed")
     command = block.replace("http://127.0.0.1:8000", live_server.url)
-    out = subprocess.run(["bash", "-c", f"set -o pipefail\n{command}"], capture_output=True, text=True, timeout=60)
+    out = subprocess.run(
+        ["bash", "-c", f"set -o pipefail\n{command}"], capture_output=True, text=True, timeout=60, cwd=tmp_path
+    )
     assert out.returncode == 0, out.stderr
     body = out.stdout.strip()
+    saved = re.findall(r"\s-o (\S+)", block)
+    if saved:  # a file, not a JSON body
+        for name in saved:
+            _check_saved(tmp_path / name)
+        if "-D -" in block:
+            assert "x-mesh-closed: true" in body.lower(), body
+        return
     assert body
     if "/metrics" in block:
         assert "curve_vae_http_requests_total" in body
