@@ -114,3 +114,15 @@ def test_mse_per_curve_is_paper_eq4():
     b = a.copy()
     b[1, 0, 0] = 3.0  # one coordinate of six off by 3 → 9/6
     np.testing.assert_allclose(mse_per_curve(a, b), [0.0, 1.5])
+
+
+def test_chord_fit_of_many_curves_and_bunched_points():
+    # Chord parameters must end exactly at the last knot for every curve.
+    for ctrl in random_control_points(np.random.default_rng(7), 200):
+        pts = sample_bspline(ctrl, 161)
+        fit = fit_bspline(pts, param="chord")
+        # chord length is not the curve's own parameter, so the fit is close but not exact
+        assert np.isfinite(fit.control_points).all() and fit.rms_error < 0.04 * np.ptp(pts, axis=0).max()
+    bunched = np.concatenate([np.stack([np.linspace(0, 0.01, 10), np.zeros(10)], 1), [[10, 0], [20, 5]]])
+    with pytest.raises(ValueError, match="cannot fit 10 control points"):
+        fit_bspline(bunched, n_ctrl=10, param="chord", refine=0)

@@ -30,14 +30,6 @@ def test_fit_recovers_a_known_bspline_from_its_exact_samples(client, n_ctrl):
         assert f["degree"] == 3 and f["rms_error"] < 1e-9 and f["max_error"] < 1e-9
 
 
-CHORD_END_BUG = (
-    "geometry.fit_bspline, param chord: u = cumsum(seg) / seg.sum() can end at 1 + 2.2e-16, past the last knot, "
-    "and scipy's make_lsq_spline refuses it ('Out of bounds'): about 40% of the paper's curves. The fix is in "
-    "geometry (divide by the cumulative sum's last entry); then delete this mark."
-)
-
-
-@pytest.mark.xfail(strict=True, reason=CHORD_END_BUG)
 def test_fit_defaults_to_ten_control_points_by_chord_length(client):
     ctrl = random_control_points(np.random.default_rng(1), 1)[0]
     c = sample_bspline(ctrl, 200)
