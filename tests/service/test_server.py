@@ -52,7 +52,7 @@ def test_concurrent_requests(live_server, curves):
 
 
 def _curl_blocks() -> list[str]:
-    text = (ROOT / "service" / "CURL.md").read_text()
+    text = (ROOT / "README.md").read_text()
     return re.findall(r"```sh\n(.*?)```", text, flags=re.S)
 
 
