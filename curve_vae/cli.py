@@ -43,8 +43,6 @@ def _data_config(a: argparse.Namespace):
 def cmd_dataset(a: argparse.Namespace) -> int:
     import time
 
-    import numpy as np
-
     from training.data import load_or_generate
     from training.evaluate import _plt, _save
 
@@ -69,7 +67,6 @@ def cmd_dataset(a: argparse.Namespace) -> int:
         fig.suptitle("training curves (green: first point)")
         _save(fig, Path(a.preview))
         print(f"preview: {a.preview}")
-    del np
     return 0
 
 
