@@ -56,3 +56,48 @@ def test_output_can_be_negative():
 def test_unknown_variant_is_rejected():
     with pytest.raises(ValueError, match="unknown variant"):
         ModelConfig(variant="resnet")
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_decoder_prefix_equals_the_full_stack_in_eval(variant):
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant=variant)).eval()
+    for m in model.modules():  # non-trivial running statistics, so BatchNorm matters
+        if isinstance(m, torch.nn.BatchNorm1d):
+            m.running_mean.uniform_(-0.5, 0.5)
+            m.running_var.uniform_(0.5, 2.0)
+    z = torch.randn(16, 32)
+    with torch.no_grad():
+        prefix, full = model.decoder(z), model.decoder(z, full=True)
+    assert prefix.shape == full.shape == (16, 161, 2)
+    # float32 rounding of outputs around 64 px, in units of the network's scale (64 px)
+    assert torch.allclose(prefix / 64, full / 64, atol=1e-5, rtol=0)
+    crops = model.decoder.crops
+    assert crops[-1] == 161 and len(crops) == len(model.decoder.features)
+
+
+def test_decoder_prefix_is_much_shorter_than_the_full_stack():
+    decoder = VAE(ModelConfig()).decoder
+    lengths = [m.shape[-1] for m in _layer_inputs(decoder)]
+    assert decoder.crops == [7, 7, 7, 21, 19, 19, 19, 56, 54, 54, 54, 161]
+    assert lengths == [16, 18, 18, 54, 54, 56, 56, 168, 168, 172, 172, 516]
+
+
+def _layer_inputs(decoder):
+    x = torch.zeros(2, *decoder.feat_shape)
+    inputs = []
+    with torch.no_grad():
+        for layer in decoder.features:
+            inputs.append(x)
+            x = layer(x)
+    return inputs
+
+
+def test_training_runs_the_full_decoder_stack():
+    torch.manual_seed(0)
+    decoder = VAE(ModelConfig()).decoder.train()
+    z = torch.randn(8, 32)
+    with torch.no_grad():
+        default, full, prefix = decoder(z), decoder(z, full=True), decoder(z, full=False)
+    assert torch.equal(default, full)  # BatchNorm's batch statistics over the whole maps
+    assert not torch.allclose(default, prefix, atol=1e-3)  # …which the prefix path would change
