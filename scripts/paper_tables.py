@@ -40,8 +40,8 @@ PAPER = {
 }
 
 
-def run_name(variant: str, latent: int, lap: float, epochs: int, train_limit: int) -> str:
-    return f"{variant}_z{latent}_lap{lap:g}_e{epochs}_n{train_limit}"
+def run_name(variant: str, latent: int, lap: float, epochs: int, train_limit: int, init: str = "") -> str:
+    return f"{variant}_z{latent}_lap{lap:g}_e{epochs}_n{train_limit}" + (f"_from-{init}" if init else "")
 
 
 def fresh_mse(run: Path, seed: int) -> float:
@@ -60,6 +60,16 @@ def fresh_mse(run: Path, seed: int) -> float:
     return json.loads(cache.read_text())["mse"]
 
 
+def _init_label(path: str) -> str:
+    """A short label of the starting weights: the model version of a model directory's manifest, else the file stem."""
+    if not path:
+        return ""
+    manifest = Path(path).parent / "manifest.json"
+    if manifest.exists():
+        return "v" + json.loads(manifest.read_text()).get("version", Path(path).stem)
+    return Path(path).stem
+
+
 def laplacian_figure(runs: list[tuple[float, Path]], data: str, out: Path, *, curve: int = 0) -> None:
     """Tangents of one test curve: the input, then each run's reconstruction (paper Fig. 3)."""
     from training.data import DataConfig, load_or_generate
@@ -71,7 +81,7 @@ def laplacian_figure(runs: list[tuple[float, Path]], data: str, out: Path, *, cu
         encode, decode, _ = torch_codec(run / "best.pt")
         curves.append(decode(encode(test))[0])
         labels.append(f"reconstruction, λ_lap = {lap:g}")
-    plot_tangents(curves, labels, out / "tangents_laplacian.png")
+    plot_tangents(curves, labels, out)
 
 
 def main() -> None:
@@ -84,17 +94,26 @@ def main() -> None:
     p.add_argument("--data", default="data/curves.npz", help="data set cache (default: data/curves.npz)")
     p.add_argument("--out", default="runs/tables", help="run directories (default: runs/tables)")
     p.add_argument("--fresh-seed", type=int, default=7919, help="seed of the second test set (default: 7919)")
+    p.add_argument(
+        "--init-from",
+        default="",
+        help="start every row from these weights instead of from scratch (e.g. models/vae.pt; "
+        "rows whose architecture differs cannot use it)",
+    )
     p.add_argument("--figures", default="docs/figures", help="--table lap: figure folder (default: docs/figures)")
     a = p.parse_args()
+    init = _init_label(a.init_from)
     rows = []
     for variant, latent, lap, paper in PAPER[a.table]:
-        run = Path(a.out) / run_name(variant, latent, lap, a.epochs, a.train_limit)
+        run = Path(a.out) / run_name(variant, latent, lap, a.epochs, a.train_limit, init)
         if not (run / "report.json").exists():
             args = ["train", "--run-dir", str(run), "--resume", "--no-progress", "--data", a.data]
             args += ["--variant", variant, "--latent-dim", str(latent), "--lap-weight", str(lap)]
             args += ["--epochs", str(a.epochs), "--train-limit", str(a.train_limit), "--lr", str(a.lr)]
             if a.threads:
                 args += ["--threads", str(a.threads)]
+            if a.init_from:
+                args += ["--init-from", a.init_from]
             cli(args)
         rep = json.loads((run / "report.json").read_text())
         log = [json.loads(line) for line in (run / "log.jsonl").read_text().splitlines() if line.strip()]
@@ -102,7 +121,8 @@ def main() -> None:
         rows.append((variant, latent, lap, paper, rep, sum(r["seconds"] for r in log)))
     budget = (
         f"{a.epochs} epochs × {a.train_limit:,} curves ({a.epochs * a.train_limit:,} curves seen), "
-        f"one-cycle peak lr {a.lr:g}, batch 128, fp32, from scratch"
+        f"one-cycle peak lr {a.lr:g}, batch 128, fp32, "
+        + (f"starting from {a.init_from} ({init})" if a.init_from else "from scratch")
     )
     lines = [
         f"Budget per row: {budget}.",
@@ -125,9 +145,10 @@ def main() -> None:
     (Path(a.out) / f"table_{a.table}.md").write_text(text)
     print(text)
     if a.table == "lap":
-        runs = [(lap, Path(a.out) / run_name(v, z, lap, a.epochs, a.train_limit)) for v, z, lap, _ in PAPER["lap"]]
-        laplacian_figure(runs, a.data, Path(a.figures))
-        print(f"figure: {Path(a.figures) / 'tangents_laplacian.png'}")
+        runs = [(lap, Path(a.out) / run_name(v, z, lap, a.epochs, a.train_limit, init)) for v, z, lap, _ in PAPER["lap"]]
+        figure = Path(a.figures) / ("tangents_laplacian.png" if not init else f"tangents_laplacian_from-{init}.png")
+        laplacian_figure(runs, a.data, figure)
+        print(f"figure: {figure}")
 
 
 if __name__ == "__main__":
