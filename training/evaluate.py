@@ -152,14 +152,16 @@ def plot_tangents(
         seg = c[window]
         d = np.diff(seg, axis=0)
         t = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+        length = 0.08 * np.ptp(seg, axis=0).max()  # arrows a fixed fraction of the stretch shown
         ax.plot(*seg.T, "k-", lw=0.8)
         ax.quiver(
             seg[:-1:every, 0],
             seg[:-1:every, 1],
-            t[::every, 0],
-            t[::every, 1],
+            length * t[::every, 0],
+            length * t[::every, 1],
             angles="xy",
-            scale=12,
+            scale_units="xy",
+            scale=1,
             width=0.006,
             color="tab:red",
         )
