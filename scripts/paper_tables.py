@@ -135,7 +135,8 @@ def main() -> None:
         t = rep["test_sets"]["test"]
         name = "cnn6 (Inception)" if variant == "inception" else variant
         lines.append(
-            f"| {name} | {latent} | {lap:g} | {paper if paper is not None else '—'} | {t['mse']:.3f} | {rep['fresh_mse']:.3f} | "
+            f"| {name} | {latent} | {lap:g} | {paper if paper is not None else '—'} | "
+            f"{t['mse']:.3f} | {rep['fresh_mse']:.3f} | "
             f"{t['smoothness_output']['roughness']:.2f} / {t['smoothness_input']['roughness']:.2f} | "
             f"{100 * t['self_intersecting_outputs']:.1f}% | "
             f"{rep['interpolation']['latent']['roughness']:.2f} | {seconds:.0f} |"
@@ -145,7 +146,9 @@ def main() -> None:
     (Path(a.out) / f"table_{a.table}.md").write_text(text)
     print(text)
     if a.table == "lap":
-        runs = [(lap, Path(a.out) / run_name(v, z, lap, a.epochs, a.train_limit, init)) for v, z, lap, _ in PAPER["lap"]]
+        runs = [
+            (lap, Path(a.out) / run_name(v, z, lap, a.epochs, a.train_limit, init)) for v, z, lap, _ in PAPER["lap"]
+        ]
         figure = Path(a.figures) / ("tangents_laplacian.png" if not init else f"tangents_laplacian_from-{init}.png")
         laplacian_figure(runs, a.data, figure)
         print(f"figure: {figure}")
