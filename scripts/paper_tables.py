@@ -51,12 +51,13 @@ def fresh_mse(run: Path, seed: int) -> float:
         from geometry import mse_per_curve
         from training.data import DataConfig, generate_curves
         from training.evaluate import batched, torch_codec
+        from training.io import atomic_write_text
 
         cfg = DataConfig()
         curves, _ = generate_curves(1000, seed, n_ctrl=cfg.n_ctrl, n_points=cfg.n_points)
         encode, decode, _ = torch_codec(run / "best.pt")
         recon = batched(lambda x: decode(encode(x)), curves)
-        cache.write_text(json.dumps({"mse": float(mse_per_curve(curves, recon).mean())}) + "\n")
+        atomic_write_text(cache, json.dumps({"mse": float(mse_per_curve(curves, recon).mean())}) + "\n")
     return json.loads(cache.read_text())["mse"]
 
 

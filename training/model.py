@@ -44,10 +44,36 @@ def conv_block(c_in: int, c_out: int, k: int, *, transposed: bool = False) -> nn
     return nn.Sequential(conv(c_in, c_out, k), nn.ReLU())
 
 
-def _out_len(module: nn.Module, c_in: int, length: int) -> tuple[int, int]:
-    with torch.no_grad():
-        y = module(torch.zeros(1, c_in, length))
+@torch.no_grad()
+def _trace(layers: nn.Sequential, x: torch.Tensor) -> list[torch.Tensor]:
+    """The input of every layer and the final output, for shape probing.
+
+    Runs in eval mode, so probing leaves BatchNorm's running statistics untouched.
+    """
+    was_training = layers.training
+    layers.eval()
+    try:
+        xs = [x]
+        for layer in layers:
+            xs.append(layer(xs[-1]))
+    finally:
+        layers.train(was_training)
+    return xs
+
+
+def _out_len(module: nn.Sequential, c_in: int, length: int) -> tuple[int, int]:
+    y = _trace(module, torch.zeros(1, c_in, length))[-1]
     return y.shape[1], y.shape[2]
+
+
+def _prefix_lengths(layers: nn.Sequential, n: int, x: torch.Tensor) -> list[int]:
+    """Input length each layer needs for the chain's first n outputs, in layer order."""
+    inputs = _trace(layers, x)[:-1]
+    needs = []
+    for layer, xi in zip(reversed(layers), reversed(inputs)):
+        n = _needed(layer, n, xi)
+        needs.append(n)
+    return needs[::-1]
 
 
 def _needed(module: nn.Module, n: int, x: torch.Tensor) -> int:
@@ -59,12 +85,7 @@ def _needed(module: nn.Module, n: int, x: torch.Tensor) -> int:
     """
     length = x.shape[-1]
     if isinstance(module, nn.Sequential):
-        inputs = [x]
-        for child in module:
-            inputs.append(child(inputs[-1]))
-        for child, xi in zip(reversed(module), reversed(inputs[:-1])):
-            n = _needed(child, n, xi)
-        return n
+        return _prefix_lengths(module, n, x)[0]
     if isinstance(module, Inception):
         return max(_needed(b, n, x) for b in (module.b1, module.b3, module.b5, module.bp))
     if isinstance(module, (nn.ConvTranspose1d, nn.Conv1d, nn.MaxPool1d)):
@@ -168,19 +189,7 @@ class Decoder(nn.Module):
         _, out_len = _out_len(self.features, feat_channels, feat_len)
         if out_len < cfg.n_points:
             raise ValueError(f"decoder of {cfg.variant} yields {out_len} < {cfg.n_points} points")
-        self.crops = self._prefix_plan(cfg.n_points)
-
-    @torch.no_grad()
-    def _prefix_plan(self, n_points: int) -> list[int]:
-        """Input length each layer of self.features needs for the first n_points outputs."""
-        inputs = [torch.zeros(2, *self.feat_shape)]
-        for layer in self.features:
-            inputs.append(layer(inputs[-1]))
-        crops, n = [], n_points
-        for layer, x in zip(reversed(self.features), reversed(inputs[:-1])):
-            n = _needed(layer, n, x)
-            crops.append(n)
-        return crops[::-1]
+        self.crops = _prefix_lengths(self.features, cfg.n_points, torch.zeros(1, *self.feat_shape))
 
     def forward(self, z: torch.Tensor, *, full: bool | None = None) -> torch.Tensor:
         """Decode; full runs every layer over its whole length (default: in training only)."""

@@ -101,3 +101,13 @@ def test_training_runs_the_full_decoder_stack():
         default, full, prefix = decoder(z), decoder(z, full=True), decoder(z, full=False)
     assert torch.equal(default, full)  # BatchNorm's batch statistics over the whole maps
     assert not torch.allclose(default, prefix, atol=1e-3)  # …which the prefix path would change
+
+
+def test_building_a_model_leaves_batchnorm_statistics_untouched():
+    model = VAE(ModelConfig())  # shape probing at construction must not count as a batch
+    assert model.training
+    for m in model.modules():
+        if isinstance(m, torch.nn.BatchNorm1d):
+            assert torch.equal(m.running_mean, torch.zeros_like(m.running_mean))
+            assert torch.equal(m.running_var, torch.ones_like(m.running_var))
+            assert m.num_batches_tracked.item() == 0
