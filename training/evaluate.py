@@ -69,12 +69,21 @@ def evaluate_set(curves: np.ndarray, recon: np.ndarray) -> dict[str, Any]:
     """The report of one test set: eq. 4 MSE statistics and smoothness of inputs vs outputs."""
     mse = mse_per_curve(curves, recon)
     s_in, s_out = smoothness(curves), smoothness(recon)
+    d = np.asarray(curves, np.float64) - np.asarray(recon, np.float64)
+    by_point = np.mean(d * d, axis=(0, 2))  # eq. 4 at each point index, over the set
+    ends = 10
     return {
         "n_curves": len(curves),
         "mse": float(mse.mean()),  # paper eq. 4, averaged over the set (Table 1's number)
         "mse_median": float(np.median(mse)),
         "mse_p95": float(np.percentile(mse, 95)),
         "mse_max": float(mse.max()),
+        # where along the curve the error sits: the end points are the hardest
+        "mse_first_point": float(by_point[0]),
+        "mse_last_point": float(by_point[-1]),
+        f"error_share_first_last_{ends}_points": float(
+            (by_point[:ends].sum() + by_point[-ends:].sum()) / max(by_point.sum(), 1e-300)
+        ),
         "smoothness_input": {k: float(v.mean()) for k, v in s_in.items()},
         "smoothness_output": {k: float(v.mean()) for k, v in s_out.items()},
         "self_intersecting_outputs": float(self_intersects(recon).mean()),
@@ -220,6 +229,35 @@ def plot_pair_interpolation(
     _save(fig, path)
 
 
+def plot_latent_vs_pointwise(
+    encode: Encoder, decode: Decoder, pairs: list[tuple[np.ndarray, np.ndarray]], path: Path, *, steps: int = 5
+) -> None:
+    """Each row: one pair blended in latent space (eq. 9) and point by point (paper Fig. 10).
+
+    Titles give the mean roughness of the interior curves and how many of them self-intersect.
+    """
+    plt = _plt()
+    w = np.linspace(1, 0, steps)
+    fig, axes = plt.subplots(len(pairs), 2, figsize=(9, 3.6 * len(pairs)), squeeze=False)
+    cmap = plt.get_cmap("viridis")
+    for row, (a, b) in zip(axes, pairs):
+        mu = encode(np.stack([a, b]))
+        latent = decode(w[:, None] * mu[0] + (1 - w[:, None]) * mu[1])
+        pointwise = w[:, None, None] * a[None] + (1 - w[:, None, None]) * b[None]
+        for ax, curves, name in ((row[0], latent, "latent"), (row[1], pointwise, "point-wise")):
+            for i, c in enumerate(curves):
+                ax.plot(*c.T, color=cmap(i / (steps - 1)), lw=1.2, label=f"w={w[i]:.2f}")
+            inner = curves[1:-1]
+            rough = smoothness(inner)["roughness"].mean()
+            crossing = int(self_intersects(inner).sum())
+            ax.set_title(f"{name}: roughness {rough:.2f}°, {crossing}/{len(inner)} self-intersecting", fontsize=9)
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+    axes[0, 0].legend(fontsize=7, loc="best")
+    _save(fig, path)
+
+
 def plot_triplet(encode: Encoder, decode: Decoder, curves: np.ndarray, path: Path, *, steps: int = 4) -> None:
     """Three inputs and the barycentric grid of eq. 10 between them (paper Fig. 8)."""
     plt = _plt()
@@ -291,6 +329,12 @@ def run_evaluation(
             encode, decode, [(first[0], first[1]), (first[2], first[3])], out / "interpolation_pair.png"
         )
         plot_triplet(encode, decode, first[4:7], out / "interpolation_triplet.png")
+        plot_latent_vs_pointwise(
+            encode,
+            decode,
+            [(first[i % len(first)], first[(i + 1) % len(first)]) for i in (8, 10, 12)],
+            out / "interpolation_latent_vs_pointwise.png",
+        )
         plot_latent_tsne(encode, first, out / "latent_tsne.png")
     if figures and log_path is not None and log_path.exists():
         plot_training(log_path, out / "training.png")

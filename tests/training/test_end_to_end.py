@@ -100,7 +100,15 @@ def test_evaluate_exported_model(trained, capsys):
     assert "test: MSE" in printed and "fresh_seed_7919: MSE" in printed
     report = json.loads((out / "report.json").read_text())
     assert report["interpolation"]["latent"]["self_intersecting"] >= 0
-    assert (out / "tangents_test.png").exists()
+    for figure in (
+        "tangents_test.png",
+        "reconstructions_fresh_seed_7919.png",
+        "interpolation_pair.png",
+        "interpolation_triplet.png",
+        "interpolation_latent_vs_pointwise.png",
+        "latent_tsne.png",
+    ):
+        assert (out / figure).stat().st_size > 10_000, figure
 
 
 def test_ddp_two_cpu_processes(tmp_path):
