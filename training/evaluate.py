@@ -201,6 +201,13 @@ def plot_training(log_path: Path, path: Path) -> None:
     _save(fig, path)
 
 
+def latent_sweep(encode: Encoder, decode: Decoder, a: np.ndarray, b: np.ndarray, steps: int) -> np.ndarray:
+    """Decoded curves of eq. 9 from w=1 (curve a) to w=0 (curve b), `steps` of them."""
+    w = np.linspace(1, 0, steps)
+    mu = encode(np.stack([a, b]))
+    return decode(w[:, None] * mu[0] + (1 - w[:, None]) * mu[1])
+
+
 def plot_pair_interpolation(
     encode: Encoder, decode: Decoder, pairs: list[tuple[np.ndarray, np.ndarray]], path: Path, *, steps: int = 5
 ) -> None:
@@ -212,8 +219,7 @@ def plot_pair_interpolation(
     )
     cmap = plt.get_cmap("viridis")
     for row, (a, b) in zip(axes, pairs):
-        mu = encode(np.stack([a, b]))
-        out = decode(w[:, None] * mu[0] + (1 - w[:, None]) * mu[1])
+        out = latent_sweep(encode, decode, a, b, steps)
         row[0].plot(*a.T, color=cmap(0.0))
         row[1].plot(*b.T, color=cmap(1.0))
         for i, c in enumerate(out):
@@ -241,8 +247,7 @@ def plot_latent_vs_pointwise(
     fig, axes = plt.subplots(len(pairs), 2, figsize=(9, 3.6 * len(pairs)), squeeze=False)
     cmap = plt.get_cmap("viridis")
     for row, (a, b) in zip(axes, pairs):
-        mu = encode(np.stack([a, b]))
-        latent = decode(w[:, None] * mu[0] + (1 - w[:, None]) * mu[1])
+        latent = latent_sweep(encode, decode, a, b, steps)
         pointwise = w[:, None, None] * a[None] + (1 - w[:, None, None]) * b[None]
         for ax, curves, name in ((row[0], latent, "latent"), (row[1], pointwise, "point-wise")):
             for i, c in enumerate(curves):
