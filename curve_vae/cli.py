@@ -1,4 +1,4 @@
-"""`curve-vae` command line: dataset, train, export, evaluate, sample, augment, fit, revolve, serve.
+"""`curve-vae` command line: dataset, train, average, export, evaluate, sample, augment, fit, revolve, serve.
 
 Each subcommand imports what it needs when it runs, so `curve-vae serve` and the offline
 commands (sample, augment, fit, revolve) work in the base install (no torch).
@@ -184,6 +184,8 @@ def cmd_export(a: argparse.Namespace) -> int:
         "best_epoch": ckpt["state"]["best_epoch"],
         "best_val_mse": ckpt["state"]["best_val"],
     }
+    if "averaged" in ckpt:  # made by curve-vae average: which checkpoints, and what it measured
+        training["averaged"] = ckpt["averaged"]
     if a.training_info:
         training.update(json.loads(Path(a.training_info).read_text()))
     manifest = export(
@@ -204,6 +206,30 @@ def cmd_export(a: argparse.Namespace) -> int:
         (Path(a.out) / "report").rmdir()
         for name, r in report["test_sets"].items():
             print(f"{name}: MSE {r['mse']:.4f} (median {r['mse_median']:.4f}) over {r['n_curves']} curves")
+    return 0
+
+
+# ------------------------------------------------------------------------------ average
+
+
+def cmd_average(a: argparse.Namespace) -> int:
+    import torch
+
+    from training.average import average_checkpoints
+    from training.data import DataConfig, load_or_generate
+    from training.train import atomic_save, load_checkpoint
+
+    if a.threads > 0:
+        torch.set_num_threads(a.threads)
+    for p in a.checkpoints:
+        if not Path(p).is_file():
+            raise SystemExit(f"curve-vae average: no checkpoint at {p}")
+    d = load_checkpoint(a.checkpoints[-1])["data_config"]
+    ds = load_or_generate(DataConfig(**{**d, "center": tuple(d["center"])}), a.data)
+    train_curves = ds.train[: a.bn_curves] if a.bn_curves > 0 else None
+    ckpt = average_checkpoints(a.checkpoints, train_curves=train_curves, val_curves=ds.val)
+    atomic_save(ckpt, Path(a.out))
+    print(f"averaged {len(a.checkpoints)} checkpoints → {a.out} (export it with curve-vae export --checkpoint)")
     return 0
 
 
@@ -424,6 +450,23 @@ def build_parser() -> argparse.ArgumentParser:
         help="measure the exported graphs on both test sets and store the metrics in the manifest (default: on)",
     )
     s.set_defaults(func=cmd_export)
+
+    s = sub.add_parser(
+        "average", help="average the weights of checkpoints and re-measure BatchNorm statistics (SWA-style)"
+    )
+    s.add_argument("checkpoints", nargs="+", help="training checkpoints of one run (e.g. best.pt last.pt)")
+    s.add_argument("--out", required=True, help="the averaged checkpoint (training format, for export)")
+    s.add_argument(
+        "--data", default=DEFAULT_DATA, help=f"data set cache of the checkpoints' data config (default: {DEFAULT_DATA})"
+    )
+    s.add_argument(
+        "--bn-curves",
+        type=int,
+        default=20_000,
+        help="training curves to measure BatchNorm statistics on; 0 keeps the averaged ones (default: 20000)",
+    )
+    s.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's default)")
+    s.set_defaults(func=cmd_average)
 
     s = sub.add_parser("evaluate", help="reconstruction MSE, smoothness and figures on the test sets")
     src = s.add_mutually_exclusive_group()

@@ -205,3 +205,25 @@ def test_time_budget_anneals_and_stops(tmp_path):
     assert rows[-1]["trained_seconds"] >= 6
     assert rows[-1]["lr"] < 1e-3 * 0.01  # annealed by the end of the budget, not by epoch count
     assert (run / "report.json").exists()  # a finished run is evaluated
+
+
+def test_average_checkpoints_then_export(trained, capsys):
+    tmp, data, cut, _, _ = trained
+    out = tmp / "averaged.pt"
+    cmd = ["average", str(cut / "best.pt"), str(cut / "last.pt"), "--out", str(out), "--data", data]
+    assert main([*cmd, "--bn-curves", "128", "--threads", "2"]) == 0
+    printed = capsys.readouterr().out
+    assert "validation MSE" in printed and "BatchNorm statistics of 128 training curves" in printed
+    avg, best, last = (load_checkpoint(p) for p in (out, cut / "best.pt", cut / "last.pt"))
+    rec = avg["averaged"]
+    assert [s["epoch"] for s in rec["sources"]] == [best["state"]["epoch"], last["state"]["epoch"]]
+    assert rec["bn_curves"] == 128 and rec["val_mse"] > 0
+    for k, v in avg["model"].items():  # weights are the mean; BatchNorm statistics re-measured
+        if v.is_floating_point() and "running_" not in k:
+            torch.testing.assert_close(v, (best["model"][k] + last["model"][k]) / 2, msg=k)
+    models = tmp / "models-averaged"
+    assert main(["export", "--checkpoint", str(out), "--out", str(models), "--data", data, "--no-evaluate"]) == 0
+    manifest = json.loads((models / "manifest.json").read_text())
+    assert manifest["training"]["averaged"]["sources"][1]["path"] == str(cut / "last.pt")
+    with pytest.raises(SystemExit, match="no checkpoint at"):
+        main(["average", str(cut / "missing.pt"), "--out", str(out), "--data", data])
