@@ -104,6 +104,8 @@ def _add_train_options(p: argparse.ArgumentParser) -> None:
         "train_limit": "use only the first N training curves (0: all)",
         "time_budget": "seconds of training; the schedule follows elapsed training time and the run "
         "stops when it is spent, whatever the throughput (0: off; --epochs stays an upper bound)",
+        "snapshots": "keep the weights of the latest N epochs as RUN_DIR/epoch-NNNN.pt, to average them "
+        "afterwards with curve-vae average (0: off)",
     }
     for f in fields(TrainConfig):
         flag = "--" + f.name.replace("_", "-")

@@ -58,11 +58,14 @@ class TrainConfig:
     device: str = "auto"  # auto | cpu | cuda
     train_limit: int = 0  # use only the first N training curves (0: all)
     time_budget: float = 0.0  # seconds of training: the schedule follows elapsed time, not steps (0: off)
+    snapshots: int = 0  # keep the weights of the latest N epochs as epoch-NNNN.pt, for curve-vae average
 
     def __post_init__(self) -> None:
         if self.schedule not in SCHEDULES:
             raise ValueError(f"schedule must be one of {', '.join(SCHEDULES)}, got {self.schedule!r}")
         if self.time_budget and self.schedule == "plateau":
             raise ValueError("a time budget needs a onecycle, cosine or constant schedule, not plateau")
+        if self.snapshots < 0:
+            raise ValueError(f"snapshots must be ≥ 0, got {self.snapshots}")
         if self.epochs < 1 or self.batch_size < 1 or self.lr <= 0:
             raise ValueError("epochs and batch_size must be ≥ 1 and lr > 0")

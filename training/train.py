@@ -205,6 +205,15 @@ def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch
     return None
 
 
+def _keep_snapshot(run_dir: Path, ckpt: dict[str, Any], epoch: int, keep: int) -> None:
+    """Save this epoch's weights (no optimiser state) and drop snapshots older than the latest `keep`."""
+    atomic_save(
+        {k: v for k, v in ckpt.items() if k not in ("optimizer", "scheduler", "rng")}, run_dir / f"epoch-{epoch:04d}.pt"
+    )
+    for old in sorted(run_dir.glob("epoch-[0-9][0-9][0-9][0-9].pt"))[:-keep]:
+        old.unlink()
+
+
 def _rng_state(gen: np.random.Generator) -> dict[str, Any]:
     return {"torch": torch.get_rng_state(), "numpy": json.dumps(gen.bit_generator.state)}
 
@@ -221,7 +230,7 @@ def train(
     stop_after: int = 0,
     init_from: str | Path | None = None,
 ) -> RunState:
-    """Train into `run_dir` (last.pt, best.pt, log.jsonl); resume from last.pt if asked.
+    """Train into `run_dir` (last.pt, best.pt, log.jsonl, epoch-NNNN.pt snapshots); resume from last.pt if asked.
 
     stop_after: leave after this many epochs of this call (0: run to cfg.epochs), so a long
     schedule can be run in time-boxed slices and continued with resume=True.
@@ -367,6 +376,8 @@ def train(
                 if improved:
                     atomic_save(ckpt, run_dir / "best.pt")
                 atomic_save(ckpt, last)
+                if cfg.snapshots:
+                    _keep_snapshot(run_dir, ckpt, state.epoch, cfg.snapshots)
                 with open(run_dir / "log.jsonl", "a") as f:
                     f.write(json.dumps(row) + "\n")
                 print(  # one line per epoch, with or without the progress bar

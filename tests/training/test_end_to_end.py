@@ -25,14 +25,14 @@ def _log(run):
 
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory):
-    """A 3-epoch run interrupted after 2 epochs and resumed, plus an uninterrupted twin."""
+    """A 3-epoch run interrupted after 2 epochs and resumed (keeping 2 snapshots), plus an uninterrupted twin."""
     tmp = tmp_path_factory.mktemp("e2e")
     data = str(tmp / "curves.npz")
     cut, whole = tmp / "cut", tmp / "whole"
     common = [*TINY, "--data", data, "--epochs", "3"]
-    assert main(["train", "--run-dir", str(cut), "--stop-after", "2", *common]) == 0
+    assert main(["train", "--run-dir", str(cut), "--stop-after", "2", "--snapshots", "2", *common]) == 0
     after_two = _log(cut)
-    assert main(["train", "--run-dir", str(cut), "--resume", *common]) == 0
+    assert main(["train", "--run-dir", str(cut), "--resume", "--snapshots", "2", *common]) == 0
     assert main(["train", "--run-dir", str(whole), *common]) == 0
     return tmp, data, cut, whole, after_two
 
@@ -227,3 +227,19 @@ def test_average_checkpoints_then_export(trained, capsys):
     assert manifest["training"]["averaged"]["sources"][1]["path"] == str(cut / "last.pt")
     with pytest.raises(SystemExit, match="no checkpoint at"):
         main(["average", str(cut / "missing.pt"), "--out", str(out), "--data", data])
+
+
+def test_snapshots_keep_the_latest_epochs(trained, capsys):
+    tmp, data, cut, whole, _ = trained
+    assert sorted(p.name for p in cut.glob("epoch-*.pt")) == ["epoch-0002.pt", "epoch-0003.pt"]
+    assert not list(whole.glob("epoch-*.pt"))  # off by default
+    snap, last = load_checkpoint(cut / "epoch-0003.pt"), load_checkpoint(cut / "last.pt")
+    assert "optimizer" not in snap and snap["state"]["epoch"] == 3
+    for k in last["model"]:
+        torch.testing.assert_close(snap["model"][k], last["model"][k], msg=k)
+    out = tmp / "snapshots-averaged.pt"
+    snaps = [str(p) for p in sorted(cut.glob("epoch-*.pt"))]
+    assert main(["average", *snaps, "--out", str(out), "--data", data, "--bn-curves", "0"]) == 0
+    rec = load_checkpoint(out)["averaged"]
+    assert [s["epoch"] for s in rec["sources"]] == [2, 3] and rec["bn_curves"] == 0
+    assert "averaged BatchNorm statistics" in capsys.readouterr().out
