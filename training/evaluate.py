@@ -185,16 +185,18 @@ def plot_training(log_path: Path, path: Path) -> None:
     plt = _plt()
     rows = [json.loads(line) for line in log_path.read_text().splitlines() if line.strip()]
     ep = [r["epoch"] for r in rows]
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6), layout="constrained")
     axes[0].semilogy(ep, [r["train_mse"] for r in rows], label="train MSE")
     axes[0].semilogy(ep, [r["val_mse"] for r in rows], label="validation MSE")
     axes[0].axhline(0.099, color="gray", ls=":", label="paper (0.099)")
     axes[0].set_xlabel("epoch")
     axes[0].legend()
-    axes[1].plot(ep, [r["train_kl"] for r in rows], label="KL")
-    axes[1].plot(ep, [r["train_lap"] for r in rows], label="Laplacian")
+    axes[1].plot(ep, [r["train_kl"] for r in rows], label="KL", color="C0")
+    axes[1].set_ylabel("KL", color="C0")
+    lap = axes[1].twinx()  # the Laplacian term is ~100× smaller than the KL: its own scale
+    lap.plot(ep, [r["train_lap"] for r in rows], label="Laplacian", color="C1")
+    lap.set_ylabel("Laplacian", color="C1")
     axes[1].set_xlabel("epoch")
-    axes[1].legend()
     axes[2].plot(ep, [r["lr"] for r in rows])
     axes[2].set_xlabel("epoch")
     axes[2].set_ylabel("learning rate")
