@@ -19,7 +19,7 @@ from torch import nn
 
 from training.config import ModelConfig
 from training.model import VAE
-from training.train import CHECKPOINT_VERSION, load_checkpoint
+from training.train import CHECKPOINT_VERSION, load_checkpoint, validation_mse
 
 __all__ = ["average_state_dicts", "recompute_batchnorm", "average_checkpoints"]
 
@@ -58,12 +58,6 @@ def recompute_batchnorm(
     model.eval()
 
 
-def _val_mse(model: VAE, val: np.ndarray) -> float:
-    from training.train import reconstruct
-
-    return float(np.mean((reconstruct(model, val) - val) ** 2))
-
-
 def average_checkpoints(
     paths: Sequence[str | Path],
     *,
@@ -88,18 +82,18 @@ def average_checkpoints(
         src: dict[str, Any] = {"path": str(p), "epoch": c["state"]["epoch"]}
         if val_curves is not None:
             model.load_state_dict(c["model"])
-            src["val_mse"] = _val_mse(model.eval(), val_curves)
+            src["val_mse"] = validation_mse(model.eval(), val_curves)
             log(f"{p} (epoch {src['epoch']}): validation MSE {src['val_mse']:.4f}")
         record["sources"].append(src)
     model.load_state_dict(average_state_dicts([c["model"] for c in ckpts]))
     model.eval()
     if val_curves is not None:
-        record["val_mse_running_stats"] = _val_mse(model, val_curves)
+        record["val_mse_running_stats"] = validation_mse(model, val_curves)
         log(f"average, averaged BatchNorm statistics: validation MSE {record['val_mse_running_stats']:.4f}")
     if train_curves is not None:
         recompute_batchnorm(model, train_curves, batch=bn_batch)
         if val_curves is not None:
-            record["val_mse"] = _val_mse(model, val_curves)
+            record["val_mse"] = validation_mse(model, val_curves)
             log(
                 f"average, BatchNorm statistics of {len(train_curves)} training curves: "
                 f"validation MSE {record['val_mse']:.4f}"

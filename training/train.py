@@ -23,6 +23,7 @@ import torch.distributed as dist
 from torch import nn
 from tqdm import tqdm
 
+from geometry import mse_per_curve
 from training.config import SCHEDULES, ModelConfig, TrainConfig
 from training.data import DataConfig, load_or_generate
 from training.io import atomic_path
@@ -179,6 +180,12 @@ def reconstruct(
     x = torch.as_tensor(curves, dtype=torch.float32)
     out = [model(x[i : i + batch].to(device))[0].float().cpu() for i in range(0, len(x), batch)]
     return torch.cat(out).numpy()
+
+
+def validation_mse(model: nn.Module, curves: np.ndarray | torch.Tensor, *, device: torch.device | None = None) -> float:
+    """Paper eq. 4 averaged over `curves`, reconstructing from the latent mean (model selection's number)."""
+    target = curves.numpy() if isinstance(curves, torch.Tensor) else np.asarray(curves)
+    return float(mse_per_curve(target, reconstruct(model, target, device=device)).mean())
 
 
 def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch: int, clock: Clock):
@@ -339,7 +346,7 @@ def train(
             bar.close()
             train_time = time.perf_counter() - t0
             state.trained_seconds = clock.spent
-            val_mse = float(np.mean((reconstruct(model, val, device=device) - val.numpy()) ** 2))
+            val_mse = validation_mse(model, val, device=device)
             if distributed:  # decide on rank 0's number so every rank stops together
                 v = torch.tensor([val_mse], dtype=torch.float64)
                 dist.broadcast(v, 0)
