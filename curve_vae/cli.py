@@ -84,6 +84,13 @@ def _add_train_options(p: argparse.ArgumentParser) -> None:
         "(cnn6 = inception, the paper's model; cnn1…cnn5: Table 1's ablations) (default: inception)",
     )
     g.add_argument("--latent-dim", type=int, default=32, help="latent size, paper Table 2 (default: 32)")
+    g.add_argument(
+        "--spline-ctrl",
+        type=int,
+        default=0,
+        help="B-spline output head: project decoded points onto a clamped cubic B-spline with this many "
+        "control points, 7k+3 to keep the data's knots (0: raw points) (default: 0)",
+    )
     d = TrainConfig()
     g = p.add_argument_group("training")
     helps = {
@@ -128,7 +135,7 @@ def cmd_train(a: argparse.Namespace) -> int:
     from training.evaluate import plot_training, run_evaluation, torch_codec
     from training.train import train
 
-    model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim)
+    model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim, spline_ctrl=a.spline_ctrl)
     cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
     run_dir = Path(a.run_dir)
     state = train(
@@ -179,6 +186,14 @@ def cmd_export(a: argparse.Namespace) -> int:
     data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
     ds = load_or_generate(data_cfg, a.data)
     model = model_from_checkpoint(a.checkpoint)
+    if a.spline_ctrl is not None and a.spline_ctrl != model.cfg.spline_ctrl:
+        from dataclasses import replace
+
+        from training.model import VAE
+
+        head = VAE(replace(model.cfg, spline_ctrl=a.spline_ctrl))  # the head has no weights: same state dict
+        head.load_state_dict(model.state_dict())
+        model = head.eval()
     training: dict[str, Any] = {
         "data": ckpt["data_config"],
         "train": ckpt["train_config"],
@@ -190,17 +205,46 @@ def cmd_export(a: argparse.Namespace) -> int:
         training["averaged"] = ckpt["averaged"]
     if a.training_info:
         training.update(json.loads(Path(a.training_info).read_text()))
+    prior, prior_info = None, None
+    if a.prior:
+        import numpy as np
+        import torch
+
+        from training.prior import FIT_CURVES, fit_prior
+
+        fit_on = ds.train[:FIT_CURVES]
+        with torch.no_grad():
+            means = np.concatenate(
+                [model.encoder(torch.from_numpy(fit_on[i : i + 500]))[0].numpy() for i in range(0, len(fit_on), 500)]
+            )
+        prior = fit_prior(means, components=a.prior_components)
+        prior_info = {"fitted_on": f"latent means of the first {len(fit_on)} training curves"}
+        print(f"fitted a {a.prior_components}-component latent prior to {len(fit_on)} training curves")
     manifest = export(
-        model, a.out, name=a.name, version=a.version, model_size=model_size_of(ds.train), extra={"training": training}
+        model,
+        a.out,
+        name=a.name,
+        version=a.version,
+        model_size=model_size_of(ds.train),
+        extra={"training": training},
+        prior=prior,
+        prior_info=prior_info,
     )
     print(f"exported {a.checkpoint} → {a.out}/encoder.onnx, decoder.onnx, vae.pt, manifest.json")
     if a.evaluate:
         from training.data import generate_curves
 
         fresh, _ = generate_curves(1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
+        from service.runtime import CurveRuntime
+
         enc, dec, _ = onnx_codec(a.out)
         report = run_evaluation(
-            enc, dec, {"test": ds.test, f"fresh_seed_{a.fresh_seed}": fresh}, Path(a.out) / "report", figures=False
+            enc,
+            dec,
+            {"test": ds.test, f"fresh_seed_{a.fresh_seed}": fresh},
+            Path(a.out) / "report",
+            figures=False,
+            runtime=CurveRuntime.load(a.out, providers="cpu"),
         )
         manifest["metrics"] = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
         atomic_write_text(Path(a.out) / "manifest.json", json.dumps(manifest, indent=2) + "\n")
@@ -242,13 +286,17 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
     from training.data import DataConfig, generate_curves, load_or_generate
     from training.evaluate import onnx_codec, run_evaluation, torch_codec
 
+    runtime = None
     if a.checkpoint:
         enc, dec, meta = torch_codec(a.checkpoint)
         import torch
 
         data_cfg_d = torch.load(a.checkpoint, map_location="cpu", weights_only=True).get("data_config")
     else:
+        from service.runtime import CurveRuntime
+
         enc, dec, meta = onnx_codec(a.model_dir)
+        runtime = CurveRuntime.load(a.model_dir, providers="cpu")
         data_cfg_d = meta.get("training", {}).get("data")
     data_cfg = DataConfig(**{**data_cfg_d, "center": tuple(data_cfg_d["center"])}) if data_cfg_d else DataConfig()
     ds = load_or_generate(data_cfg, a.data)
@@ -258,13 +306,28 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
             1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points
         )[0]
     log = Path(a.checkpoint).parent / "log.jsonl" if a.checkpoint else None
-    report = run_evaluation(enc, dec, sets, a.out, log_path=log, figures=not a.no_figures)
+    report = run_evaluation(enc, dec, sets, a.out, log_path=log, figures=not a.no_figures, runtime=runtime)
     for name, r in report["test_sets"].items():
         s_in, s_out = r["smoothness_input"]["roughness"], r["smoothness_output"]["roughness"]
         print(
             f"{name}: MSE {r['mse']:.4f} (paper eq. 4, {r['n_curves']} curves; median {r['mse_median']:.4f}); "
             f"roughness in {s_in:.3f}° out {s_out:.3f}°; self-intersecting outputs {r['self_intersecting_outputs']:.1%}"
         )
+        lat, pw = r["interpolation"]["latent"], r["interpolation"]["pointwise"]
+        print(
+            f"  interpolants ({r['interpolation']['pairs']} pairs): latent roughness {lat['roughness']:.3f}°, "
+            f"self-intersecting {lat['self_intersecting']:.1%}; point-wise blends {pw['roughness']:.3f}°, "
+            f"{pw['self_intersecting']:.1%}"
+        )
+    for prior, g in report.get("generation", {}).items():
+        if isinstance(g, dict):
+            raw, kept = g["every_draw"], g["valid"]
+            print(
+                f"samples, {prior} prior: {raw['self_intersecting']:.1%} self-intersecting before rejection "
+                f"({kept['rejected_share']:.1%} of draws rejected); size {kept['size_vs_data']:.2f}× the data's, "
+                f"roughness {kept['roughness']:.3f}°, coverage {kept['coverage_vs_real']:.2f}×, "
+                f"precision {kept['precision_vs_real']:.2f}× of real curves'"
+            )
     print(f"report: {Path(a.out) / 'report.json'}")
     return 0
 
@@ -282,16 +345,29 @@ def _runtime(a: argparse.Namespace):
 
 def cmd_sample(a: argparse.Namespace) -> int:
     from curve_vae.files import write_output
-    from service.payloads import sample_body
+    from service.payloads import sample_body, with_output
     from service.runtime import fresh_seed
 
     runtime = _runtime(a)
     seed = fresh_seed() if a.seed is None else a.seed
-    latents, curves = runtime.sample(
-        a.count, seed=seed, temperature=a.temperature, n_points=a.n_points, spacing=a.spacing
+    splines: list | None = [] if a.output_as != "points" else None
+    made = runtime.sample(
+        a.count,
+        seed=seed,
+        temperature=a.temperature,
+        prior=a.prior,
+        valid=a.valid,
+        n_points=a.n_points,
+        spacing=a.spacing,
+        splines=splines,
     )
-    write_output(a.output, sample_body(latents, curves, seed, metrics=a.metrics), array_key="curves")
-    print(f"{a.output}: {a.count} curves of {curves.shape[1]} points from the prior, seed {seed}", file=sys.stderr)
+    body = with_output(sample_body(made, seed, metrics=a.metrics), splines, a.output_as)
+    write_output(a.output, body, array_key="curves" if "curves" in body else None)
+    print(
+        f"{a.output}: {a.count} curves of {made.curves.shape[1]} points from the {made.prior} prior, seed {seed}; "
+        f"{made.rejected} draws rejected and drawn again",
+        file=sys.stderr,
+    )
     return 0
 
 
@@ -362,11 +438,11 @@ def cmd_fit(a: argparse.Namespace) -> int:
     from curve_vae.files import read_curves, write_output
     from service.payloads import fit_body
 
-    body = fit_body(read_curves(a.input), a.n_ctrl, param=a.param, n_points=a.n_points)
+    body = fit_body(read_curves(a.input), a.n_ctrl, param=a.param, n_points=a.n_points, tolerance=a.tolerance)
     write_output(a.output, body)
     for i, f in enumerate(body["fits"]):
         print(
-            f"curve {i}: {a.n_ctrl} control points, rms error {f['rms_error']:.4g}, max {f['max_error']:.4g}",
+            f"curve {i}: {f['n_ctrl']} control points, rms error {f['rms_error']:.4g}, max {f['max_error']:.4g}",
             file=sys.stderr,
         )
     return 0
@@ -446,6 +522,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="JSON file merged into the manifest's training section (wall time, hardware)",
     )
     s.add_argument(
+        "--prior",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="fit the learned latent distribution /sample draws from and ship it as prior.npz (default: on)",
+    )
+    s.add_argument("--prior-components", type=int, default=8, help="Gaussian mixture components (default: 8)")
+    s.add_argument(
+        "--spline-ctrl",
+        type=int,
+        default=None,
+        help="export with this B-spline output head (control points, 0: none) in place of the checkpoint's; "
+        "the head has no weights, so any checkpoint takes any head (default: the checkpoint's)",
+    )
+    s.add_argument(
         "--evaluate",
         action=argparse.BooleanOptionalAction,
         default=True,
@@ -493,7 +583,27 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("sample", help="new curves from the latent prior, offline (as POST /sample)")
     _add_generate_options(s)
-    s.add_argument("--temperature", type=float, default=1.0, help="latent standard deviation (default: 1.0)")
+    s.add_argument(
+        "--temperature", type=float, default=1.0, help="spread of the latents about the prior's means (default: 1.0)"
+    )
+    s.add_argument(
+        "--prior",
+        choices=["learned", "standard"],
+        default=None,
+        help="learned: the latent density shipped with the model; standard: N(0, I) (default: learned if shipped)",
+    )
+    s.add_argument(
+        "--valid",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="redraw curves that cross themselves or leave the data's disc (default: on)",
+    )
+    s.add_argument(
+        "--output-as",
+        choices=["points", "bspline", "both"],
+        default="points",
+        help="curves as points, as B-splines (control points, knots, params), or both; JSON only (default: points)",
+    )
     _add_model_options(s)
     s.set_defaults(func=cmd_sample)
 
@@ -517,7 +627,18 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("fit", help="least-squares cubic B-spline of each curve (no model needed)")
     s.add_argument("input", help="curves: .json ([[x, y], …], a list of curves, or {curves: …}), .npy, or - (stdin)")
     s.add_argument("-o", "--output", default="-", help="JSON output file (default: - = stdout)")
-    s.add_argument("--n-ctrl", type=int, default=10, help="control points (default: 10, as the training data)")
+    s.add_argument(
+        "--n-ctrl",
+        type=int,
+        default=None,
+        help="control points (default: the fewest, from 4 up, whose RMS error is within --tolerance)",
+    )
+    s.add_argument(
+        "--tolerance",
+        type=float,
+        default=1e-3,
+        help="without --n-ctrl: RMS fit error to reach, as a fraction of the bounding-box diagonal (default: 0.001)",
+    )
     s.add_argument(
         "--param",
         choices=["uniform", "chord"],

@@ -1,4 +1,4 @@
-"""Curve files for the offline commands: JSON (as the REST API speaks it) or NPY."""
+"""Curve files for the offline commands: JSON (as the REST API speaks it), NPY, and airfoil coordinate files (.dat)."""
 
 from __future__ import annotations
 
@@ -12,13 +12,16 @@ import numpy as np
 
 
 def read_curves(path: str) -> list[np.ndarray]:
-    """Curves from a .npy array (n, 2) or (N, n, 2), or JSON: [[x, y], …], [curve, …] or {"curves": […]}.
+    """Curves from a .npy array (n, 2) or (N, n, 2), an airfoil .dat file, or JSON: [[x, y], …], [curve, …] or
+    {"curves": […]}.
 
     "-" reads JSON from standard input.
     """
     if path.endswith(".npy"):
         arr = np.load(path, allow_pickle=False)
         data: Any = arr[None] if arr.ndim == 2 else arr
+    elif path.endswith(".dat"):
+        data = [parse_dat(Path(path).read_text(errors="replace"), path)]
     else:
         text = sys.stdin.read() if path == "-" else Path(path).read_text()
         data = json.loads(text)
@@ -36,6 +39,39 @@ def read_curves(path: str) -> list[np.ndarray]:
             j = int(np.argwhere(~np.isfinite(c))[0][0])
             raise ValueError(f"{path}: curve {i} point {j} is not finite")
     return curves
+
+
+def parse_dat(text: str, name: str = "<dat>") -> np.ndarray:
+    """One airfoil from a coordinate file (n, 2): Selig format (a title line, then x y from the trailing edge over one
+    surface to the leading edge and back) or Lednicer format (a title line, a line of the two surfaces' point counts,
+    then each surface from leading to trailing edge), returned in Selig order. ValueError names the file and line.
+    """
+    rows: list[tuple[int, float, float]] = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        parts = line.replace(",", " ").split()
+        if not parts:
+            continue
+        try:
+            values = [float(p) for p in parts]
+        except ValueError:
+            if rows:
+                raise ValueError(f"{name}:{number}: expected two numbers x y, got {line.strip()!r}") from None
+            continue  # the title line(s)
+        if len(values) != 2 or not np.isfinite(values).all():
+            raise ValueError(f"{name}:{number}: expected two finite numbers x y, got {line.strip()!r}")
+        rows.append((number, values[0], values[1]))
+    if not rows:
+        raise ValueError(f"{name}: no coordinates found")
+    pts = np.array([r[1:] for r in rows])
+    if pts[0].min() >= 2 and float(pts[0, 0]).is_integer() and float(pts[0, 1]).is_integer():  # Lednicer counts
+        upper, lower = int(pts[0, 0]), int(pts[0, 1])
+        if len(pts) - 1 != upper + lower:
+            raise ValueError(f"{name}:{rows[0][0]}: counts {upper} + {lower} but {len(pts) - 1} points follow")
+        up, lo = pts[1 : 1 + upper], pts[1 + upper :]
+        pts = np.concatenate([up[::-1], lo[1:] if np.allclose(lo[0], up[0]) else lo])
+    if len(pts) < 4:
+        raise ValueError(f"{name}: {len(pts)} points; a curve needs at least 4")
+    return pts
 
 
 def write_output(path: str, payload: dict[str, Any], array_key: str | None = None) -> None:

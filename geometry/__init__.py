@@ -7,10 +7,14 @@ A curve is an array of shape (n_points, 2); a batch is (batch, n_points, 2).
 
 from geometry.bspline import (
     BSplineFit,
+    arc_length_params,
     clamped_uniform_knots,
+    evaluate_bspline,
     fit_bspline,
+    fit_bspline_auto,
     random_control_points,
     sample_bspline,
+    spline_head,
 )
 from geometry.frame import Frame, arc_fractions, at_fractions, blend_frames, fit_frame, resample
 from geometry.mesh import Mesh, revolve
@@ -23,6 +27,7 @@ from geometry.metrics import (
 )
 
 __all__ = [
+    "arc_length_params",
     "arc_fractions",
     "at_fractions",
     "BSplineFit",
@@ -31,7 +36,9 @@ __all__ = [
     "blend_frames",
     "clamped_uniform_knots",
     "curve_length",
+    "evaluate_bspline",
     "fit_bspline",
+    "fit_bspline_auto",
     "fit_frame",
     "mse_per_curve",
     "random_control_points",
@@ -40,5 +47,6 @@ __all__ = [
     "sample_bspline",
     "self_intersects",
     "smoothness",
+    "spline_head",
     "turning_angles",
 ]

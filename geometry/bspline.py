@@ -56,6 +56,44 @@ def sample_bspline(ctrl: np.ndarray, n_points: int = 161, degree: int = 3) -> np
     return np.einsum("pc,...cd->...pd", basis, ctrl)
 
 
+def spline_head(n_ctrl: int, n_points: int, degree: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """The fixed linear B-spline output head: basis (n_points, n_ctrl) and its pseudo-inverse (n_ctrl, n_points).
+
+    Point i of a curve sits at parameter i/(n_points-1) of a clamped uniform B-spline with
+    n_ctrl control points. `pinv @ curve` are the least-squares control points and
+    `basis @ pinv` the orthogonal projector onto the splines: it leaves every curve of the
+    space unchanged and can only shorten the distance to one, so it never adds error on
+    such curves. With n_ctrl = 7k + 3 the knots contain those of the paper's 10-point data
+    (every 1/7), so data curves lie in the space exactly.
+    """
+    basis = BSpline.design_matrix(np.linspace(0.0, 1.0, n_points), clamped_uniform_knots(n_ctrl, degree), degree)
+    dense = basis.toarray()
+    return dense, np.linalg.pinv(dense)
+
+
+def evaluate_bspline(control_points: np.ndarray, params: np.ndarray, degree: int = 3) -> np.ndarray:
+    """Points (…, len(params), 2) of clamped uniform B-splines (…, n_ctrl, 2) at parameters in [0, 1]."""
+    ctrl = np.asarray(control_points, dtype=np.float64)
+    u = np.clip(np.asarray(params, dtype=np.float64), 0.0, 1.0)
+    basis = BSpline.design_matrix(u, clamped_uniform_knots(ctrl.shape[-2], degree), degree).toarray()
+    return np.einsum("pc,...cd->...pd", basis, ctrl)
+
+
+def arc_length_params(control_points: np.ndarray, n_points: int, *, degree: int = 3, dense: int = 4096) -> np.ndarray:
+    """n_points parameters in [0, 1] of a clamped uniform B-spline (n_ctrl, 2), evenly spaced in its arc length.
+
+    The length is that of the spline sampled at `dense` parameters; the parameters in between are
+    interpolated linearly, which places points within ~1e-6 of the curve's length of even spacing.
+    """
+    u = np.linspace(0.0, 1.0, dense)
+    pts = evaluate_bspline(control_points, u, degree)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    if not s[-1] > 0:
+        return np.linspace(0.0, 1.0, n_points)  # a spline collapsed to a point: any spacing is even
+    keep = np.concatenate([[True], np.diff(s) > 0])
+    return np.interp(np.linspace(0.0, s[-1], n_points), s[keep], u[keep])
+
+
 @dataclass(frozen=True)
 class BSplineFit:
     """A least-squares B-spline: control points, knots and how far the curve is from it."""
@@ -131,3 +169,33 @@ def fit_bspline(
         rms_error=float(np.sqrt(np.mean(err**2))),
         max_error=float(err.max()),
     )
+
+
+#: Control-point counts `fit_bspline_auto` tries, in order: dense where few points matter, sparser above.
+AUTO_CTRL = (4, 5, 6, 7, 8, 10, 12, 14, 17, 20, 24, 28, 32, 40, 48, 56, 64)
+
+
+def fit_bspline_auto(
+    points: np.ndarray, *, tolerance: float = 1e-3, param: str = "chord", max_ctrl: int = 64
+) -> BSplineFit:
+    """The fit with the fewest control points (from 4 up) whose RMS error is within `tolerance` × the curve's
+    bounding-box diagonal; the most accurate one tried when none is (at most min(points, max_ctrl) control points).
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 4:
+        raise ValueError(f"points must have shape (n ≥ 4, 2), got {pts.shape}")
+    goal = tolerance * float(np.linalg.norm(np.ptp(pts, axis=0)))
+    limit = min(len(pts), max_ctrl)
+    best: BSplineFit | None = None
+    for n in [*(k for k in AUTO_CTRL if k < limit), limit]:
+        try:
+            fit = fit_bspline(pts, n, param=param)
+        except ValueError:
+            continue  # too many control points for how the points bunch up: try the next count
+        if best is None or fit.rms_error < best.rms_error:
+            best = fit
+        if fit.rms_error <= goal:
+            return fit
+    if best is None:
+        raise ValueError("no B-spline fits these points with 4 or more control points")
+    return best

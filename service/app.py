@@ -32,12 +32,13 @@ from service import schemas as s
 from service.metrics import Metrics, MetricsMiddleware
 from service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
 from service.npy import chunk_bytes, npy_header, npy_size
-from service.payloads import augment_body, fit_body, frames_json, sample_body, with_metrics
+from service.payloads import augment_body, fit_body, frames_json, sample_body, with_metrics, with_output
 from service.runtime import (
     AugmentPlan,
     CurveRuntime,
     InputError,
     ModelLoadError,
+    Spline,
     format_loc,
     fresh_seed,
     simplex_grid,
@@ -221,6 +222,19 @@ def _check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
     return np.array(req.weights, dtype=np.float64)
 
 
+def _splines_wanted(output: str, runtime: CurveRuntime) -> list[Spline] | None:
+    """A list for the runtime to fill with splines when the request asks for them; None for points only."""
+    if output == "points":
+        return None
+    if not runtime.has_splines:
+        raise InputError(
+            ("output",),
+            f'"{output}" needs a model with a B-spline head, and this one has none (GET /model: spline is null); '
+            'ask for "points", or fit splines to the points with /fit',
+        )
+    return []
+
+
 def _limiter(request: Request) -> anyio.CapacityLimiter | None:
     return getattr(request.app.state, "limiter", None)  # set by the lifespan; None: anyio's default
 
@@ -364,10 +378,14 @@ async def decode(
     _check_n_points(req.n_points, settings)
     frames = [Frame(center=f.center, size=f.size) for f in req.frames] if req.frames else None
 
+    splines = _splines_wanted(req.output, runtime)
+
     def work() -> Response:
         latents = np.array(req.latents, np.float64)
-        curves = runtime.decode(latents, n_points=req.n_points, spacing=req.spacing, frames=frames)
-        return JSONResponse(with_metrics({"curves": curves.tolist()}, curves, req.metrics))
+        curves = runtime.decode(latents, n_points=req.n_points, spacing=req.spacing, frames=frames, splines=splines)
+        return JSONResponse(
+            with_output(with_metrics({"curves": curves.tolist()}, curves, req.metrics), splines, req.output)
+        )
 
     return await _run(request, "/decode", len(req.latents), work)
 
@@ -391,6 +409,9 @@ async def reconstruct(
                 "resampled": _example(
                     "Two curves, returned at 100 points each", {"curves": [_C1, _C2], "n_points": 100}
                 ),
+                "points and spline": _example(
+                    "The reconstruction as points and as the B-spline they lie on", {"curves": [_C1], "output": "both"}
+                ),
             }
         ),
     ],
@@ -399,9 +420,14 @@ async def reconstruct(
     curves = _check_curves(req.curves, settings)
     _check_n_points(req.n_points, settings)
 
+    splines = _splines_wanted(req.output, runtime)
+
     def work() -> Response:
-        out, mse = runtime.reconstruct(curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing)
-        return JSONResponse(with_metrics({"curves": [c.tolist() for c in out], "mse": mse.tolist()}, out, req.metrics))
+        out, mse = runtime.reconstruct(
+            curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines
+        )
+        body = with_metrics({"curves": [c.tolist() for c in out], "mse": mse.tolist()}, out, req.metrics)
+        return JSONResponse(with_output(body, splines, req.output))
 
     return await _run(request, "/reconstruct", len(curves), work)
 
@@ -434,6 +460,10 @@ async def interpolate(
                 "weights": _example(
                     "Explicit weights, one entry per curve", {"curves": [_C1, _C2], "weights": [[0.25, 0.75]]}
                 ),
+                "as B-splines": _example(
+                    "The middle curve as a B-spline: control points, knots, degree and the parameter of each point",
+                    {"curves": [_C1, _C2], "weights": [[0.5, 0.5]], "output": "bspline"},
+                ),
             }
         ),
     ],
@@ -444,10 +474,14 @@ async def interpolate(
     _check_n_points(req.n_points, settings)
     weights = _check_weights(req, settings)
 
+    splines = _splines_wanted(req.output, runtime)
+
     def work() -> Response:
-        out, frames = runtime.interpolate(curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing)
+        out, frames = runtime.interpolate(
+            curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines
+        )
         body = {"weights": weights.tolist(), "curves": out.tolist(), "frames": frames_json(frames)}
-        return JSONResponse(with_metrics(body, out, req.metrics))
+        return JSONResponse(with_output(with_metrics(body, out, req.metrics), splines, req.output))
 
     return await _run(request, "/interpolate", len(weights), work)
 
@@ -456,7 +490,7 @@ async def interpolate(
     "/sample",
     response_model=s.SampleResponse,
     responses=_POST_ERRORS,
-    summary="New curves from the latent prior",
+    summary="New curves from the learned latent distribution (or the standard prior)",
     openapi_extra=_curl("/sample", '{"count": 3, "seed": 7, "n_points": 50}'),
 )
 async def sample(
@@ -469,6 +503,9 @@ async def sample(
             openapi_examples={
                 "seeded": _example("Three curves, reproducible", {"count": 3, "seed": 7, "n_points": 50}),
                 "tame": _example("Closer to typical shapes", {"count": 2, "seed": 1, "temperature": 0.5}),
+                "standard prior": _example(
+                    "The VAE's N(0, I), every draw kept", {"count": 2, "seed": 1, "prior": "standard", "valid": False}
+                ),
                 "framed": _example(
                     "In a frame of one's own, with smoothness metrics",
                     {"count": 2, "seed": 3, "frame": {"center": [0, 0], "size": 2}, "metrics": True},
@@ -477,19 +514,31 @@ async def sample(
         ),
     ],
 ) -> Response:
-    """Decode latents drawn from N(0, temperature²·I) into curves in the model's 128×128 plane (or `frame`).
-    The same seed gives the same curves; without one, the response reports the seed drawn."""
+    """Decode latents drawn from the learned latent distribution (a Gaussian mixture fitted to the training curves'
+    latent means, shipped with the model) or from the standard prior N(0, I), into curves in the model's 128×128
+    plane (or `frame`). By default a curve that crosses itself or leaves the data's disc is drawn again. The same
+    seed gives the same curves; without one, the response reports the seed drawn."""
     if req.count > settings.max_curves:
         raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
     _check_n_points(req.n_points, settings)
     seed = fresh_seed() if req.seed is None else req.seed
     frame = Frame(center=req.frame.center, size=req.frame.size) if req.frame else None
 
+    splines = _splines_wanted(req.output, runtime)
+
     def work() -> Response:
-        latents, curves = runtime.sample(
-            req.count, seed=seed, temperature=req.temperature, n_points=req.n_points, spacing=req.spacing, frame=frame
+        made = runtime.sample(
+            req.count,
+            seed=seed,
+            temperature=req.temperature,
+            prior=req.prior,
+            valid=req.valid,
+            n_points=req.n_points,
+            spacing=req.spacing,
+            frame=frame,
+            splines=splines,
         )
-        return JSONResponse(sample_body(latents, curves, seed, metrics=req.metrics))
+        return JSONResponse(with_output(sample_body(made, seed, metrics=req.metrics), splines, req.output))
 
     return await _run(request, "/sample", req.count, work)
 
@@ -558,6 +607,9 @@ async def augment(
         raise InputError(("count",), f"at most {limit}, got {req.count} (format {req.format}, {setting}){more}")
     if req.metrics and req.format == "npy":
         raise InputError(("metrics",), "only with format json: a .npy body carries the curves alone")
+    if req.output != "points" and req.format == "npy":
+        raise InputError(("output",), 'only "points" with format npy: a .npy body carries the curves\' points alone')
+    splines = _splines_wanted(req.output, runtime)
     _check_n_points(req.n_points, settings)
     seed = fresh_seed() if req.seed is None else req.seed
     start, stop = req.offset, req.offset + req.count
@@ -572,10 +624,10 @@ async def augment(
 
     def work() -> Response:
         out, sources, weights, frames = runtime.augment_batch(
-            plan(), start, stop, n_points=req.n_points, spacing=req.spacing
+            plan(), start, stop, n_points=req.n_points, spacing=req.spacing, splines=splines
         )
         body = augment_body(out, sources, weights, frames, seed=seed, offset=req.offset, metrics=req.metrics)
-        return JSONResponse(body)
+        return JSONResponse(with_output(body, splines, req.output))
 
     return await _run(request, "/augment", req.count, work)
 
@@ -646,6 +698,7 @@ async def fit(
         s.FitRequest,
         Body(
             openapi_examples={
+                "automatic": _example("The fewest control points within 0.1% of the diagonal", {"curves": [_C1]}),
                 "five control points": _example("A 7-point curve, 5 control points", {"curves": [_C1], "n_ctrl": 5}),
                 "with the fitted curve": _example(
                     "Control polygon and the spline at 20 points", {"curves": [_C1, _C2], "n_ctrl": 6, "n_points": 20}
@@ -654,13 +707,15 @@ async def fit(
         ),
     ],
 ) -> Response:
-    """Clamped uniform cubic B-spline with `n_ctrl` control points (default 10, as the paper's data) fitted to each
-    curve by least squares: control points, knots, and how far the curve is from the spline."""
+    """Clamped uniform cubic B-spline with `n_ctrl` control points (omitted: the fewest within `tolerance`) fitted to
+    each curve by least squares: control points, knots, and how far the curve is from the spline."""
     curves = _check_curves(req.curves, settings)
     _check_n_points(req.n_points, settings)
 
     def work() -> Response:
-        return JSONResponse(fit_body(curves, req.n_ctrl, param=req.param, n_points=req.n_points))
+        return JSONResponse(
+            fit_body(curves, req.n_ctrl, param=req.param, n_points=req.n_points, tolerance=req.tolerance)
+        )
 
     return await _run(request, "/fit", len(curves), work)
 
@@ -793,6 +848,14 @@ async def model_info(runtime: RuntimeDep, settings: SettingsDep) -> dict[str, An
         "n_points": runtime.n_points,
         "latent_dim": runtime.latent_dim,
         "model_size": runtime.model_size,
+        "prior": (
+            {k: v for k, v in m["prior"].items() if k in ("kind", "components", "fitted_on")}
+            if m.get("prior")
+            else None
+        ),
+        "spline": (
+            {k: m["spline"][k] for k in ("n_ctrl", "degree", "knots") if k in m["spline"]} if m.get("spline") else None
+        ),
         "files": {k: {"sha256": v["sha256"], "bytes": v.get("bytes", 0)} for k, v in m["files"].items()},
         "providers": runtime.providers,
         "requested_providers": runtime.requested_providers,

@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from geometry import Frame, fit_bspline
-from service.runtime import InputError, curve_metrics
+from geometry import Frame, fit_bspline, fit_bspline_auto
+from service.runtime import InputError, Sampled, Spline, curve_metrics
 
 
 def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
@@ -27,8 +27,26 @@ def with_metrics(body: dict[str, Any], curves: Sequence[np.ndarray], wanted: boo
     return {**body, "metrics": curve_metrics(curves)} if wanted else body
 
 
-def sample_body(latents: np.ndarray, curves: np.ndarray, seed: int, *, metrics: bool = False) -> dict[str, Any]:
-    return with_metrics({"latents": latents.tolist(), "curves": curves.tolist(), "seed": seed}, curves, metrics)
+def with_output(body: dict[str, Any], splines: Sequence[Spline] | None, output: str = "points") -> dict[str, Any]:
+    """`body` with its curves as the request's `output` asks: "points" (`curves`), "bspline" (`splines`) or "both"."""
+    if output == "points" or splines is None:
+        return body
+    out = {**body, "splines": [sp.json() for sp in splines]}
+    if output == "bspline":
+        out.pop("curves", None)
+    return out
+
+
+def sample_body(made: Sampled, seed: int, *, metrics: bool = False) -> dict[str, Any]:
+    body = {
+        "latents": made.latents.tolist(),
+        "curves": made.curves.tolist(),
+        "seed": seed,
+        "prior": made.prior,
+        "rejected": made.rejected,
+        "invalid": made.invalid,
+    }
+    return with_metrics(body, made.curves, metrics)
 
 
 def augment_body(
@@ -53,26 +71,39 @@ def augment_body(
 
 
 def fit_body(
-    curves: Sequence[np.ndarray], n_ctrl: int = 10, *, param: str = "chord", n_points: int | None = None
+    curves: Sequence[np.ndarray],
+    n_ctrl: int | None = None,
+    *,
+    param: str = "chord",
+    n_points: int | None = None,
+    tolerance: float = 1e-3,
 ) -> dict[str, Any]:
-    """Least-squares cubic B-spline of each curve (geometry.fit_bspline); InputError names a curve it cannot fit."""
+    """Least-squares cubic B-spline of each curve (geometry.fit_bspline; without n_ctrl, fit_bspline_auto picks the
+    fewest control points within `tolerance` of the diagonal); InputError names a curve it cannot fit."""
     fits = []
     for i, c in enumerate(curves):
-        if len(c) < n_ctrl:
+        if n_ctrl is not None and len(c) < n_ctrl:
             raise InputError(
-                ("curves", i), f"n_ctrl={n_ctrl} control points need at least as many points, got {len(c)}"
+                ("curves", i),
+                f"n_ctrl={n_ctrl} control points need at least as many points, got {len(c)}; "
+                "omit n_ctrl to have it chosen",
             )
         try:
             with np.errstate(all="ignore"):
-                f = fit_bspline(c, n_ctrl, param=param)
+                f = (
+                    fit_bspline(c, n_ctrl, param=param)
+                    if n_ctrl is not None
+                    else fit_bspline_auto(c, tolerance=tolerance, param=param)
+                )
         except (ValueError, np.linalg.LinAlgError) as e:
             raise InputError(("curves", i), _unfittable(n_ctrl, e)) from e
         if not (np.isfinite(f.control_points).all() and np.isfinite([f.rms_error, f.max_error]).all()):
-            raise InputError(("curves", i), _unfittable(n_ctrl))
+            raise InputError(("curves", i), _unfittable(len(f.control_points)))
         out: dict[str, Any] = {
             "control_points": f.control_points.tolist(),
             "knots": f.knots.tolist(),
             "degree": f.degree,
+            "n_ctrl": len(f.control_points),
             "rms_error": f.rms_error,
             "max_error": f.max_error,
         }
@@ -82,9 +113,10 @@ def fit_body(
     return {"fits": fits}
 
 
-def _unfittable(n_ctrl: int, error: Exception | None = None) -> str:
+def _unfittable(n_ctrl: int | None, error: Exception | None = None) -> str:
     why = f" ({error})" if error is not None and len(str(error)) < 120 else ""
+    count = f"{n_ctrl}" if n_ctrl is not None else "any number of"
     return (
-        f"no unique least-squares spline with {n_ctrl} control points{why}: some knot span holds too few of the "
+        f"no unique least-squares spline with {count} control points{why}: some knot span holds too few of the "
         'curve\'s points; use fewer control points, more points, or param "uniform"'
     )

@@ -34,15 +34,19 @@ import onnxruntime as ort
 from geometry import (
     Frame,
     arc_fractions,
+    arc_length_params,
     at_fractions,
     blend_frames,
+    clamped_uniform_knots,
     curve_length,
+    evaluate_bspline,
     fit_frame,
     mse_per_curve,
     resample,
     self_intersects,
     smoothness,
 )
+from service.prior import PRIOR_FILE, LatentPrior
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +55,21 @@ Spacing = Literal["parameter", "arc_length"]
 CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
 _F32_MAX = float(np.finfo(np.float32).max)
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
+
+
+Prior = Literal["learned", "standard"]
+MAX_DRAWS = 50  # per sampled curve: at an 11% rejection rate, 50 draws fail with probability ~1e-48
+
+
+@dataclass(frozen=True)
+class Sampled:
+    """What `CurveRuntime.sample` made: latents (count, Z), curves, the prior used and the bookkeeping of rejection."""
+
+    latents: np.ndarray
+    curves: np.ndarray
+    prior: str
+    rejected: int  # draws rejected (self-intersecting or outside the disc) and drawn again
+    invalid: int  # curves still not valid after max_draws (0 unless the distribution is far off)
 
 
 class ModelLoadError(RuntimeError):
@@ -106,8 +125,10 @@ def read_manifest(model_dir: str | Path) -> dict[str, Any]:
         raise ModelLoadError(
             f"{path}: implausible n_points={n_points}, latent_dim={latent_dim}, model_size={model_size}"
         )
-    for graph in ("encoder", "decoder"):
-        name = graph_file(manifest, graph)
+    names = [graph_file(manifest, graph) for graph in ("encoder", "decoder")]
+    if manifest.get("prior"):
+        names.append(str(manifest["prior"].get("file", PRIOR_FILE)))
+    for name in names:
         file = root / name
         if not file.is_file():
             raise ModelLoadError(f"{file} is missing (listed in {path})")
@@ -118,7 +139,7 @@ def read_manifest(model_dir: str | Path) -> dict[str, Any]:
         if actual != expected:
             raise ModelLoadError(
                 f"{file}: sha256 {actual} does not match the manifest's {expected}; "
-                "the graph was changed or truncated after export: re-export the model or restore the file"
+                "the file was changed or truncated after export: re-export the model or restore the file"
             )
     return manifest
 
@@ -186,8 +207,31 @@ class Prepared:
     inputs: list[np.ndarray]  # the caller's curves, float64
 
 
+@dataclass(frozen=True)
+class Spline:
+    """A returned curve as a clamped cubic B-spline in the caller's frame: the curve's points are
+    the spline at `params` exactly (the model's B-spline head; a similarity keeps B-splines)."""
+
+    control_points: np.ndarray  # (n_ctrl, 2)
+    knots: np.ndarray  # (n_ctrl + degree + 1,)
+    degree: int
+    params: np.ndarray  # (n,) parameter of each returned point, in [0, 1]
+
+    def json(self) -> dict[str, Any]:
+        return {
+            "control_points": self.control_points.tolist(),
+            "knots": self.knots.tolist(),
+            "degree": self.degree,
+            "params": self.params.tolist(),
+        }
+
+
 class CurveRuntime:
-    """Encoder and decoder sessions of one exported model, with frame and length handling."""
+    """Encoder and decoder sessions of one exported model, with frame and length handling.
+
+    Methods that return curves take `splines`: a list to which one `Spline` per returned curve
+    is appended, for models with a B-spline head (`has_splines`).
+    """
 
     def __init__(
         self,
@@ -197,13 +241,22 @@ class CurveRuntime:
         *,
         batch_size: int = 64,
         requested_providers: str = "cpu",
+        prior: LatentPrior | None = None,
     ) -> None:
         self.encoder, self.decoder, self.manifest = encoder, decoder, manifest
+        self.prior = prior
         self.batch_size = batch_size
         self.requested_providers = requested_providers
         self.n_points = int(manifest["n_points"])
         self.latent_dim = int(manifest["latent_dim"])
         self.model_size = float(manifest["frame"]["model_size"])
+        spline = manifest.get("spline")
+        self.spline_degree = int(spline["degree"]) if spline else 0
+        self.knots = clamped_uniform_knots(int(spline["n_ctrl"]), self.spline_degree) if spline else None
+        # Where the data lives in the model plane (paper §3.1: a radius-64 disc in the 128×128 plane): the region a
+        # valid sample must stay in.
+        self.disc_center = np.asarray(manifest["frame"].get("center", [64.0, 64.0]), np.float64)
+        self.disc_radius = float(manifest.get("training", {}).get("data", {}).get("radius", 64.0))
         self._enc_in = encoder.get_inputs()[0].name
         self._dec_in = decoder.get_inputs()[0].name
         self._check_signature()
@@ -238,7 +291,14 @@ class CurveRuntime:
                     f"{sessions[-1].get_providers()}): check that the CUDA 12 and cuDNN 9 libraries of "
                     "onnxruntime-gpu are installed and a GPU is visible, or run with --providers cpu or auto"
                 )
-        runtime = cls(*sessions, manifest, batch_size=batch_size, requested_providers=providers)
+        prior = None
+        if manifest.get("prior"):
+            path = root / str(manifest["prior"].get("file", PRIOR_FILE))
+            try:
+                prior = LatentPrior.load(path)
+            except (OSError, ValueError, KeyError) as e:
+                raise ModelLoadError(f"{path}: not a usable latent prior ({e})") from e
+        runtime = cls(*sessions, manifest, batch_size=batch_size, requested_providers=providers, prior=prior)
         if warm_up:
             runtime.warm_up()
         return runtime
@@ -257,8 +317,18 @@ class CurveRuntime:
             problems.append(
                 f"decoder input {dec_in.name} has shape {dec_in.shape}, expected [batch, {self.latent_dim}]"
             )
+        dec_out = [o.name for o in self.decoder.get_outputs()]
+        if self.has_splines and dec_out[:2] != ["curves", "control_points"]:
+            problems.append(f"decoder outputs {dec_out}, expected curves and control_points (the manifest's spline)")
+        if self.prior is not None and self.prior.latent_dim != self.latent_dim:
+            problems.append(f"the prior has {self.prior.latent_dim} latent dimensions, the model {self.latent_dim}")
         if problems:
             raise ModelLoadError("graphs do not match the manifest: " + "; ".join(problems))
+
+    @property
+    def has_splines(self) -> bool:
+        """Whether the decoder ends in a B-spline head (curves can be returned as splines)."""
+        return self.knots is not None
 
     @property
     def providers(self) -> list[str]:
@@ -295,12 +365,20 @@ class CurveRuntime:
 
     def decode_model(self, latents: np.ndarray) -> np.ndarray:
         """(B, latent_dim) -> (B, n_points, 2) in the model plane."""
+        return self.decode_model_splines(latents)[0]
+
+    def decode_model_splines(self, latents: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """(B, latent_dim) -> curves (B, n_points, 2) and, with a B-spline head, control points (B, n_ctrl, 2)."""
         z = np.ascontiguousarray(latents, dtype=np.float32)
-        outs = [
-            self.decoder.run(None, {self._dec_in: z[i : i + self.batch_size]})[0]
-            for i in range(0, len(z), self.batch_size)
-        ]
-        return np.concatenate(outs) if outs else np.zeros((0, self.n_points, 2), np.float32)
+        curves, ctrls = [], []
+        for i in range(0, len(z), self.batch_size):
+            out = self.decoder.run(None, {self._dec_in: z[i : i + self.batch_size]})
+            curves.append(out[0])
+            ctrls.append(out[1] if self.has_splines else None)
+        if not curves:
+            n_ctrl = len(self.knots) - self.spline_degree - 1 if self.has_splines else 0
+            return np.zeros((0, self.n_points, 2), np.float32), np.zeros((0, n_ctrl, 2), np.float32)
+        return np.concatenate(curves), (np.concatenate(ctrls) if self.has_splines else None)
 
     # ----------------------------------------------------------------------- caller's curves
 
@@ -346,19 +424,38 @@ class CurveRuntime:
         n_points: int | None,
         spacing: Spacing = "parameter",
         fractions: np.ndarray | None = None,
+        ctrl: np.ndarray | None = None,
+        splines: list[Spline] | None = None,
     ) -> np.ndarray:
         """One model-plane result (n_points_model, 2) -> the caller's frame and length.
 
         n_points given: that many points, spaced as `spacing` says (with "parameter" and the
         model's count, the model's own points). Otherwise at the input's positions
-        (`fractions`), or the model's points as they are.
+        (`fractions`), or the model's points as they are. With the control points of a
+        B-spline head (`ctrl`) the points are the spline's at those parameters, not a polyline
+        interpolation, and the spline is appended to `splines`.
         """
-        curve = np.asarray(out, np.float64)
+        if ctrl is None:
+            curve = np.asarray(out, np.float64)
+            if n_points is not None:
+                curve = resample(curve, n_points, spacing=spacing)
+            elif fractions is not None:
+                curve = at_fractions(curve, fractions)
+            return frame.from_model(curve, self.model_size) if frame is not None else curve
+        c = np.asarray(ctrl, np.float64)
         if n_points is not None:
-            curve = resample(curve, n_points, spacing=spacing)
+            u = np.linspace(0.0, 1.0, n_points) if spacing == "parameter" else arc_length_params(c, n_points)
         elif fractions is not None:
-            curve = at_fractions(curve, fractions)
-        return frame.from_model(curve, self.model_size) if frame is not None else curve
+            u = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
+        else:
+            u = np.linspace(0.0, 1.0, self.n_points)
+        if frame is not None:
+            c = frame.from_model(c, self.model_size)
+        curve = evaluate_bspline(c, u, self.spline_degree)
+        if splines is not None:
+            assert self.knots is not None
+            splines.append(Spline(c, self.knots, self.spline_degree, u))
+        return curve
 
     def encode(
         self, curves: Sequence[np.ndarray], *, frame: FrameMode = "auto", spacing: Spacing = "parameter"
@@ -378,6 +475,7 @@ class CurveRuntime:
         n_points: int | None = None,
         frames: Sequence[Frame] | None = None,
         spacing: Spacing = "parameter",
+        splines: list[Spline] | None = None,
     ) -> np.ndarray:
         """Curves (B, n, 2) for latents (B, latent_dim): in the model plane, or mapped to `frames`."""
         z = np.asarray(latents, np.float64)
@@ -385,12 +483,19 @@ class CurveRuntime:
             raise InputError(("latents",), f"expected rows of {self.latent_dim} numbers, got shape {list(z.shape)}")
         _check_range(z, "latents")
         with np.errstate(all="ignore"):
-            out = self.decode_model(z)
+            out, ctrl = self.decode_model_splines(z)
             _check_finite(
                 out, "latents", "decodes to non-finite coordinates: the latent is far outside the training range"
             )
             curves = [
-                self._to_caller(o, frames[i] if frames else None, n_points=n_points, spacing=spacing)
+                self._to_caller(
+                    o,
+                    frames[i] if frames else None,
+                    n_points=n_points,
+                    spacing=spacing,
+                    ctrl=None if ctrl is None else ctrl[i],
+                    splines=splines,
+                )
                 for i, o in enumerate(out)
             ]
         result = np.stack(curves) if curves else np.zeros((0, n_points or self.n_points, 2))
@@ -404,6 +509,7 @@ class CurveRuntime:
         frame: FrameMode = "auto",
         n_points: int | None = None,
         spacing: Spacing = "parameter",
+        splines: list[Spline] | None = None,
     ) -> tuple[list[np.ndarray], np.ndarray]:
         """Encode the means, decode them; the curves in the caller's frame and their MSE (paper eq. 4) there.
 
@@ -414,13 +520,19 @@ class CurveRuntime:
         with np.errstate(all="ignore"):
             mean, _ = self.encode_model(prep.model)
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
-            out = self.decode_model(mean)
+            out, ctrl = self.decode_model_splines(mean)
             results, mse = [], np.empty(len(out))
             for i, o in enumerate(out):
-                own = self._to_caller(o, prep.frames[i], n_points=None, fractions=prep.fractions[i])
+                c = None if ctrl is None else ctrl[i]
+                kept = splines if n_points is None else None
+                own = self._to_caller(
+                    o, prep.frames[i], n_points=None, fractions=prep.fractions[i], ctrl=c, splines=kept
+                )
                 mse[i] = mse_per_curve(prep.inputs[i][None], own[None])[0]
                 if n_points is not None:
-                    own = self._to_caller(o, prep.frames[i], n_points=n_points, spacing=spacing)
+                    own = self._to_caller(
+                        o, prep.frames[i], n_points=n_points, spacing=spacing, ctrl=c, splines=splines
+                    )
                 results.append(own)
                 if not (np.isfinite(results[-1]).all() and np.isfinite(mse[i])):
                     raise InputError(("curves", i), "the reconstruction does not fit in float64: scale the curve down")
@@ -434,6 +546,7 @@ class CurveRuntime:
         frame: FrameMode = "auto",
         n_points: int | None = None,
         spacing: Spacing = "parameter",
+        splines: list[Spline] | None = None,
     ) -> tuple[np.ndarray, list[Frame | None]]:
         """Decode affine combinations of the curves' latent means (paper eqs. 9, 10), one per weight row.
 
@@ -445,10 +558,16 @@ class CurveRuntime:
         with np.errstate(all="ignore"):
             mean, _ = self.encode_model(prep.model)
         _check_finite(mean, "curves", _ENCODE_OVERFLOW)
-        return self._mix(prep, mean.astype(np.float64), np.asarray(weights, np.float64), n_points, spacing)
+        return self._mix(prep, mean.astype(np.float64), np.asarray(weights, np.float64), n_points, spacing, splines)
 
     def _mix(
-        self, prep: Prepared, mean: np.ndarray, w: np.ndarray, n_points: int | None, spacing: Spacing
+        self,
+        prep: Prepared,
+        mean: np.ndarray,
+        w: np.ndarray,
+        n_points: int | None,
+        spacing: Spacing,
+        splines: list[Spline] | None = None,
     ) -> tuple[np.ndarray, list[Frame | None]]:
         """Decode weight rows w (rows, len(prep.inputs)) over the encoded means; see `interpolate`."""
         auto = prep.frames and prep.frames[0] is not None
@@ -457,7 +576,7 @@ class CurveRuntime:
             # a curve must not change with the batch or page it is made in.
             z = (w[:, :, None] * mean[None, :, :]).sum(axis=1)  # (rows, latent_dim)
             _check_range(z, "weights")
-            out = self.decode_model(z)
+            out, ctrl = self.decode_model_splines(z)
             _check_finite(out, "weights", "the weighted latent decodes to non-finite coordinates: weights too extreme")
             given = [f for f in prep.frames if f is not None]
             frames: list[Frame | None] = (
@@ -469,12 +588,17 @@ class CurveRuntime:
                 n_points = self.n_points
             results = []
             for r, o in enumerate(out):
+                c = None if ctrl is None else ctrl[r]
                 if blend:
                     positions = w[r] @ np.stack(prep.fractions)  # type: ignore[arg-type]
                     positions = np.maximum.accumulate(np.clip(positions, 0.0, 1.0))  # extrapolating rows stay ordered
-                    results.append(self._to_caller(o, frames[r], n_points=None, fractions=positions))
+                    results.append(
+                        self._to_caller(o, frames[r], n_points=None, fractions=positions, ctrl=c, splines=splines)
+                    )
                 else:
-                    results.append(self._to_caller(o, frames[r], n_points=n_points, spacing=spacing))
+                    results.append(
+                        self._to_caller(o, frames[r], n_points=n_points, spacing=spacing, ctrl=c, splines=splines)
+                    )
             result = np.stack(results) if results else np.zeros((0, self.mix_length(prep, n_points), 2))
         _check_finite(result, "weights", "the interpolant does not fit in float64")
         return result, frames
@@ -494,18 +618,60 @@ class CurveRuntime:
         *,
         seed: int | None = None,
         temperature: float = 1.0,
+        prior: Prior | None = None,
+        valid: bool = True,
+        max_draws: int = MAX_DRAWS,
         n_points: int | None = None,
         spacing: Spacing = "parameter",
         frame: Frame | None = None,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """New curves from the prior: latents z ~ N(0, temperature²·I), decoded into the model plane
-        (or mapped into `frame`).
+        splines: list[Spline] | None = None,
+    ) -> Sampled:
+        """New curves from a latent distribution, decoded into the model plane (or mapped into `frame`).
 
-        The same seed gives the same latents and curves; the first rows of a larger count
-        are the curves of a smaller one.
+        prior "learned": the Gaussian mixture fitted to the training curves' latent means (the default where the
+        model ships one); "standard": the VAE's N(0, I). temperature scales the spread (see service/prior.py).
+        valid: a draw whose curve crosses itself or leaves the data's disc is rejected and item i draws again, at
+        most max_draws times in all. Item i's draws come from its own generator default_rng([seed, i]), so the
+        seed decides every curve, across rejections too, and the first items of a larger count are the items of
+        a smaller one.
         """
-        z = np.random.default_rng(seed).standard_normal((count, self.latent_dim)) * temperature
-        return z, self.decode(z, n_points=n_points, spacing=spacing, frames=[frame] * count if frame else None)
+        chosen = prior or ("learned" if self.prior is not None else "standard")
+        if chosen == "learned" and self.prior is None:
+            raise InputError(
+                ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
+            )
+        root = fresh_seed() if seed is None else seed
+        rngs = [np.random.default_rng([root, i]) for i in range(count)]
+
+        def draw(i: int) -> np.ndarray:
+            if chosen == "learned":
+                assert self.prior is not None
+                return self.prior.draw(rngs[i], temperature)
+            return rngs[i].standard_normal(self.latent_dim) * temperature
+
+        z = np.array([draw(i) for i in range(count)]).reshape(count, self.latent_dim)
+        draws, ok, todo = np.ones(count, np.int64), np.zeros(count, bool), np.arange(count)
+        while valid and len(todo):
+            with np.errstate(all="ignore"):
+                good = self.plausible(self.decode_model(z[todo]).astype(np.float64))
+            ok[todo[good]] = True
+            todo = todo[~good & (draws[todo] < max_draws)]
+            for i in todo:
+                z[i] = draw(int(i))
+                draws[i] += 1
+        invalid = int((~ok).sum()) if valid else 0
+        frames = [frame] * count if frame else None
+        curves = self.decode(z, n_points=n_points, spacing=spacing, frames=frames, splines=splines)
+        return Sampled(z, curves, chosen, rejected=int(draws.sum() - count), invalid=invalid)
+
+    def plausible(self, curves: np.ndarray) -> np.ndarray:
+        """(B, n, 2) model-plane curves -> (B,) bool: finite, free of self-intersections and inside the data's disc."""
+        finite = np.isfinite(curves).all(axis=(1, 2))
+        inside = np.linalg.norm(np.where(finite[:, None, None], curves, 0) - self.disc_center, axis=-1).max(axis=1)
+        ok = finite & (inside <= self.disc_radius)
+        if ok.any():
+            ok[ok] = ~self_intersects(curves[ok])
+        return ok
 
     def plan_augment(
         self,
@@ -543,13 +709,20 @@ class CurveRuntime:
         return AugmentPlan(prep=prep, mean=mean, k=k, seed=seed, pools=pools)
 
     def augment_batch(
-        self, plan: AugmentPlan, start: int, stop: int, *, n_points: int | None = None, spacing: Spacing = "parameter"
+        self,
+        plan: AugmentPlan,
+        start: int,
+        stop: int,
+        *,
+        n_points: int | None = None,
+        spacing: Spacing = "parameter",
+        splines: list[Spline] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
         """Items start … stop-1 of the plan's sequence: curves, sources (m, k), weights (m, k), frames."""
         sources, weights = plan.draw(start, stop)
         full = np.zeros((len(sources), len(plan.mean)))
         np.put_along_axis(full, sources, weights, axis=1)
-        out, frames = self._mix(plan.prep, plan.mean, full, n_points, spacing)
+        out, frames = self._mix(plan.prep, plan.mean, full, n_points, spacing, splines)
         return out, sources, weights, frames
 
     def augment_chunks(

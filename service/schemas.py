@@ -69,6 +69,16 @@ NPoints = Annotated[
     ),
 ]
 
+OutputMode = Annotated[
+    Literal["points", "bspline", "both"],
+    Field(
+        description='How returned curves are given. "points" (default): `curves`, arrays of [x, y]. "bspline": '
+        "`splines`, each the clamped cubic B-spline the model's B-spline head decoded (control points, knots, "
+        "degree, and the parameter of each returned point: the points are the spline at those parameters, exactly). "
+        '"both": `curves` and `splines`. Needs a model with a B-spline head (GET /model: `spline`).'
+    ),
+]
+
 # A quarter-ellipse-like arc; any frame, any length ≥ 4: the examples work as pasted.
 EXAMPLE_CURVE = [[0.0, 0.0], [1.0, 2.0], [2.5, 3.2], [4.0, 3.5], [5.5, 3.0], [7.0, 1.5], [8.0, 0.0]]
 EXAMPLE_CURVE_2 = [[0.0, 0.0], [1.5, 0.5], [3.0, 2.0], [4.0, 4.0], [5.0, 6.5], [6.5, 8.0], [8.0, 8.5]]
@@ -153,11 +163,28 @@ class DecodeRequest(_Request):
         description="Optional frame per latent (as /encode returns them): curves are mapped into it. "
         "Omitted: curves come back in the model's 128×128 plane.",
     )
+    output: OutputMode = "points"
     metrics: MetricsFlag = False
 
 
+class SplineOut(BaseModel):
+    """A returned curve as a clamped cubic B-spline, in the frame the curve is returned in."""
+
+    control_points: list[tuple[float, float]] = Field(description="n_ctrl control points [x, y].")
+    knots: list[float] = Field(description="Clamped uniform knot vector on [0, 1], n_ctrl + degree + 1 entries.")
+    degree: int = Field(description="3: cubic.")
+    params: list[float] = Field(
+        description="The spline parameter in [0, 1] of each point of the returned curve, in order."
+    )
+
+
 class CurvesResponse(BaseModel):
-    curves: list[list[tuple[float, float]]] = Field(description="Curves as arrays of [x, y] points.")
+    curves: list[list[tuple[float, float]]] | None = Field(
+        None, description='Curves as arrays of [x, y] points (output "points" or "both").'
+    )
+    splines: list[SplineOut] | None = Field(
+        None, description='The same curves as B-splines, one per curve (output "bspline" or "both").'
+    )
     metrics: MetricsOut = None
 
 
@@ -168,6 +195,7 @@ class ReconstructRequest(_Request):
     frame: FrameMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
+    output: OutputMode = "points"
     metrics: MetricsFlag = False
 
 
@@ -201,6 +229,7 @@ class InterpolateRequest(_Request):
     frame: FrameMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
+    output: OutputMode = "points"
     metrics: MetricsFlag = False
 
     @model_validator(mode="after")
@@ -240,7 +269,22 @@ class SampleRequest(_Request):
         le=100,
         strict=True,
         allow_inf_nan=False,
-        description="Standard deviation of the latents, z ~ N(0, temperature²·I): below 1 stays near typical shapes.",
+        description="Spread of the latents about the prior's means: each component's covariance is scaled by "
+        "temperature² (standard prior: z ~ N(0, temperature²·I)). 1 is the distribution itself; below 1 stays "
+        "near typical shapes, 0 gives the component means.",
+    )
+    prior: Literal["learned", "standard"] | None = Field(
+        None,
+        description='"learned": the Gaussian mixture fitted to the latent means of the training curves, shipped '
+        "with the model: curves like the data. \"standard\": the VAE's prior N(0, I), which the encoder's latents "
+        "do not fill (small, tangled curves). Omitted: learned where the model ships it (GET /model: prior).",
+    )
+    valid: bool = Field(
+        True,
+        strict=True,
+        description="Reject and redraw a curve that crosses itself or leaves the disc the data lies in (as the "
+        "paper's generator rejects self-intersecting curves), at most 50 draws per curve; the seed still decides "
+        "every curve. false: keep every draw.",
     )
     n_points: NPoints = None
     spacing: SpacingMode = "parameter"
@@ -249,12 +293,16 @@ class SampleRequest(_Request):
         description="Map every curve into this frame (centre and size, e.g. one /encode returned). Omitted: the "
         "model's 128×128 plane.",
     )
+    output: OutputMode = "points"
     metrics: MetricsFlag = False
 
 
 class SampleResponse(CurvesResponse):
     latents: list[list[float]] = Field(description="The latent vector each curve was decoded from.")
     seed: int = Field(description="The seed used: the request's, or the one drawn for it.")
+    prior: Literal["learned", "standard"] = Field(description="The distribution the latents were drawn from.")
+    rejected: int = Field(description="Draws rejected (self-intersecting or outside the disc) and drawn again.")
+    invalid: int = Field(description="Curves still invalid after 50 draws each (returned as drawn; normally 0).")
 
 
 class AugmentRequest(_Request):
@@ -300,6 +348,7 @@ class AugmentRequest(_Request):
     frame: FrameMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
+    output: OutputMode = "points"
     metrics: MetricsFlag = False
 
 
@@ -319,12 +368,20 @@ class FitRequest(_Request):
     """Curves to approximate by least-squares cubic B-splines."""
 
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
-    n_ctrl: int = Field(
-        10,
+    n_ctrl: int | None = Field(
+        None,
         ge=4,
         strict=True,
         description="Control points of each clamped uniform cubic B-spline (10: the paper's data); at most the "
-        "number of points of the curve.",
+        "number of points of the curve. Omitted: the fewest (from 4 up) whose fit is within `tolerance`.",
+    )
+    tolerance: float = Field(
+        1e-3,
+        gt=0,
+        le=1,
+        strict=True,
+        allow_inf_nan=False,
+        description="Without n_ctrl: the RMS fit error to reach, as a fraction of the curve's bounding-box diagonal.",
     )
     param: Literal["chord", "uniform"] = Field(
         "chord",
@@ -344,6 +401,7 @@ class BSplineOut(BaseModel):
     control_points: list[tuple[float, float]] = Field(description="n_ctrl control points [x, y].")
     knots: list[float] = Field(description="Clamped uniform knot vector on [0, 1], n_ctrl + degree + 1 entries.")
     degree: int = Field(description="3: cubic.")
+    n_ctrl: int = Field(description="Number of control points (given, or chosen by the tolerance).")
     rms_error: float = Field(description="Root mean squared distance of the points from the spline at their parameter.")
     max_error: float = Field(description="Largest such distance.")
     curve: list[tuple[float, float]] | None = Field(None, description="The spline at `n_points`, when asked for.")
@@ -397,6 +455,13 @@ class ModelInfo(BaseModel):
     n_points: int = Field(description="Points per curve the model sees (161).")
     latent_dim: int = Field(description="Length of every latent vector.")
     model_size: float = Field(description='Bounding-box size curves are scaled to by frame "auto".')
+    prior: dict[str, Any] | None = Field(
+        None, description="The learned latent distribution /sample draws from by default, when the model ships one."
+    )
+    spline: dict[str, Any] | None = Field(
+        None,
+        description='The decoder\'s B-spline head (n_ctrl, degree, knots), when it has one: output "bspline" works.',
+    )
     files: dict[str, FileInfo] = Field(description="sha256 and size of each exported file, from the manifest.")
     providers: list[str] = Field(description="onnxruntime execution providers the sessions actually run on.")
     requested_providers: Literal["cpu", "cuda", "auto"]

@@ -6,7 +6,7 @@ checkpoint alone, whatever the defaults here become.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 # Table 1's shallow networks: (filters, kernel) of each conv layer of the encoder; the
 # decoder mirrors them with transposed convolutions. CNN_6 is the Inception network.
@@ -28,6 +28,10 @@ class ModelConfig:
     n_points: int = 161  # points per curve, fixed by the network's shape arithmetic
     center: float = 64.0  # plane centre: inputs are shifted by this ...
     scale: float = 64.0  # ... and divided by this, so the data lie in about [-1, 1]
+    # B-spline output head: decoded points are projected onto clamped uniform cubic B-splines with
+    # this many control points (0: raw points). A fixed projector, no weights: it removes the
+    # stride-3 upsampling's zig-zag; 7k + 3 keeps the data's knots, so data curves pass unchanged.
+    spline_ctrl: int = 0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "variant", ALIASES.get(self.variant.lower(), self.variant.lower()))
@@ -35,6 +39,12 @@ class ModelConfig:
             raise ValueError(f"unknown variant {self.variant!r}; choose one of {', '.join(VARIANTS)}")
         if self.latent_dim < 1:
             raise ValueError(f"latent_dim must be ≥ 1, got {self.latent_dim}")
+        if self.spline_ctrl and not 4 <= self.spline_ctrl <= self.n_points:
+            raise ValueError(f"spline_ctrl must be 0 (off) or 4 … {self.n_points}, got {self.spline_ctrl}")
+
+    def same_weights(self, other: ModelConfig) -> bool:
+        """Whether the two configs have the same trainable weights (the spline head has none)."""
+        return replace(self, spline_ctrl=0) == replace(other, spline_ctrl=0)
 
 
 SCHEDULES = ("onecycle", "cosine", "constant", "plateau")

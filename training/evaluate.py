@@ -114,7 +114,74 @@ def interpolation_report(
     return out
 
 
+def nearest_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """For each curve of a (N, n, 2), the RMS point distance to its nearest curve of b (M, n, 2)."""
+    x, y = a.reshape(len(a), -1).astype(np.float64), b.reshape(len(b), -1).astype(np.float64)
+    d2 = (x * x).sum(1)[:, None] + (y * y).sum(1)[None, :] - 2 * x @ y.T
+    return np.sqrt(np.maximum(d2.min(axis=1), 0.0) / a.shape[1])
+
+
+def sample_quality(samples: np.ndarray, data: np.ndarray, reference: np.ndarray) -> dict[str, float]:
+    """How generated curves compare with real ones (all (N, n, 2) in the model plane).
+
+    coverage: mean distance from each held-out data curve to its nearest sample, over the same
+    figure for a second set of real curves (`reference`, as many as the samples); precision:
+    mean distance from each sample to its nearest data curve, over the reference's. 1 means
+    "as close as real data"; above 1, samples miss parts of the data (coverage) or lie off it.
+    """
+    size = lambda c: np.linalg.norm(np.ptp(c, axis=1), axis=1)  # bounding-box diagonals
+    return {
+        "self_intersecting": float(self_intersects(samples).mean()),
+        "roughness": float(smoothness(samples)["roughness"].mean()),
+        "roughness_data": float(smoothness(data)["roughness"].mean()),
+        "size_vs_data": float(size(samples).mean() / size(data).mean()),
+        "coverage_vs_real": float(nearest_distances(data, samples).mean() / nearest_distances(data, reference).mean()),
+        "precision_vs_real": float(nearest_distances(samples, data).mean() / nearest_distances(reference, data).mean()),
+    }
+
+
+def generation_report(
+    runtime: Any, data: np.ndarray, reference: np.ndarray, *, seed: int = 0, max_draws: int = 10
+) -> dict[str, Any]:
+    """Samples of each prior the model has (learned, standard), as /sample makes them by default (valid: rejected
+    and drawn again, here at most `max_draws` times: a model whose draws keep failing is reported as such without
+    spending 50 decodes a curve) and every draw kept; as many samples as `reference` curves."""
+    out: dict[str, Any] = {"n_samples": len(reference), "seed": seed}
+    for prior in ("learned", "standard") if runtime.prior is not None else ("standard",):
+        raw = runtime.sample(len(reference), seed=seed, prior=prior, valid=False)
+        kept = runtime.sample(len(reference), seed=seed, prior=prior, valid=True, max_draws=max_draws)
+        out[prior] = {
+            "every_draw": {
+                **sample_quality(raw.curves, data, reference),
+                "implausible": float(1 - runtime.plausible(raw.curves).mean()),
+            },
+            "valid": {
+                **sample_quality(kept.curves, data, reference),
+                "rejected_share": kept.rejected / (kept.rejected + len(reference)),
+                "invalid": kept.invalid,
+            },
+        }
+    return out
+
+
 # ---------------------------------------------------------------------------------- figures
+
+
+def plot_samples(samples: np.ndarray, data: np.ndarray, path: Path, *, n: int = 16) -> None:
+    """n generated curves beside n data curves, each in its own cell of the 128×128 plane."""
+    plt = _plt()
+    fig, axes = plt.subplots(4, 2 * (n // 4), figsize=(2 * n // 4 * 1.6, 4 * 1.6), squeeze=False)
+    for j, (curves, label, color) in enumerate(((samples, "samples", "tab:red"), (data, "data", "tab:blue"))):
+        for i in range(n):
+            ax = axes[i // (n // 4), j * (n // 4) + i % (n // 4)]
+            ax.plot(*curves[i].T, color=color, lw=1.0)
+            ax.set_xlim(-4, 132)
+            ax.set_ylim(-4, 132)
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+        axes[0, j * (n // 4)].set_title(label, loc="left", fontsize=10)
+    _save(fig, path)
 
 
 def _plt():
@@ -319,18 +386,29 @@ def run_evaluation(
     *,
     log_path: Path | None = None,
     figures: bool = True,
+    runtime: Any = None,
 ) -> dict[str, Any]:
-    """Evaluate on each named test set; write report.json (and figures) into out_dir."""
+    """Evaluate on each named test set; write report.json (and figures) into out_dir.
+
+    runtime: the exported model as the service runs it (service.runtime.CurveRuntime): adds the
+    generation report of its priors, the first test set held out and the second as the real reference.
+    """
     out = Path(out_dir)
     report: dict[str, Any] = {"test_sets": {}}
     for name, curves in test_sets.items():
         recon = batched(lambda x: decode(encode(x)), curves)
         report["test_sets"][name] = evaluate_set(curves, recon)
+        report["test_sets"][name]["interpolation"] = interpolation_report(encode, decode, curves)
         if figures:
             plot_reconstructions(curves, recon, out / f"reconstructions_{name}.png")
             plot_tangents([curves[0], recon[0]], ["input", "reconstruction"], out / f"tangents_{name}.png")
     first = next(iter(test_sets.values()))
-    report["interpolation"] = interpolation_report(encode, decode, first)
+    if runtime is not None and len(test_sets) >= 2:
+        reference = list(test_sets.values())[1]
+        report["generation"] = generation_report(runtime, first, reference)
+        if figures:
+            made = runtime.sample(16, seed=0)
+            plot_samples(made.curves, first, out / "samples.png")
     if figures:
         plot_pair_interpolation(
             encode, decode, [(first[0], first[1]), (first[2], first[3])], out / "interpolation_pair.png"

@@ -1,7 +1,8 @@
 """Export a trained VAE as two single-file ONNX graphs and a manifest (the service's input).
 
 encoder.onnx: curves (B, n_points, 2) in the 128×128 plane → mean, log_var (B, latent_dim)
-decoder.onnx: latent (B, latent_dim) → curves (B, n_points, 2) in the 128×128 plane
+decoder.onnx: latent (B, latent_dim) → curves (B, n_points, 2) in the 128×128 plane, and with a
+    B-spline head also control_points (B, n_ctrl, 2): curves = basis @ control_points
 manifest.json: names, dims, sha256 of each file, the frame convention, config and metrics.
 """
 
@@ -19,8 +20,10 @@ import numpy as np
 import torch
 from torch import nn
 
+from geometry import clamped_uniform_knots
+from service.prior import PRIOR_FILE, LatentPrior
 from training.io import atomic_path, atomic_write_text
-from training.model import VAE
+from training.model import VAE, ModelConfig
 
 MANIFEST_VERSION = 1
 OPSET = 18
@@ -33,6 +36,31 @@ class _EncoderGraph(nn.Module):
 
     def forward(self, curves: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         return self.encoder(curves)
+
+
+class _DecoderGraph(nn.Module):
+    """The decoder at inference; with a B-spline head it also returns the control points."""
+
+    def __init__(self, vae: VAE) -> None:
+        super().__init__()
+        self.decoder = vae.decoder
+
+    def forward(self, latent: torch.Tensor) -> torch.Tensor | tuple[torch.Tensor, torch.Tensor]:
+        curves, ctrl = self.decoder.decode(latent)
+        return curves if ctrl is None else (curves, ctrl)
+
+
+def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
+    """How the decoder's control points make its curves, for consumers of the graph."""
+    if not cfg.spline_ctrl:
+        return None
+    return {
+        "n_ctrl": cfg.spline_ctrl,
+        "degree": 3,
+        "knots": clamped_uniform_knots(cfg.spline_ctrl, 3).tolist(),
+        "params": f"curve point i is the clamped uniform cubic B-spline at u = i/{cfg.n_points - 1}",
+        "output": "control_points",
+    }
 
 
 def sha256(path: str | Path) -> str:
@@ -78,8 +106,14 @@ def export(
     model_size: float,
     extra: dict[str, Any] | None = None,
     weights: bool = True,
+    prior: LatentPrior | None = None,
+    prior_info: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Write encoder.onnx, decoder.onnx, (vae.pt,) and manifest.json into out_dir; return the manifest."""
+    """Write encoder.onnx, decoder.onnx, (vae.pt, prior.npz) and manifest.json into out_dir; return the manifest.
+
+    prior: the learned latent distribution (training/prior.py) the service samples from; prior_info
+    says how it was fitted.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     model = model.float().cpu().eval()
@@ -91,8 +125,12 @@ def export(
         "curves",
         ["mean", "log_var"],
     )
-    _export(model.decoder, torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", "latent", ["curves"])
+    dec_outputs = ["curves", "control_points"] if cfg.spline_ctrl else ["curves"]
+    _export(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", "latent", dec_outputs)
     files = ["encoder.onnx", "decoder.onnx"]
+    if prior is not None:
+        prior.save(out / PRIOR_FILE)
+        files.append(PRIOR_FILE)
     if weights:
         with atomic_path(out / "vae.pt") as tmp:
             torch.save({"model_config": asdict(cfg), "model": model.state_dict()}, tmp)
@@ -115,9 +153,25 @@ def export(
             "decoder": {
                 "file": "decoder.onnx",
                 "inputs": {"latent": ["batch", cfg.latent_dim]},
-                "outputs": {"curves": ["batch", cfg.n_points, 2]},
+                "outputs": {
+                    "curves": ["batch", cfg.n_points, 2],
+                    **({"control_points": ["batch", cfg.spline_ctrl, 2]} if cfg.spline_ctrl else {}),
+                },
             },
         },
+        **({"spline": spline_manifest(cfg)} if cfg.spline_ctrl else {}),
+        **(
+            {
+                "prior": {
+                    "file": PRIOR_FILE,
+                    "kind": "gaussian_mixture",
+                    "components": len(prior.weights),
+                    **(prior_info or {}),
+                }
+            }
+            if prior is not None
+            else {}
+        ),
         "frame": {
             "plane": [128.0, 128.0],
             "center": [cfg.center, cfg.center],

@@ -10,6 +10,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
+from geometry import spline_head
 from training.config import CONV_VARIANTS, VARIANTS, ModelConfig
 
 __all__ = ["VAE", "Encoder", "Decoder", "Inception", "ModelConfig", "VARIANTS", "count_parameters"]
@@ -190,15 +191,27 @@ class Decoder(nn.Module):
         if out_len < cfg.n_points:
             raise ValueError(f"decoder of {cfg.variant} yields {out_len} < {cfg.n_points} points")
         self.crops = _prefix_lengths(self.features, cfg.n_points, torch.zeros(1, *self.feat_shape))
+        if cfg.spline_ctrl:
+            # Fixed, not trained and not saved: rebuilt from the config, so older weights load unchanged.
+            basis, pinv = spline_head(cfg.spline_ctrl, cfg.n_points)
+            self.register_buffer("basis", torch.tensor(basis, dtype=torch.float32), persistent=False)
+            self.register_buffer("pinv", torch.tensor(pinv, dtype=torch.float32), persistent=False)
 
     def forward(self, z: torch.Tensor, *, full: bool | None = None) -> torch.Tensor:
-        """Decode; full runs every layer over its whole length (default: in training only)."""
+        """Decode to curves (B, N, 2); full runs every layer over its whole length (default: in training only)."""
+        return self.decode(z, full=full)[0]
+
+    def decode(self, z: torch.Tensor, *, full: bool | None = None) -> tuple[torch.Tensor, torch.Tensor | None]:
+        """Curves (B, N, 2) and, with the spline head, their control points (B, K, 2); else None."""
         full = self.training if full is None else full
         x = self.dense(z).view(-1, *self.feat_shape)  # (B, C, L)
         for layer, n in zip(self.features, self.crops):
             x = layer(x if full else x[:, :, :n])
-        x = x[:, :, : self.cfg.n_points]  # (B, 2, N)
-        return x.transpose(1, 2) * self.cfg.scale + self.cfg.center  # (B, N, 2)
+        x = x[:, :, : self.cfg.n_points]  # (B, 2, N), normalised
+        if not self.cfg.spline_ctrl:
+            return x.transpose(1, 2) * self.cfg.scale + self.cfg.center, None  # (B, N, 2)
+        ctrl = torch.matmul(self.pinv, x.transpose(1, 2)) * self.cfg.scale + self.cfg.center  # (B, K, 2)
+        return torch.matmul(self.basis, ctrl), ctrl  # (B, N, 2), (B, K, 2)
 
 
 class VAE(nn.Module):

@@ -308,7 +308,7 @@ def train(
                 print(f"no checkpoint at {last}: starting a new run", flush=True)
             if init_from:
                 init = torch.load(init_from, map_location="cpu", weights_only=True)
-                if ModelConfig(**init["model_config"]) != model_cfg:
+                if not ModelConfig(**init["model_config"]).same_weights(model_cfg):
                     raise ValueError(f"{init_from} holds a {init['model_config']} model, not {asdict(model_cfg)}")
                 model.load_state_dict(init["model"])
                 if rank == 0:

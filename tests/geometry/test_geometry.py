@@ -4,10 +4,13 @@ import numpy as np
 import pytest
 
 from geometry import (
+    arc_length_params,
     blend_frames,
     clamped_uniform_knots,
     curve_length,
+    evaluate_bspline,
     fit_bspline,
+    fit_bspline_auto,
     fit_frame,
     mse_per_curve,
     random_control_points,
@@ -15,6 +18,7 @@ from geometry import (
     sample_bspline,
     self_intersects,
     smoothness,
+    spline_head,
     turning_angles,
 )
 
@@ -126,3 +130,42 @@ def test_chord_fit_of_many_curves_and_bunched_points():
     bunched = np.concatenate([np.stack([np.linspace(0, 0.01, 10), np.zeros(10)], 1), [[10, 0], [20, 5]]])
     with pytest.raises(ValueError, match="cannot fit 10 control points"):
         fit_bspline(bunched, n_ctrl=10, param="chord", refine=0)
+
+
+@pytest.mark.parametrize("n_ctrl", [10, 17, 24, 31])
+def test_spline_head_leaves_data_set_curves_unchanged(n_ctrl):
+    """The projector of the B-spline output head keeps every curve of the paper's data (knots every 1/7) exactly."""
+    ctrl = random_control_points(np.random.default_rng(n_ctrl), 50)
+    curves = sample_bspline(ctrl, 161)
+    basis, pinv = spline_head(n_ctrl, 161)
+    np.testing.assert_allclose(basis @ (pinv @ curves), curves, rtol=0, atol=1e-10)
+    if n_ctrl == 10:  # the data's own basis: the control points themselves come back
+        np.testing.assert_allclose(pinv @ curves, ctrl, rtol=0, atol=1e-10)
+
+
+def test_spline_head_removes_a_zig_zag():
+    """A period-3 zig-zag on a data curve (the stride-3 upsampling's artefact) is projected away."""
+    curve = sample_bspline(random_control_points(np.random.default_rng(0), 1)[0], 161)
+    zigzag = curve + 0.5 * np.array([1.0, -0.5, -0.5])[np.arange(161) % 3, None]
+    basis, pinv = spline_head(31, 161)
+    smooth = basis @ pinv @ zigzag
+    assert smoothness(smooth)["roughness"] < 1.5 * smoothness(curve)["roughness"] < smoothness(zigzag)["roughness"]
+    assert mse_per_curve(curve, smooth) < 0.02 * mse_per_curve(curve, zigzag)
+
+
+def test_arc_length_params_space_points_evenly():
+    ctrl = random_control_points(np.random.default_rng(2), 1)[0]
+    u = arc_length_params(ctrl, 400)
+    pts = evaluate_bspline(ctrl, u)
+    step = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    assert u[0] == 0 and u[-1] == 1 and np.all(np.diff(u) > 0)
+    assert step.max() / step.min() < 1.01  # chords of a fine sampling: even up to curvature
+
+
+def test_fit_bspline_auto_takes_the_fewest_control_points():
+    ctrl = random_control_points(np.random.default_rng(4), 1)[0]
+    exact = sample_bspline(ctrl, 161)
+    assert len(fit_bspline_auto(exact, tolerance=1e-9, param="uniform").control_points) == 10
+    seven = np.array([[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]], float)
+    fit = fit_bspline_auto(seven)
+    assert 4 <= len(fit.control_points) <= 7 and fit.rms_error <= 1e-3 * np.linalg.norm(np.ptp(seven, axis=0))

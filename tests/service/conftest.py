@@ -31,21 +31,42 @@ SHIPPED = ROOT / "models"
 
 @pytest.fixture(scope="session")
 def model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """An untrained Inception VAE exported exactly as training/export.py ships one."""
+    """An untrained Inception VAE with the shipped model's B-spline head, exported as training/export.py ships one."""
+    return _export_untrained(tmp_path_factory.mktemp("model"), spline_ctrl=31)
+
+
+@pytest.fixture(scope="session")
+def raw_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The same untrained VAE without a B-spline head: its decoder returns the raw points."""
+    return _export_untrained(tmp_path_factory.mktemp("raw_model"), spline_ctrl=0)
+
+
+def _export_untrained(out: Path, *, spline_ctrl: int) -> Path:
+    """With a learned prior: a mixture around the latent means of four data-set curves (tight, so its samples
+    decode near those curves' reconstructions)."""
     import torch
 
+    from service.prior import LatentPrior
     from training.export import export
     from training.model import VAE, ModelConfig
 
     torch.manual_seed(0)  # the same untrained weights every run
-    out = tmp_path_factory.mktemp("model")
-    export(VAE(ModelConfig()).eval(), out, model_size=100.0, weights=False)
+    model = VAE(ModelConfig(spline_ctrl=spline_ctrl)).eval()
+    with torch.no_grad():
+        means = model.encoder(torch.tensor(bspline_curves(4, seed=5), dtype=torch.float32))[0].numpy()
+    prior = LatentPrior(np.full(4, 0.25), means.astype(np.float64), np.stack([np.eye(32) * 0.05] * 4))
+    export(model, out, model_size=100.0, weights=False, prior=prior, prior_info={"fitted_on": "4 test curves"})
     return out
 
 
 @pytest.fixture(scope="session")
 def runtime(model_dir: Path) -> CurveRuntime:
     return CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
+
+
+@pytest.fixture(scope="session")
+def raw_runtime(raw_model_dir: Path) -> CurveRuntime:
+    return CurveRuntime.load(raw_model_dir, providers="cpu", intra_op_threads=1)
 
 
 @pytest.fixture(scope="session")

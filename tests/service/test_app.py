@@ -200,8 +200,11 @@ def test_sample_is_reproducible_with_a_seed(client, runtime):
     assert a == b and a["latents"] != c["latents"]
     assert np.shape(a["latents"]) == (3, 32) and np.shape(a["curves"]) == (3, 50, 2)
     np.testing.assert_allclose(a["curves"], runtime.decode(np.array(a["latents"]), n_points=50), rtol=1e-9)
-    cold = client.post("/sample", json={"count": 2, "temperature": 0}).json()
+    cold = client.post("/sample", json={"count": 2, "temperature": 0, "prior": "standard", "valid": False}).json()
     assert np.all(np.array(cold["latents"]) == 0)
+    cold = client.post("/sample", json={"count": 4, "temperature": 0, "valid": False}).json()  # the learned prior
+    for z in cold["latents"]:  # each a component's mean
+        assert np.abs(runtime.prior.means - np.array(z)).max(axis=1).min() < 1e-12
 
 
 @pytest.mark.parametrize("mode,k", [("pair", 2), ("triplet", 3)])

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from geometry import clamped_uniform_knots, random_control_points, sample_bspline
+from geometry import clamped_uniform_knots, fit_bspline, random_control_points, sample_bspline
+from geometry.bspline import AUTO_CTRL
 from service.app import create_app
 from service.settings import Settings
 
@@ -30,15 +31,28 @@ def test_fit_recovers_a_known_bspline_from_its_exact_samples(client, n_ctrl):
         assert f["degree"] == 3 and f["rms_error"] < 1e-9 and f["max_error"] < 1e-9
 
 
-def test_fit_defaults_to_ten_control_points_by_chord_length(client):
+def test_fit_without_n_ctrl_picks_the_fewest_control_points_within_tolerance(client):
     ctrl = random_control_points(np.random.default_rng(1), 1)[0]
     c = sample_bspline(ctrl, 200)
-    f = client.post("/fit", json={"curves": [c.tolist()], "n_points": 50}).json()["fits"][0]
-    assert np.shape(f["control_points"]) == (10, 2) and len(f["knots"]) == 14
-    assert np.shape(f["curve"]) == (50, 2)
-    assert 0 < f["rms_error"] <= f["max_error"] < 10  # chord parameters: close, not exact, on a 128-unit curve
-    np.testing.assert_allclose(f["curve"][0], f["control_points"][0], atol=1e-9)  # clamped: ends at its end points
-    np.testing.assert_allclose(f["curve"][-1], f["control_points"][-1], atol=1e-9)
+    diag = np.linalg.norm(np.ptp(c, axis=0))
+    for tolerance in (1e-2, 1e-3):
+        body = {"curves": [c.tolist()], "n_points": 50, "tolerance": tolerance}
+        f = client.post("/fit", json=body).json()["fits"][0]
+        n = f["n_ctrl"]
+        assert np.shape(f["control_points"]) == (n, 2) and len(f["knots"]) == n + 4
+        assert f["rms_error"] <= tolerance * diag
+        fewer = [k for k in AUTO_CTRL if k < n]
+        if fewer:  # the next smaller count tried does not reach the tolerance
+            assert fit_bspline(c, fewer[-1], param="chord").rms_error > tolerance * diag
+        assert np.shape(f["curve"]) == (50, 2)
+        np.testing.assert_allclose(f["curve"][0], f["control_points"][0], atol=1e-9)  # clamped: ends at its ends
+        np.testing.assert_allclose(f["curve"][-1], f["control_points"][-1], atol=1e-9)
+
+
+def test_fit_of_a_short_curve_without_n_ctrl(client):
+    """The README's 7-point example: no n_ctrl, no error; at most as many control points as points."""
+    f = client.post("/fit", json={"curves": [CURVE]}).json()["fits"][0]
+    assert 4 <= f["n_ctrl"] <= len(CURVE)
 
 
 def test_fit_works_before_any_model_is_loaded(model_dir):
@@ -64,7 +78,7 @@ def test_fit_works_before_any_model_is_loaded(model_dir):
             id="knot-spans-without-points",
         ),
         pytest.param(
-            {"curves": [[[0, 0]] * 8 + [[1, 1], [2, 2], [3, 3]]]},
+            {"curves": [[[0, 0]] * 8 + [[1, 1], [2, 2], [3, 3]]], "n_ctrl": 10},
             "curves[0]: no unique least-squares spline with 10 control points",
             id="points-bunched-together",
         ),

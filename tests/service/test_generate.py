@@ -31,8 +31,11 @@ def test_sample_same_seed_same_batch_and_seed_reported(client):
     assert first["latents"] == a["latents"][:2]  # a larger count extends a smaller one
 
 
-def test_sample_latents_follow_the_temperature(client):
-    z = np.array(client.post("/sample", json={"count": 256, "seed": 0, "temperature": 0.5}).json()["latents"])
+def test_standard_prior_latents_follow_the_temperature(client):
+    body = {"count": 256, "seed": 0, "temperature": 0.5, "prior": "standard", "valid": False}
+    r = client.post("/sample", json=body).json()
+    z = np.array(r["latents"])
+    assert r["prior"] == "standard" and r["rejected"] == 0
     assert z.shape == (256, 32) and abs(z.std() - 0.5) < 0.02 and abs(z.mean()) < 0.02
 
 
@@ -135,8 +138,8 @@ def test_the_stream_holds_one_chunk_at_a_time(make_client, runtime, monkeypatch)
     """Decoding is asked for batch_size rows at a time, never the whole count."""
     client = make_client(max_stream_curves=10_000)
     seen: list[int] = []
-    decode = runtime.decode_model
-    monkeypatch.setattr(runtime, "decode_model", lambda z: seen.append(len(z)) or decode(z))
+    decode = runtime.decode_model_splines
+    monkeypatch.setattr(runtime, "decode_model_splines", lambda z: seen.append(len(z)) or decode(z))
     r = client.post("/augment", json={"curves": [CURVE, CURVE[::-1]], "count": 1000, "format": "npy", "seed": 1})
     assert r.status_code == 200 and len(r.content) == 128 + 1000 * 7 * 2 * 4
     assert max(seen) == runtime.batch_size and sum(seen) == 1000

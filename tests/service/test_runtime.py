@@ -10,7 +10,7 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 
-from geometry import blend_frames, fit_frame, mse_per_curve
+from geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve
 from service.runtime import CurveRuntime, InputError, ModelLoadError, resolve_providers, simplex_grid, simplex_grid_size
 
 # ----------------------------------------------------------------------------- loading
@@ -115,13 +115,26 @@ def test_reconstruction_follows_scale_and_shift(runtime, curves, scale, shift, n
     np.testing.assert_allclose(moved_mse, base_mse * scale**2, rtol=1e-5)
 
 
-def test_model_frame_passes_coordinates_untouched(runtime, curves):
+def test_model_frame_passes_coordinates_untouched(raw_runtime, curves):
     c = curves(2)
-    out, mse = runtime.reconstruct(list(c), frame="model")
-    mean, _ = runtime.encode_model(c)
-    direct = runtime.decode_model(mean)
+    out, mse = raw_runtime.reconstruct(list(c), frame="model")
+    mean, _ = raw_runtime.encode_model(c)
+    direct = raw_runtime.decode_model(mean)
     np.testing.assert_array_equal(np.stack(out), direct.astype(np.float64))
     np.testing.assert_allclose(mse, mse_per_curve(c, direct))
+
+
+def test_spline_head_points_are_the_spline_at_its_params(runtime, curves):
+    """With a B-spline head, returned points are the returned spline at the returned parameters (float64), and in
+    the model's frame at its 161 points they are the graph's own curves (to float32 rounding)."""
+    c = curves(2)
+    splines: list = []
+    out, _ = runtime.reconstruct(list(c), frame="model", splines=splines)
+    direct = runtime.decode_model(runtime.encode_model(c)[0])
+    np.testing.assert_allclose(np.stack(out), direct, rtol=0, atol=1e-4)
+    for curve, spline in zip(out, splines, strict=True):
+        np.testing.assert_array_equal(spline.params, np.linspace(0, 1, 161))
+        np.testing.assert_allclose(evaluate_bspline(spline.control_points, spline.params), curve, rtol=0, atol=1e-12)
 
 
 def test_auto_frame_maps_into_and_out_of_the_model_frame(runtime, curves):

@@ -99,7 +99,12 @@ def test_evaluate_exported_model(trained, capsys):
     printed = capsys.readouterr().out
     assert "test: MSE" in printed and "fresh_seed_7919: MSE" in printed
     report = json.loads((out / "report.json").read_text())
-    assert report["interpolation"]["latent"]["self_intersecting"] >= 0
+    for name in ("test", "fresh_seed_7919"):
+        interp = report["test_sets"][name]["interpolation"]
+        assert interp["pairs"] > 150 and interp["steps"] == 5
+        # point-wise blends of data-set B-splines are B-splines of the same knots: as smooth as the data
+        assert interp["pointwise"]["roughness"] < 1.5 * report["test_sets"][name]["smoothness_input"]["roughness"]
+    assert "interpolants (" in printed
     for figure in (
         "tangents_test.png",
         "reconstructions_fresh_seed_7919.png",
@@ -243,3 +248,39 @@ def test_snapshots_keep_the_latest_epochs(trained, capsys):
     rec = load_checkpoint(out)["averaged"]
     assert [s["epoch"] for s in rec["sources"]] == [2, 3] and rec["bn_curves"] == 0
     assert "averaged BatchNorm statistics" in capsys.readouterr().out
+
+
+def test_export_with_spline_head(trained):
+    """--spline-ctrl puts the B-spline head into decoder.onnx: control points out, curves = basis @ control points."""
+    from geometry import spline_head
+    from service.runtime import CurveRuntime
+
+    tmp, data, cut, _, _ = trained
+    out = tmp / "models_spline"
+    args = ["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--spline-ctrl", "10"]
+    assert main([*args, "--no-evaluate"]) == 0
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["spline"]["n_ctrl"] == 10 and manifest["model_config"]["spline_ctrl"] == 10
+    assert manifest["graphs"]["decoder"]["outputs"]["control_points"] == ["batch", 10, 2]
+
+    dec = ort.InferenceSession(str(out / "decoder.onnx"), providers=["CPUExecutionProvider"])
+    assert [o.name for o in dec.get_outputs()] == ["curves", "control_points"]
+    z = np.random.default_rng(1).standard_normal((5, 32)).astype(np.float32)
+    curves, ctrl = dec.run(None, {"latent": z})
+    basis, _ = spline_head(10, 161)
+    np.testing.assert_allclose(curves, basis @ ctrl.astype(np.float64), atol=1e-3)
+    raw = model_from_checkpoint(cut / "best.pt")
+    with torch.no_grad():
+        t_raw = raw.decoder(torch.from_numpy(z)).numpy().astype(np.float64)
+    # the head is the orthogonal projector: it keeps the spline part of the raw points and drops the rest
+    np.testing.assert_allclose(curves, basis @ np.linalg.pinv(basis) @ t_raw, atol=1e-3)
+
+    runtime = CurveRuntime.load(out, providers="cpu")
+    assert runtime.has_splines
+    splines: list = []
+    points = runtime.decode(z, n_points=40, spacing="arc_length", splines=splines)
+    from geometry import evaluate_bspline
+
+    for p, s in zip(points, splines):
+        assert len(s.params) == 40 and s.control_points.shape == (10, 2)
+        np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), p, atol=1e-9)

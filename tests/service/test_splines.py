@@ -1,0 +1,69 @@
+"""Curves returned as B-splines (`output`): what the model's B-spline head decoded, in the caller's frame."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from geometry import clamped_uniform_knots, evaluate_bspline
+from service.app import create_app
+from service.settings import Settings
+
+C1 = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
+C2 = [[0, 0], [1.5, 0.5], [3, 2], [4, 4], [5, 6.5], [6.5, 8], [8, 8.5]]
+C3 = [[0, 4], [2, 5], [4, 4], [6, 2], [8, 1], [10, 2], [12, 4]]
+Z = np.random.default_rng(3).normal(size=(2, 32)).round(6).tolist()
+
+REQUESTS = [
+    pytest.param("/decode", {"latents": Z, "n_points": 30, "spacing": "arc_length"}, id="decode"),
+    pytest.param("/decode", {"latents": Z, "frames": [{"center": [5, -3], "size": 0.01}] * 2}, id="decode-framed"),
+    pytest.param("/reconstruct", {"curves": [C1, C2]}, id="reconstruct"),
+    pytest.param("/reconstruct", {"curves": [C1, C2], "n_points": 64}, id="reconstruct-64"),
+    pytest.param("/interpolate", {"curves": [C1, C2, C3], "steps": 3}, id="interpolate-triplet"),
+    pytest.param("/sample", {"count": 3, "seed": 5, "frame": {"center": [0, 0], "size": 2}}, id="sample"),
+    pytest.param("/augment", {"curves": [C1, C2, C3], "count": 4, "seed": 2, "mode": "triplet"}, id="augment"),
+]
+
+
+@pytest.mark.parametrize(("path", "body"), REQUESTS)
+def test_returned_splines_evaluate_back_to_the_returned_points(client, path, body):
+    points = client.post(path, json=body).json()["curves"]
+    both = client.post(path, json={**body, "output": "both"}).json()
+    only = client.post(path, json={**body, "output": "bspline"}).json()
+    assert "curves" not in only and "splines" not in client.post(path, json=body).json()
+    np.testing.assert_allclose(both["curves"], points, rtol=0, atol=1e-12)  # asking for splines changes no point
+    assert only["splines"] == both["splines"] and len(both["splines"]) == len(points)
+    for curve, spline in zip(points, both["splines"], strict=True):
+        assert spline["degree"] == 3 and np.shape(spline["control_points"]) == (31, 2)
+        np.testing.assert_array_equal(spline["knots"], clamped_uniform_knots(31))
+        assert len(spline["params"]) == len(curve) and np.all(np.diff(spline["params"]) >= 0)
+        assert spline["params"][0] == pytest.approx(0, abs=1e-12) and spline["params"][-1] == pytest.approx(1)
+        scale = np.ptp(np.array(curve), axis=0).max()
+        again = evaluate_bspline(spline["control_points"], spline["params"])
+        np.testing.assert_allclose(again, curve, rtol=0, atol=1e-12 * scale)
+
+
+def test_model_info_names_the_spline_head(client):
+    spline = client.get("/model").json()["spline"]
+    assert spline["n_ctrl"] == 31 and spline["degree"] == 3 and len(spline["knots"]) == 35
+
+
+def test_a_model_without_a_head_refuses_splines_and_says_why(raw_model_dir, raw_runtime):
+    with TestClient(create_app(Settings(model_dir=raw_model_dir), runtime=raw_runtime)) as client:
+        assert client.get("/model").json()["spline"] is None
+        r = client.post("/reconstruct", json={"curves": [C1], "output": "bspline"})
+        assert r.status_code == 422
+        assert r.json()["detail"].startswith('output: "bspline" needs a model with a B-spline head')
+        assert client.post("/reconstruct", json={"curves": [C1]}).status_code == 200
+
+
+def test_npy_augment_is_points_only(client):
+    body = {"curves": [C1, C2], "count": 3, "format": "npy", "output": "both"}
+    r = client.post("/augment", json=body)
+    assert r.status_code == 422 and r.json()["detail"].startswith('output: only "points" with format npy')
+
+
+def test_unknown_output_is_a_422(client):
+    r = client.post("/decode", json={"latents": Z, "output": "nurbs"})
+    assert r.status_code == 422 and "output" in r.json()["detail"]
