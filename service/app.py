@@ -45,6 +45,7 @@ from service.runtime import (
     simplex_grid_size,
 )
 from service.settings import Settings, get_settings
+from service.web import mount_web
 
 log = logging.getLogger("service")
 
@@ -956,6 +957,8 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
         version=__version__,
         description=DESCRIPTION,
         lifespan=_lifespan,
+        docs_url=None,  # served offline by service.web
+        redoc_url=None,
         generate_unique_id_function=lambda route: route.name,  # operationId "encode", not "encode_encode_post"
         openapi_tags=[
             {"name": "curves", "description": "Encode, decode, reconstruct, interpolate, sample and augment curves."},
@@ -968,6 +971,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.include_router(curves_router)
     app.include_router(design_router)
     app.include_router(ops_router)
+    mount_web(app)
     app.add_exception_handler(RequestValidationError, _on_validation_error)
     app.add_exception_handler(InputError, _on_input_error)
     app.add_exception_handler(HTTPException, _on_http_error)
@@ -979,6 +983,14 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
             allow_origins=settings.cors_origins,
             allow_methods=["GET", "POST"],
             allow_headers=["Content-Type"],
+            # what a page on another origin needs to read (the .npy seed, the mesh counts, download names)
+            expose_headers=[
+                "X-Augment-Seed",
+                "X-Mesh-Vertices",
+                "X-Mesh-Faces",
+                "X-Mesh-Closed",
+                "Content-Disposition",
+            ],
             max_age=600,
         )
     routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *app.routes)

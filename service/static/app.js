@@ -1,0 +1,401 @@
+// curve-vae's page: draw curves, reconstruct and interpolate them through the REST API, take the result away.
+// Plain JavaScript, no build step, no CDN. Everything it shows comes from the same endpoints any front-end uses;
+// `?api=https://host:port` points it at a service on another origin (which must allow it with CORS).
+"use strict";
+
+const API = new URLSearchParams(location.search).get("api") || "";
+const W = 1000, H = 700;  // the board's viewBox; API coordinates are the board's with y pointing up
+const COLORS = ["#1f77b4", "#2ca02c", "#9467bd"];
+const NAMES = ["A", "B", "C"];
+const N_POINTS = 100;
+
+// Everything the page shows, in API coordinates; window.curveVae for tests and the console.
+const state = {
+  curves: [], recon: [], mode: "pair", weight: 0.5, bary: [1 / 3, 1 / 3, 1 / 3],
+  result: null, strip: [], lastRequest: null, vase: null,
+};
+window.curveVae = state;
+
+const $ = (id) => document.getElementById(id);
+let stroke = null;  // the points of the stroke being drawn, in board coordinates
+const toApi = ([x, y]) => [x, H - y];
+const toBoard = ([x, y]) => [x, H - y];
+const round = (v) => Math.round(v * 1000) / 1000;
+
+// ------------------------------------------------------------------------------------------ API
+
+async function api(path, body, errorEl, { raw = false } = {}) {
+  errorEl.textContent = "";
+  state.lastRequest = { path, body };
+  showCurl();
+  let response;
+  try {
+    response = await fetch(API + path, {
+      method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
+    });
+  } catch (e) {
+    errorEl.textContent = `The service did not answer (${e.message}). Is it running, and does it allow this page's origin?`;
+    throw e;
+  }
+  if (!response.ok) {
+    let detail = `${response.status} ${response.statusText}`;
+    try { detail = (await response.json()).detail || detail; } catch (e) { /* not JSON */ }
+    errorEl.textContent = `${path}: ${detail}`;
+    throw new Error(detail);
+  }
+  return raw ? response : response.json();
+}
+
+function showCurl() {
+  const r = state.lastRequest;
+  if (!r) return;
+  const origin = API || location.origin;
+  $("curl").textContent = `curl -s ${origin}${r.path} -H 'Content-Type: application/json' \\\n  -d '${JSON.stringify(r.body)}'`;
+}
+
+// ------------------------------------------------------------------------------------------ drawing
+
+const SVG_NS = "http://www.w3.org/2000/svg";
+function el(name, attrs, parent) {
+  const e = document.createElementNS(SVG_NS, name);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (parent) parent.appendChild(e);
+  return e;
+}
+const pathOf = (pts) => pts.map((p, i) => `${i ? "L" : "M"}${round(p[0])},${round(p[1])}`).join(" ");
+
+function render() {
+  const board = $("board");
+  board.replaceChildren();
+  state.curves.forEach((c, i) => {
+    el("path", { d: pathOf(c.map(toBoard)), fill: "none", stroke: COLORS[i], "stroke-width": 3, class: "input" }, board);
+    const [x, y] = toBoard(c[0]);
+    el("text", { x: x + 6, y: y - 6, fill: COLORS[i], "font-size": 22 }, board).textContent = NAMES[i];
+  });
+  state.recon.forEach((r, i) => {
+    if (!r) return;
+    el("path", { d: pathOf(r.points.map(toBoard)), fill: "none", stroke: COLORS[i], "stroke-width": 1.5,
+      "stroke-dasharray": "6 4", class: "reconstruction" }, board);
+    if ($("show-ctrl").checked && r.spline) drawControl(board, r.spline, COLORS[i]);
+  });
+  if (state.result) {
+    el("path", { d: pathOf(state.result.points.map(toBoard)), fill: "none", stroke: "#d62728", "stroke-width": 3.5,
+      id: "interpolant", class: "interpolant" }, board);
+    if ($("show-ctrl").checked && state.result.spline) drawControl(board, state.result.spline, "#d62728");
+  }
+  if (stroke) drawStroke();  // a stroke in progress survives a redraw by an answer arriving meanwhile
+  renderStrip();
+  renderMetrics();
+}
+
+function drawStroke() {
+  const path = $("stroke") || el("path", { id: "stroke", fill: "none", stroke: "#555", "stroke-width": 2 }, $("board"));
+  path.setAttribute("d", pathOf(stroke));
+}
+
+function drawControl(board, spline, color) {
+  const pts = spline.control_points.map(toBoard);
+  el("path", { d: pathOf(pts), fill: "none", stroke: color, "stroke-width": 1, opacity: 0.6, class: "control-polygon" },
+    board);
+  for (const [x, y] of pts) el("circle", { cx: x, cy: y, r: 3.5, fill: color, opacity: 0.6 }, board);
+}
+
+function renderStrip() {
+  const strip = $("strip");
+  strip.replaceChildren();
+  for (const curve of state.strip) {
+    const xs = curve.map((p) => p[0]), ys = curve.map((p) => p[1]);
+    const pad = 10, x0 = Math.min(...xs) - pad, y0 = Math.min(...ys) - pad;
+    const w = Math.max(...xs) - x0 + pad, h = Math.max(...ys) - y0 + pad;
+    const svg = el("svg", { viewBox: `${x0} ${-(y0 + h)} ${w} ${h}`, class: "thumb" }, strip);
+    el("path", { d: pathOf(curve.map(([x, y]) => [x, -y])), fill: "none", stroke: "#d62728",
+      "stroke-width": Math.max(w, h) / 60 }, svg);
+  }
+}
+
+function renderMetrics() {
+  const dl = $("metrics");
+  dl.replaceChildren();
+  const m = state.result && state.result.metrics;
+  if (!m) return;
+  const rows = [
+    ["roughness", `${m.smoothness.roughness.toFixed(3)}°`],
+    ["sharpest turn", `${m.smoothness.max_turn.toFixed(1)}°`],
+    ["self-intersects", m.self_intersects ? "yes" : "no"],
+    ["control points", state.result.spline ? state.result.spline.control_points.length : "–"],
+  ];
+  for (const [k, v] of rows) {
+    const dt = document.createElement("dt"); dt.textContent = k; dl.appendChild(dt);
+    const dd = document.createElement("dd"); dd.textContent = v; dd.dataset.metric = k; dl.appendChild(dd);
+  }
+}
+
+// Pointer events cover mouse, pen and touch alike.
+function boardPoint(ev) {
+  const r = $("board").getBoundingClientRect();
+  return [((ev.clientX - r.left) / r.width) * W, ((ev.clientY - r.top) / r.height) * H];
+}
+$("board").addEventListener("pointerdown", (ev) => {
+  ev.preventDefault();
+  $("board").setPointerCapture(ev.pointerId);
+  stroke = [boardPoint(ev)];
+  drawStroke();
+});
+$("board").addEventListener("pointermove", (ev) => {
+  if (!stroke) return;
+  const p = boardPoint(ev), q = stroke[stroke.length - 1];
+  if (Math.hypot(p[0] - q[0], p[1] - q[1]) < 3) return;
+  stroke.push(p);
+  drawStroke();
+});
+$("board").addEventListener("pointerup", () => finishStroke());
+$("board").addEventListener("pointercancel", () => { stroke = null; render(); });
+
+function finishStroke() {
+  const pts = stroke;
+  stroke = null;
+  if (!pts || pts.length < 4) {
+    $("board-error").textContent = "Too short: draw a longer stroke (at least 4 points).";
+    render();
+    return;
+  }
+  $("board-error").textContent = "";
+  const max = state.mode === "triplet" ? 3 : 2;
+  if (state.curves.length >= max) { state.curves.shift(); state.recon.shift(); }
+  state.curves.push(pts.map(toApi));
+  state.recon.push(null);
+  curvesChanged();
+}
+
+// ------------------------------------------------------------------------------------------ model calls
+
+async function reconstructAll() {
+  if (!state.curves.length) return;
+  const body = { curves: state.curves, spacing: "arc_length", n_points: N_POINTS, output: "both" };
+  const r = await api("/reconstruct", body, $("board-error"));
+  state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i] }));
+}
+
+function needed() { return state.mode === "triplet" ? 3 : 2; }
+
+function mixWeights() {
+  return state.mode === "triplet" ? [state.bary.slice()] : [[1 - state.weight, state.weight]];
+}
+
+async function updateMix() {
+  if (state.curves.length < needed()) { state.result = null; render(); return; }
+  const body = { curves: state.curves.slice(0, needed()), weights: mixWeights(), spacing: "arc_length",
+    n_points: N_POINTS, output: "both", metrics: true };
+  const r = await api("/interpolate", body, $("mix-error"));
+  state.result = { points: r.curves[0], spline: r.splines[0], metrics: r.metrics[0], weights: r.weights[0], body };
+  render();
+}
+
+async function updateStrip() {
+  if (state.curves.length < needed()) { state.strip = []; return; }
+  const steps = state.mode === "triplet" ? 4 : 5;  // pair: 5 evenly spaced; triplet: the grid of paper Fig. 8
+  const body = { curves: state.curves.slice(0, needed()), steps, spacing: "arc_length", n_points: 60 };
+  const r = await api("/interpolate", body, $("strip-error"));
+  state.strip = r.curves;
+}
+
+let busy = Promise.resolve();
+function curvesChanged() {
+  render();
+  $("hint").textContent = state.curves.length < needed()
+    ? `Draw ${needed() - state.curves.length} more curve(s).` : "Move the weights; draw again to replace the oldest curve.";
+  busy = busy.then(async () => {
+    try { await reconstructAll(); await updateStrip(); await updateMix(); } catch (e) { render(); }
+  });
+  return busy;
+}
+
+let mixTimer = null;
+function mixChanged() {
+  clearTimeout(mixTimer);
+  mixTimer = setTimeout(() => { busy = busy.then(() => updateMix().catch(() => render())); }, 40);
+}
+
+// ------------------------------------------------------------------------------------------ controls
+
+$("weight").addEventListener("input", () => {
+  state.weight = Number($("weight").value);
+  $("weight-value").textContent = state.weight.toFixed(2);
+  mixChanged();
+});
+
+for (const mode of ["pair", "triplet"]) {
+  $(`mode-${mode}`).addEventListener("change", () => {
+    state.mode = mode;
+    $("pair-controls").hidden = mode !== "pair";
+    $("triplet-controls").hidden = mode !== "triplet";
+    state.curves = state.curves.slice(-needed());
+    state.recon = state.recon.slice(-needed());
+    curvesChanged();
+  });
+}
+
+$("show-ctrl").addEventListener("change", render);
+$("clear").addEventListener("click", () => {
+  Object.assign(state, { curves: [], recon: [], result: null, strip: [] });
+  curvesChanged();
+});
+$("sample").addEventListener("click", async () => {
+  try {
+    const r = await api("/sample", { count: needed(), n_points: N_POINTS, frame: { center: [W / 2, H / 2], size: 420 } },
+      $("board-error"));
+    state.curves = r.curves;
+    state.recon = r.curves.map(() => null);
+    await curvesChanged();
+  } catch (e) { /* shown next to the board */ }
+});
+
+// The barycentric triangle: A at the top, B bottom left, C bottom right.
+const TRI = [[110, 12], [12, 185], [208, 185]];
+function renderTriangle() {
+  const svg = $("triangle");
+  svg.replaceChildren();
+  el("path", { d: pathOf(TRI) + " Z", fill: "#f4f4ff", stroke: "#888" }, svg);
+  TRI.forEach(([x, y], i) => {
+    el("text", { x: x + (i === 1 ? -10 : i === 2 ? 2 : 6), y: y + (i ? 12 : 2), fill: COLORS[i], "font-size": 14 }, svg)
+      .textContent = NAMES[i];
+  });
+  const [x, y] = [0, 1].map((k) => state.bary.reduce((s, w, i) => s + w * TRI[i][k], 0));
+  el("circle", { cx: x, cy: y, r: 6, fill: "#d62728", id: "bary-dot" }, svg);
+  $("bary-value").textContent = state.bary.map((w) => w.toFixed(2)).join(", ");
+}
+function pickBary(ev) {
+  const r = $("triangle").getBoundingClientRect();
+  const p = [((ev.clientX - r.left) / r.width) * 220, ((ev.clientY - r.top) / r.height) * 200];
+  const [a, b, c] = TRI;
+  const det = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
+  let wa = ((b[1] - c[1]) * (p[0] - c[0]) + (c[0] - b[0]) * (p[1] - c[1])) / det;
+  let wb = ((c[1] - a[1]) * (p[0] - c[0]) + (a[0] - c[0]) * (p[1] - c[1])) / det;
+  wa = Math.max(0, wa); wb = Math.max(0, wb);
+  let wc = Math.max(0, 1 - wa - wb);
+  const s = wa + wb + wc;
+  state.bary = [wa / s, wb / s, wc / s];
+  renderTriangle();
+  mixChanged();
+}
+let picking = false;
+$("triangle").addEventListener("pointerdown", (ev) => { picking = true; $("triangle").setPointerCapture(ev.pointerId); pickBary(ev); });
+$("triangle").addEventListener("pointermove", (ev) => { if (picking) pickBary(ev); });
+$("triangle").addEventListener("pointerup", () => { picking = false; });
+
+// ------------------------------------------------------------------------------------------ take it away
+
+function download(name, type, data) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(new Blob([data], { type }));
+  a.download = name;
+  document.body.appendChild(a);
+  a.click();
+  setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
+}
+function exported() {
+  const curves = state.curves.map((c, i) => ({ name: NAMES[i], role: "input", points: c }));
+  if (state.result) {
+    curves.push({ name: "mix", role: "interpolant", weights: state.result.weights, points: state.result.points,
+      spline: state.result.spline });
+  }
+  return curves;
+}
+$("download-json").addEventListener("click", () => {
+  download("curves.json", "application/json", JSON.stringify({ curves: exported() }, null, 1));
+});
+$("download-csv").addEventListener("click", () => {
+  const rows = ["curve,role,index,x,y"];
+  for (const c of exported()) c.points.forEach(([x, y], i) => rows.push(`${c.name},${c.role},${i},${x},${y}`));
+  download("curves.csv", "text/csv", rows.join("\n") + "\n");
+});
+$("download-svg").addEventListener("click", () => {
+  const svg = $("board").cloneNode(true);
+  svg.setAttribute("xmlns", SVG_NS);
+  svg.setAttribute("width", W);
+  svg.setAttribute("height", H);
+  download("curves.svg", "image/svg+xml", new XMLSerializer().serializeToString(svg));
+});
+$("copy-curl").addEventListener("click", async () => {
+  showCurl();
+  try { await navigator.clipboard.writeText($("curl").textContent); } catch (e) { /* shown below anyway */ }
+});
+
+// ------------------------------------------------------------------------------------------ the vase
+
+function profile() { return state.result ? state.result.points : state.curves[0]; }
+
+async function revolve(format) {
+  const curve = profile();
+  if (!curve) { $("vase-error").textContent = "Draw a curve first: the mix (or curve A) is the profile."; return null; }
+  return api("/revolve", { curve, segments: 48, format }, $("vase-error"), { raw: true });
+}
+
+$("vase").addEventListener("click", async () => {
+  try {
+    const r = await revolve("obj");
+    if (!r) return;
+    state.vase = parseObj(await r.text());
+    state.vase.faces_header = Number(r.headers.get("X-Mesh-Faces"));
+    drawVase();
+  } catch (e) { /* shown next to the vase */ }
+});
+for (const format of ["obj", "stl"]) {
+  $(`download-${format}`).addEventListener("click", async () => {
+    try {
+      const r = await revolve(format);
+      if (r) download(`vase.${format}`, format === "obj" ? "model/obj" : "model/stl", await r.blob());
+    } catch (e) { /* shown next to the vase */ }
+  });
+}
+$("turn").addEventListener("input", drawVase);
+
+function parseObj(text) {
+  const v = [], f = [];
+  for (const line of text.split("\n")) {
+    const p = line.trim().split(/\s+/);
+    if (p[0] === "v") v.push(p.slice(1, 4).map(Number));
+    else if (p[0] === "f") f.push(p.slice(1, 4).map((s) => Number(s.split("/")[0]) - 1));
+  }
+  return { vertices: v, faces: f };
+}
+
+// Flat-shaded triangles, painter's order, turned about the vertical axis and tilted towards the viewer.
+function drawVase() {
+  const canvas = $("vase-view"), g = canvas.getContext("2d");
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  if (!state.vase) return;
+  const { vertices, faces } = state.vase;
+  const t = (Number($("turn").value) * Math.PI) / 180, tilt = 0.35;
+  const c = [0, 1, 2].map((k) => vertices.reduce((s, p) => s + p[k], 0) / vertices.length);
+  const view = vertices.map(([x, y, z]) => {
+    const X = (x - c[0]) * Math.cos(t) + (z - c[2]) * Math.sin(t);
+    const Z = -(x - c[0]) * Math.sin(t) + (z - c[2]) * Math.cos(t);
+    const Y = y - c[1];
+    return [X, Y * Math.cos(tilt) - Z * Math.sin(tilt), Y * Math.sin(tilt) + Z * Math.cos(tilt)];
+  });
+  const size = Math.max(...view.map((p) => Math.max(Math.abs(p[0]), Math.abs(p[1])))) || 1;
+  const s = (0.45 * Math.min(canvas.width, canvas.height)) / size;
+  const tris = faces.map((f) => {
+    const [a, b, d] = f.map((i) => view[i]);
+    const n = [(b[1] - a[1]) * (d[2] - a[2]) - (b[2] - a[2]) * (d[1] - a[1]),
+      (b[2] - a[2]) * (d[0] - a[0]) - (b[0] - a[0]) * (d[2] - a[2]),
+      (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0])];
+    const len = Math.hypot(...n) || 1;
+    return { pts: [a, b, d], depth: (a[2] + b[2] + d[2]) / 3, light: Math.abs(n[2] / len) };
+  }).sort((p, q) => p.depth - q.depth);
+  for (const tri of tris) {
+    const shade = Math.round(90 + 150 * tri.light);
+    g.fillStyle = `rgb(${shade}, ${Math.round(shade * 0.8)}, ${Math.round(shade * 0.6)})`;
+    g.beginPath();
+    tri.pts.forEach(([x, y], i) => {
+      const X = canvas.width / 2 + s * x, Y = canvas.height / 2 - s * y;
+      if (i) g.lineTo(X, Y); else g.moveTo(X, Y);
+    });
+    g.closePath();
+    g.fill();
+  }
+}
+
+renderTriangle();
+render();

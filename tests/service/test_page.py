@@ -1,0 +1,220 @@
+"""The page at / in a real headless browser (Debian's chromium, driven by Playwright) against uvicorn on loopback.
+
+No browser download: Playwright launches /usr/bin/chromium (`apt-get install chromium`, done by .ci/run).
+Every test fails on a JavaScript error or a console error. A screenshot of the page lands in test-artifacts/.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+import httpx
+import numpy as np
+import pytest
+
+from tests.service.conftest import ROOT, SHIPPED, LiveServer
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+ARTIFACTS = ROOT / "test-artifacts"
+H = 700  # the board's height: API coordinates are the board's with y up
+
+if not Path(CHROMIUM).exists():
+    if os.environ.get("CI"):
+        raise RuntimeError("chromium is missing: .ci/run installs it with apt-get install chromium")
+    pytest.skip("chromium is not installed (apt-get install chromium)", allow_module_level=True)
+
+from playwright.sync_api import Browser, Page, sync_playwright  # noqa: E402
+
+ARGS = [
+    "--headless=new",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[LiveServer]:
+    """The shipped model, so that the page draws real reconstructions and interpolants."""
+    s = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
+    try:
+        s.wait_ready()
+        yield s
+    finally:
+        s.stop()
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Browser]:
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+def open_page(browser: Browser, url: str, *, width: int = 1280, height: int = 900) -> tuple[Page, list[str]]:
+    page = browser.new_context(viewport={"width": width, "height": height}, accept_downloads=True).new_page()
+    errors: list[str] = []
+    page.on("console", lambda m: errors.append(f"console: {m.text}") if m.type == "error" else None)
+    page.on("pageerror", lambda e: errors.append(f"page error: {e}"))
+    page.goto(url)
+    return page, errors
+
+
+def draw(page: Page, points: list[tuple[float, float]]) -> None:
+    """A stroke with mouse events, points in board units (1000 × 700)."""
+    box = page.locator("#board").bounding_box()
+    assert box is not None
+    at = [(box["x"] + x / 1000 * box["width"], box["y"] + y / 700 * box["height"]) for x, y in points]
+    page.mouse.move(*at[0])
+    page.mouse.down()
+    for p in at[1:]:
+        page.mouse.move(*p, steps=2)
+    page.mouse.up()
+
+
+def arc(cx: float, cy: float, r: float, a0: float, a1: float, n: int = 30) -> list[tuple[float, float]]:
+    t = np.linspace(a0, a1, n)
+    return list(zip(cx + r * np.cos(t), cy + r * np.sin(t)))
+
+
+def drawn(page: Page, selector: str) -> np.ndarray:
+    """Points of an SVG path of the board, back in API coordinates."""
+    d = page.locator(selector).get_attribute("d")
+    assert d
+    pts = np.array([[float(v) for v in seg[1:].split(",")] for seg in d.split()])
+    return np.stack([pts[:, 0], H - pts[:, 1]], axis=1)
+
+
+def state(page: Page) -> dict:
+    return page.evaluate("JSON.parse(JSON.stringify(window.curveVae))")
+
+
+def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
+    page, errors = open_page(browser, server.url + "/")
+    draw(page, arc(500, 420, 250, np.pi, 2 * np.pi))  # a bowl, drawn left to right
+    draw(page, arc(500, 250, 220, 0.9 * np.pi, 0.1 * np.pi))  # a hump
+    page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 5")
+    assert page.locator("path.reconstruction").count() == 2
+
+    page.locator("#weight").fill("0.25")  # the slider
+    page.wait_for_function("window.curveVae.result && window.curveVae.result.weights[1] === 0.25")
+    s = state(page)
+    answer = httpx.post(server.url + "/interpolate", json=s["result"]["body"], timeout=30).json()
+    np.testing.assert_allclose(drawn(page, "#interpolant"), answer["curves"][0], atol=2e-3)  # drawn = API's answer
+    strip = httpx.post(
+        server.url + "/interpolate",
+        json={**s["result"]["body"], "weights": None, "steps": 5, "n_points": 60, "output": "points", "metrics": False},
+        timeout=30,
+    ).json()
+    np.testing.assert_allclose(s["strip"], strip["curves"], atol=1e-9)
+    assert float(page.locator("dd[data-metric=roughness]").inner_text().rstrip("°")) >= 0
+
+    page.check("#show-ctrl")
+    assert page.locator(".control-polygon").count() == 3  # two reconstructions and the mix
+    assert len(s["result"]["spline"]["control_points"]) == 31
+
+    page.check("#mode-triplet")
+    draw(page, arc(500, 350, 150, 0.5 * np.pi, 2.3 * np.pi))  # a third curve
+    page.wait_for_function("window.curveVae.curves.length === 3 && window.curveVae.strip.length === 10")
+    box = page.locator("#triangle").bounding_box()
+    assert box is not None
+    page.mouse.click(box["x"] + 30 / 220 * box["width"], box["y"] + 170 / 200 * box["height"])  # near B's corner
+    page.wait_for_function("window.curveVae.result && window.curveVae.result.weights.length === 3")
+    page.wait_for_function("window.curveVae.result.weights[1] > 0.6")
+    s = state(page)
+    answer = httpx.post(server.url + "/interpolate", json=s["result"]["body"], timeout=30).json()
+    np.testing.assert_allclose(drawn(page, "#interpolant"), answer["curves"][0], atol=2e-3)
+
+    with page.expect_download() as download:
+        page.click("#download-json")
+    saved = json.loads(Path(download.value.path()).read_text())
+    assert [c["name"] for c in saved["curves"]] == ["A", "B", "C", "mix"]
+    np.testing.assert_allclose(saved["curves"][3]["points"], s["result"]["points"])
+    with page.expect_download() as download:
+        page.click("#download-csv")
+    rows = Path(download.value.path()).read_text().splitlines()
+    assert rows[0] == "curve,role,index,x,y" and len(rows) == 1 + sum(len(c["points"]) for c in saved["curves"])
+    with page.expect_download() as download:
+        page.click("#download-svg")
+    assert "<path" in Path(download.value.path()).read_text()
+
+    page.click("#copy-curl")
+    curl = page.locator("#curl").inner_text()
+    assert curl.startswith(f"curl -s {server.url}/interpolate")
+
+    page.click("#vase")
+    page.wait_for_function("window.curveVae.vase && window.curveVae.vase.faces.length > 0")
+    s = state(page)
+    assert len(s["vase"]["faces"]) == s["vase"]["faces_header"]
+    with page.expect_download() as download:
+        page.click("#download-stl")
+    stl = Path(download.value.path()).read_bytes()
+    assert len(stl) == 84 + 50 * int.from_bytes(stl[80:84], "little") > 84
+
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / "page.png"), full_page=True)
+    assert errors == []
+
+
+def test_errors_appear_next_to_their_cause(browser, server_factory, model_dir):
+    api = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--max-curves", "1")
+    api.wait_ready()
+    page, errors = open_page(browser, api.url + "/")
+    draw(page, [(100, 100), (101, 100), (102, 101)])  # a dab, not a stroke
+    assert "Too short" in page.locator("#board-error").inner_text()
+    page.click("#sample")  # two curves, but this server takes one per request
+    page.wait_for_function("document.getElementById('board-error').textContent.includes('at most 1')")
+    assert page.locator("#board-error").inner_text() == "/sample: count: at most 1, got 2"
+    assert [e for e in errors if "422" not in e] == []  # the browser logs the failed request itself; nothing else
+
+
+def test_page_on_another_origin_with_cors(browser, server, server_factory, model_dir):
+    api = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--cors-origins", server.url)
+    api.wait_ready()
+    page, errors = open_page(browser, f"{server.url}/?api={api.url}")
+    page.click("#sample")
+    page.wait_for_function("window.curveVae.result !== null")
+    metrics = httpx.get(api.url + "/metrics").text  # the other origin answered
+    assert 'curve_vae_http_requests_total{method="POST",route="/sample",status="200"} 1.0' in metrics
+    assert errors == []
+
+
+def test_phone_sized_screen(browser, server):
+    page, errors = open_page(browser, server.url + "/", width=390, height=844)
+    assert page.evaluate("document.documentElement.scrollWidth") <= 390  # no sideways scrolling
+    assert page.locator("#board").bounding_box()["width"] <= 390  # type: ignore[index]
+    page.click("#sample")
+    page.wait_for_function("window.curveVae.result !== null")
+    assert errors == []
+
+
+@pytest.mark.parametrize(("path", "text"), [("/docs", "curve-vae"), ("/redoc", "curve-vae")])
+def test_api_docs_work_offline(browser, server, path, text):
+    page = browser.new_context().new_page()
+    outside: list[str] = []
+
+    def only_loopback(route):
+        if route.request.url.startswith(server.url):
+            route.continue_()
+        else:
+            outside.append(route.request.url)
+            route.abort()
+
+    # ReDoc's footer tries its maker's logo from a CDN and drops it when that fails (an onError handler in
+    # redoc.standalone.js): the reference is complete without it. Nothing else may leave the machine.
+    redoc_logo = "https://cdn.redoc.ly/redoc/logo-mini.svg"
+
+    page.route("**/*", only_loopback)
+    page.goto(server.url + path)
+    page.wait_for_selector(".swagger-ui .info .title" if path == "/docs" else "h1", timeout=20_000)
+    assert text in page.content()
+    assert [url for url in outside if url != redoc_logo] == []
