@@ -101,16 +101,29 @@ function drawControl(board, spline, color) {
 }
 
 function renderStrip() {
+  // pair: one row; triplet: the barycentric grid as a triangle, row k holding the k+1 mixes with A's weight (n-k)/n
   const strip = $("strip");
   strip.replaceChildren();
-  for (const curve of state.strip) {
-    const xs = curve.map((p) => p[0]), ys = curve.map((p) => p[1]);
-    const pad = 10, x0 = Math.min(...xs) - pad, y0 = Math.min(...ys) - pad;
-    const w = Math.max(...xs) - x0 + pad, h = Math.max(...ys) - y0 + pad;
-    const svg = el("svg", { viewBox: `${x0} ${-(y0 + h)} ${w} ${h}`, class: "thumb" }, strip);
-    el("path", { d: pathOf(curve.map(([x, y]) => [x, -y])), fill: "none", stroke: "#d62728",
-      "stroke-width": Math.max(w, h) / 60 }, svg);
+  const rows = [];
+  if (state.mode === "triplet") {
+    for (let k = 0, i = 0; i < state.strip.length; k++) { rows.push(state.strip.slice(i, i + k + 1)); i += k + 1; }
+  } else if (state.strip.length) rows.push(state.strip);
+  strip.classList.toggle("triangle-grid", state.mode === "triplet");
+  for (const row of rows) {
+    const div = document.createElement("div");
+    div.className = "strip-row";
+    strip.appendChild(div);
+    for (const curve of row) thumbnail(div, curve);
   }
+}
+
+function thumbnail(parent, curve) {
+  const xs = curve.map((p) => p[0]), ys = curve.map((p) => p[1]);
+  const pad = 10, x0 = Math.min(...xs) - pad, y0 = Math.min(...ys) - pad;
+  const w = Math.max(...xs) - x0 + pad, h = Math.max(...ys) - y0 + pad;
+  const svg = el("svg", { viewBox: `${x0} ${-(y0 + h)} ${w} ${h}`, class: "thumb" }, parent);
+  el("path", { d: pathOf(curve.map(([x, y]) => [x, -y])), fill: "none", stroke: "#d62728",
+    "stroke-width": Math.max(w, h) / 60 }, svg);
 }
 
 function renderMetrics() {

@@ -125,6 +125,8 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     page.check("#mode-triplet")
     draw(page, arc(500, 350, 150, 0.5 * np.pi, 2.3 * np.pi))  # a third curve
     page.wait_for_function("window.curveVae.curves.length === 3 && window.curveVae.strip.length === 10")
+    rows = page.locator("#strip .strip-row")
+    assert [rows.nth(i).locator("svg").count() for i in range(rows.count())] == [1, 2, 3, 4]  # the grid as a triangle
     box = page.locator("#triangle").bounding_box()
     assert box is not None
     page.mouse.click(box["x"] + 30 / 220 * box["width"], box["y"] + 170 / 200 * box["height"])  # near B's corner
