@@ -13,7 +13,9 @@ from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
-DEFAULT_DATA = "data/curves.npz"
+from curve_vae.files import refuse_overwrite
+
+DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
 DEFAULT_MODELS = "models"
 FRESH_TEST_SEED = 7919  # the second test set: a seed no training or model selection uses
 
@@ -22,13 +24,21 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("data set (paper §3.1)")
     g.add_argument(
         "--data",
-        default=DEFAULT_DATA,
-        help=f"data set cache file; generated if missing or made with other parameters (default: {DEFAULT_DATA})",
+        default=None,
+        help="data set cache file: read when it holds this configuration, written when it does not exist, never "
+        f"overwritten (default: {DATA_HELP})",
     )
     g.add_argument("--n-train", type=int, default=70_000, help="training curves (default: 70000)")
     g.add_argument("--n-val", type=int, default=2_000, help="validation curves (default: 2000)")
     g.add_argument("--n-test", type=int, default=1_000, help="test curves (default: 1000)")
     g.add_argument("--data-seed", type=int, default=0, help="seed of the data set (default: 0)")
+
+
+def _data_path(a: argparse.Namespace, config: Any) -> Path:
+    """--data, or the default cache file of this data configuration."""
+    from training.data import default_cache
+
+    return Path(a.data) if a.data else default_cache(config)
 
 
 def _data_config(a: argparse.Namespace):
@@ -46,11 +56,14 @@ def cmd_dataset(a: argparse.Namespace) -> int:
     from training.data import load_or_generate
     from training.evaluate import _plt, _save
 
+    if a.preview:
+        refuse_overwrite(a.preview, a.force, "--preview")
     t = time.perf_counter()
-    ds = load_or_generate(_data_config(a), a.data)
+    path = _data_path(a, _data_config(a))
+    ds = load_or_generate(_data_config(a), path)
     dt = time.perf_counter() - t
     print(
-        f"{a.data}: train {ds.train.shape}, val {ds.val.shape}, test {ds.test.shape} "
+        f"{path}: train {ds.train.shape}, val {ds.val.shape}, test {ds.test.shape} "
         f"in {dt:.1f} s; coordinates in [{ds.train.min():.1f}, {ds.train.max():.1f}]"
     )
     if a.preview:
@@ -143,7 +156,7 @@ def cmd_train(a: argparse.Namespace) -> int:
         model_cfg,
         _data_config(a),
         cfg,
-        data_cache=a.data,
+        data_cache=_data_path(a, _data_config(a)),
         resume=a.resume,
         progress=not a.no_progress,
         stop_after=a.stop_after,
@@ -160,7 +173,7 @@ def cmd_train(a: argparse.Namespace) -> int:
     if finished:
         from training.data import load_or_generate
 
-        ds = load_or_generate(_data_config(a), a.data)
+        ds = load_or_generate(_data_config(a), _data_path(a, _data_config(a)))
         enc, dec, _ = torch_codec(run_dir / "best.pt")
         report = run_evaluation(enc, dec, {"test": ds.test}, run_dir, log_path=run_dir / "log.jsonl")
         print(
@@ -182,9 +195,19 @@ def cmd_export(a: argparse.Namespace) -> int:
     from training.io import atomic_write_text
     from training.train import load_checkpoint, model_from_checkpoint
 
+    held = [
+        f
+        for f in ("manifest.json", "encoder.onnx", "decoder.onnx", "vae.pt", "prior.npz")
+        if (Path(a.out) / f).exists()
+    ]
+    if held and not a.force:
+        raise ValueError(
+            f"{a.out} already holds a model ({', '.join(held)}) and is left as it is: pass --force to replace it, "
+            "or export to a new --out directory"
+        )
     ckpt = load_checkpoint(a.checkpoint)
     data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
-    ds = load_or_generate(data_cfg, a.data)
+    ds = load_or_generate(data_cfg, _data_path(a, data_cfg))
     model = model_from_checkpoint(a.checkpoint)
     if a.spline_ctrl is not None and a.spline_ctrl != model.cfg.spline_ctrl:
         from dataclasses import replace
@@ -270,8 +293,10 @@ def cmd_average(a: argparse.Namespace) -> int:
     for p in a.checkpoints:
         if not Path(p).is_file():
             raise SystemExit(f"curve-vae average: no checkpoint at {p}")
+    refuse_overwrite(a.out, a.force, "--out")
     d = load_checkpoint(a.checkpoints[-1])["data_config"]
-    ds = load_or_generate(DataConfig(**{**d, "center": tuple(d["center"])}), a.data)
+    data_cfg = DataConfig(**{**d, "center": tuple(d["center"])})
+    ds = load_or_generate(data_cfg, _data_path(a, data_cfg))
     train_curves = ds.train[: a.bn_curves] if a.bn_curves > 0 else None
     ckpt = average_checkpoints(a.checkpoints, train_curves=train_curves, val_curves=ds.val)
     atomic_save(ckpt, Path(a.out))
@@ -299,7 +324,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
         runtime = CurveRuntime.load(a.model_dir, providers="cpu")
         data_cfg_d = meta.get("training", {}).get("data")
     data_cfg = DataConfig(**{**data_cfg_d, "center": tuple(data_cfg_d["center"])}) if data_cfg_d else DataConfig()
-    ds = load_or_generate(data_cfg, a.data)
+    ds = load_or_generate(data_cfg, _data_path(a, data_cfg))
     sets = {"test": ds.test}
     if a.fresh_seed >= 0:
         sets[f"fresh_seed_{a.fresh_seed}"] = generate_curves(
@@ -348,6 +373,7 @@ def cmd_sample(a: argparse.Namespace) -> int:
     from service.payloads import sample_body, with_output
     from service.runtime import fresh_seed
 
+    refuse_overwrite(a.output, a.force)
     runtime = _runtime(a)
     seed = fresh_seed() if a.seed is None else a.seed
     splines: list | None = [] if a.output_as != "points" else None
@@ -376,6 +402,7 @@ def cmd_augment(a: argparse.Namespace) -> int:
     from service.payloads import augment_body
     from service.runtime import fresh_seed
 
+    refuse_overwrite(a.output, a.force)
     runtime = _runtime(a)
     seed = fresh_seed() if a.seed is None else a.seed
     plan = runtime.plan_augment(
@@ -438,6 +465,7 @@ def cmd_fit(a: argparse.Namespace) -> int:
     from curve_vae.files import read_curves, write_output
     from service.payloads import fit_body
 
+    refuse_overwrite(a.output, a.force)
     body = fit_body(read_curves(a.input), a.n_ctrl, param=a.param, n_points=a.n_points, tolerance=a.tolerance)
     write_output(a.output, body)
     for i, f in enumerate(body["fits"]):
@@ -453,6 +481,7 @@ def cmd_revolve(a: argparse.Namespace) -> int:
     from geometry import revolve
     from training.io import atomic_path
 
+    refuse_overwrite(a.output, a.force)
     curves = read_curves(a.input)
     if len(curves) != 1:
         raise ValueError(f"{a.input}: revolve takes one profile curve, got {len(curves)}")
@@ -508,7 +537,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--name", default="curve-vae-inception", help="model name in the manifest")
     s.add_argument("--version", default="0.1.0", help="model version in the manifest")
     s.add_argument(
-        "--data", default=DEFAULT_DATA, help=f"data set cache of the checkpoint's data config (default: {DEFAULT_DATA})"
+        "--data", default=None, help=f"data set cache of the checkpoint's data config (default: {DATA_HELP})"
     )
     s.add_argument(
         "--fresh-seed",
@@ -549,7 +578,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("checkpoints", nargs="+", help="training checkpoints of one run (e.g. best.pt last.pt)")
     s.add_argument("--out", required=True, help="the averaged checkpoint (training format, for export)")
     s.add_argument(
-        "--data", default=DEFAULT_DATA, help=f"data set cache of the checkpoints' data config (default: {DEFAULT_DATA})"
+        "--data", default=None, help=f"data set cache of the checkpoints' data config (default: {DATA_HELP})"
     )
     s.add_argument(
         "--bn-curves",
@@ -568,7 +597,7 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"exported model to evaluate with onnxruntime (default: {DEFAULT_MODELS})",
     )
     src.add_argument("--checkpoint", default="", help="evaluate a torch checkpoint instead")
-    s.add_argument("--data", default=DEFAULT_DATA, help=f"data set cache (default: {DEFAULT_DATA})")
+    s.add_argument("--data", default=None, help=f"data set cache (default: {DATA_HELP})")
     s.add_argument(
         "--fresh-seed",
         type=int,
@@ -674,6 +703,16 @@ def build_parser() -> argparse.ArgumentParser:
     else:
         configure_parser(s)
         s.set_defaults(func=run)
+    for name, what in [
+        ("dataset", "the --preview image"),
+        ("export", "the model files in --out (the shipped model too)"),
+        ("average", "the --out checkpoint"),
+        ("sample", "the output file"),
+        ("augment", "the output file"),
+        ("fit", "the output file"),
+        ("revolve", "the output file"),
+    ]:
+        sub.choices[name].add_argument("--force", action="store_true", help=f"replace {what} if it exists")
     return p
 
 

@@ -74,6 +74,12 @@ def parse_dat(text: str, name: str = "<dat>") -> np.ndarray:
     return pts
 
 
+def refuse_overwrite(path: str | Path, force: bool, flag: str = "-o") -> None:
+    """Stop before any work when `path` exists and the user did not pass --force: nothing of theirs is replaced."""
+    if str(path) != "-" and Path(path).exists() and not force:
+        raise ValueError(f"{path} exists and is left as it is: pass --force to replace it, or give another {flag}")
+
+
 def write_output(path: str, payload: dict[str, Any], array_key: str | None = None) -> None:
     """JSON to `path` ("-": standard output); a .npy path gets payload[array_key] as an array."""
     if path.endswith(".npy"):

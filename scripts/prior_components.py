@@ -22,7 +22,7 @@ import numpy as np
 
 from service.prior import PRIOR_FILE
 from service.runtime import CurveRuntime, file_sha256
-from training.data import DataConfig, generate_curves, load_or_generate
+from training.data import DataConfig, default_cache, generate_curves, load_or_generate
 from training.evaluate import sample_quality
 from training.prior import FIT_CURVES, fit_prior
 
@@ -31,9 +31,9 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--model-dir", default="models")
     p.add_argument("--components", type=int, nargs="+", default=[1, 8, 32])
-    p.add_argument("--data", default="data/curves.npz")
+    p.add_argument("--data", default=None, help="the data set cache (default: the configuration's own)")
     a = p.parse_args()
-    ds = load_or_generate(DataConfig(), a.data)
+    ds = load_or_generate(DataConfig(), a.data or default_cache(DataConfig()))
     reference = generate_curves(1000, 7919)[0]
     with tempfile.TemporaryDirectory() as tmp:
         scratch = Path(tmp) / "model"

@@ -33,7 +33,7 @@ import torch
 from geometry import smoothness, spline_head
 from service.runtime import CurveRuntime
 from training.airfoils import load_airfoils
-from training.data import DataConfig, generate_curves, load_or_generate
+from training.data import DataConfig, default_cache, generate_curves, load_or_generate
 from training.evaluate import evaluate_set, interpolation_report, onnx_codec
 from training.export import export
 from training.model import VAE, ModelConfig
@@ -124,11 +124,11 @@ def main() -> None:
     p.add_argument("--heads", type=int, nargs="*", default=[0, 10, 17, 24, 31], help="control points (0: raw)")
     p.add_argument("--checkpoint", nargs="*", default=[], help="fine-tuned checkpoints, measured with their own head")
     p.add_argument("--airfoils", default="", help="aerosandbox wheel or a directory of .dat files (optional)")
-    p.add_argument("--data", default="data/curves.npz", help="the data set cache (default: data/curves.npz)")
+    p.add_argument("--data", default=None, help="the data set cache (default: the configuration's own)")
     p.add_argument("--out", default="", help="write the rows as JSON here")
     a = p.parse_args()
     torch.set_num_threads(2)
-    ds = load_or_generate(DataConfig(), a.data)
+    ds = load_or_generate(DataConfig(), a.data or default_cache(DataConfig()))
     sets = {"test": ds.test, "fresh_seed_7919": generate_curves(1000, 7919)[0]}
     airfoils = load_airfoils(a.airfoils) if a.airfoils else []
     size = float(json.loads((Path(a.weights).parent / "manifest.json").read_text())["frame"]["model_size"])

@@ -1,4 +1,5 @@
-"""Offline commands that need no model: fit and revolve, on real files."""
+"""Offline commands on real files: fit and revolve (no model), what every writing command does to existing files,
+and the curve file formats."""
 
 import json
 
@@ -6,6 +7,7 @@ import numpy as np
 import pytest
 
 from curve_vae.cli import main
+from curve_vae.files import read_curves
 from geometry import random_control_points, sample_bspline
 
 
@@ -55,3 +57,43 @@ def test_revolve_rejects_several_profiles(curve_file, tmp_path, capsys):
     path, _ = curve_file
     assert main(["revolve", str(path), "-o", str(tmp_path / "x.obj")]) == 2
     assert "one profile curve" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        pytest.param(["fit", "{src}", "-o", "{out}"], id="fit"),
+        pytest.param(["revolve", "{profile}", "-o", "{out}"], id="revolve"),
+        pytest.param(["sample", "--count", "2", "-o", "{out}"], id="sample"),
+        pytest.param(["augment", "{src}", "--count", "2", "-o", "{out}"], id="augment"),
+    ],
+)
+def test_no_command_overwrites_a_users_file_without_force(command, curve_file, tmp_path, capsys):
+    path, _ = curve_file
+    profile = tmp_path / "p.json"
+    profile.write_text(json.dumps([[0, 0], [2, 0], [3, 1], [2, 3]]))
+    out = tmp_path / "mine.json"
+    out.write_text("the user's own file")
+    args = [a.format(src=path, profile=profile, out=out) for a in command]
+    assert main(args) == 2
+    assert out.read_text() == "the user's own file"
+    assert f"{out} exists and is left as it is: pass --force" in capsys.readouterr().err
+    assert main([*args, "--force"]) == 0
+    assert out.read_text() != "the user's own file"
+
+
+def test_airfoil_dat_files_selig_and_lednicer(tmp_path, capsys):
+    selig = tmp_path / "selig.dat"
+    selig.write_text("NACA 0012\n1.0 0.0\n0.5 0.05\n0.0 0.0\n0.5 -0.05\n1.0 0.0\n")
+    lednicer = tmp_path / "lednicer.dat"
+    lednicer.write_text("NACA 0012\n3. 3.\n\n0.0 0.0\n0.5 0.05\n1.0 0.0\n\n0.0 0.0\n0.5 -0.05\n1.0 0.0\n")
+    (curve,) = read_curves(str(selig))
+    (same,) = read_curves(str(lednicer))
+    np.testing.assert_array_equal(curve, same)  # Lednicer's two surfaces come back in Selig order
+    assert curve.shape == (5, 2)
+    bad = tmp_path / "bad.dat"
+    bad.write_text("NACA 0012\n1.0 0.0\n0.5 oops\n")
+    with pytest.raises(ValueError, match=r"bad\.dat:3: expected two numbers x y"):
+        read_curves(str(bad))
+    assert main(["fit", str(bad)]) == 2
+    assert "bad.dat:3" in capsys.readouterr().err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -98,13 +99,37 @@ class CurveDataset:
             return cls(DataConfig(**cfg), z["train"], z["val"], z["test"], z["test_ctrl"])
 
 
-def load_or_generate(config: DataConfig, cache: str | Path | None) -> CurveDataset:
-    """The data set for `config`, from `cache` when it holds exactly that configuration."""
+def default_cache(config: DataConfig) -> Path:
+    """Where a configuration's data set is cached by default: one file per configuration (data/curves-<digest>.npz),
+    so that a cache is never regenerated over, whatever the parameters asked for."""
+    digest = hashlib.sha256(json.dumps(asdict(config), sort_keys=True).encode()).hexdigest()[:10]
+    return Path("data") / f"curves-{digest}.npz"
+
+
+def load_or_generate(config: DataConfig, cache: str | Path | None, *, say: bool = True) -> CurveDataset:
+    """The data set for `config`: from `cache` when it holds exactly that configuration, generated and written there
+    when the file does not exist yet (saying where), generated without a file for cache None.
+
+    A file that holds another configuration, or no data set of ours, is never overwritten: ValueError names both.
+    """
     if cache is not None and Path(cache).exists():
-        ds = CurveDataset.load(cache)
-        if ds.config == config:
-            return ds
+        try:
+            ds = CurveDataset.load(cache)
+        except (ValueError, KeyError, OSError) as e:
+            raise ValueError(
+                f"{cache} is not a curve-vae data set ({e}); it is left as it is: give another --data path"
+            ) from e
+        if ds.config != config:
+            mine, theirs = asdict(config), asdict(ds.config)
+            diff = ", ".join(f"{k} {theirs[k]} (file) vs {mine[k]} (asked)" for k in mine if mine[k] != theirs[k])
+            raise ValueError(
+                f"{cache} holds a data set of another configuration: {diff}; it is left as it is: give another "
+                "--data path, or omit --data for the default cache of each configuration"
+            )
+        return ds
     ds = CurveDataset.generate(config)
     if cache is not None:
         ds.save(cache)
+        if say:
+            print(f"generated the data set ({config.n_train} / {config.n_val} / {config.n_test} curves) into {cache}")
     return ds

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from geometry import self_intersects
-from training.data import CurveDataset, DataConfig, generate_curves, load_or_generate
+from training.data import CurveDataset, DataConfig, default_cache, generate_curves, load_or_generate
 
 SMALL = DataConfig(n_train=300, n_val=50, n_test=40, seed=11)
 
@@ -63,7 +63,15 @@ def test_cache_round_trip_and_mismatch(tmp_path, small):
     np.testing.assert_array_equal(back.train, small.train)
     assert back.config == SMALL
     other = DataConfig(n_train=100, n_val=10, n_test=10, seed=11)
-    regenerated = load_or_generate(other, path)  # a different config is not served from the cache
-    assert regenerated.train.shape == (100, 161, 2)
-    assert CurveDataset.load(path).config == other
+    before = path.read_bytes()
+    with pytest.raises(ValueError, match=r"another configuration: n_train .* \(file\) vs 100 \(asked\)"):
+        load_or_generate(other, path)  # a file of another configuration is neither served nor overwritten
+    assert path.read_bytes() == before
+    (tmp_path / "mine.npz").write_bytes(b"not a data set")
+    with pytest.raises(ValueError, match="not a curve-vae data set"):
+        load_or_generate(SMALL, tmp_path / "mine.npz")
+    assert (tmp_path / "mine.npz").read_bytes() == b"not a data set"
+    fresh = load_or_generate(other, tmp_path / "new.npz")  # a path that does not exist yet is written
+    assert CurveDataset.load(tmp_path / "new.npz").config == other and fresh.train.shape == (100, 161, 2)
+    assert default_cache(other) != default_cache(SMALL) and default_cache(SMALL) == default_cache(SMALL)
     assert not list(tmp_path.glob("*.tmp")), "no temporary files left behind"

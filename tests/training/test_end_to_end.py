@@ -284,3 +284,29 @@ def test_export_with_spline_head(trained):
     for p, s in zip(points, splines):
         assert len(s.params) == 40 and s.control_points.shape == (10, 2)
         np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), p, atol=1e-9)
+
+
+def test_export_and_average_keep_existing_models(trained, capsys):
+    """A model directory (the shipped one included) and a checkpoint are replaced only with --force."""
+    tmp, data, cut, _, _ = trained
+    out = tmp / "models"  # exported by test_export_parity_and_manifest
+    manifest = (out / "manifest.json").read_bytes()
+    args = ["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--no-evaluate"]
+    assert main(args) == 2
+    assert "already holds a model (manifest.json, encoder.onnx, decoder.onnx" in capsys.readouterr().err
+    assert (out / "manifest.json").read_bytes() == manifest
+    assert main([*args, "--force", "--no-prior"]) == 0
+    assert (out / "manifest.json").read_bytes() != manifest
+    mine = tmp / "mine.pt"
+    mine.write_bytes(b"a checkpoint of the user's")
+    assert main(["average", str(cut / "best.pt"), str(cut / "last.pt"), "--out", str(mine), "--data", data]) == 2
+    assert mine.read_bytes() == b"a checkpoint of the user's"
+
+
+def test_train_never_rewrites_a_data_file_of_another_configuration(trained, tmp_path, capsys):
+    _, data, _, _, _ = trained
+    before = open(data, "rb").read()
+    args = ["train", "--run-dir", str(tmp_path / "run"), *TINY, "--n-train", "512", "--data", data, "--epochs", "1"]
+    assert main(args) == 2
+    assert "holds a data set of another configuration: n_train 256 (file) vs 512 (asked)" in capsys.readouterr().err
+    assert open(data, "rb").read() == before
