@@ -29,6 +29,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from geometry import Frame, revolve
 from service import schemas as s
+from service.access import ApiKeyMiddleware
 from service.metrics import Metrics, MetricsMiddleware
 from service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
 from service.npy import chunk_bytes, npy_header, npy_size
@@ -890,6 +891,8 @@ async def model_info(runtime: RuntimeDep, settings: SettingsDep) -> dict[str, An
 )
 async def metrics(request: Request) -> Response:
     """Request counts by route and status, request and inference latency histograms, batch sizes."""
+    if not request.app.state.settings.metrics:
+        raise HTTPException(404, "metrics are off on this server (CURVE_VAE_METRICS=false)")
     body, content_type = request.app.state.metrics.render()
     return Response(body, media_type=content_type)
 
@@ -977,12 +980,14 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.add_exception_handler(HTTPException, _on_http_error)
     # Added last = outermost: metrics see everything, CORS headers reach 413s too.
     app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes)
+    if settings.api_keys:  # outside the body limit: a request without a key is refused before its body is read
+        app.add_middleware(ApiKeyMiddleware, keys=settings.api_keys)
     if settings.cors_origins:
         app.add_middleware(
             CORSMiddleware,
             allow_origins=settings.cors_origins,
             allow_methods=["GET", "POST"],
-            allow_headers=["Content-Type"],
+            allow_headers=["Content-Type", "Authorization", "X-API-Key"],
             # what a page on another origin needs to read (the .npy seed, the mesh counts, download names)
             expose_headers=[
                 "X-Augment-Seed",

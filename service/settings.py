@@ -41,8 +41,12 @@ class Settings(BaseSettings):
     max_mesh_triangles: int = Field(1_000_000, ge=1)  # triangles of one /revolve mesh: 50 MB of STL
     # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
     cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)
+    # API keys (service/access.py), comma-separated or a JSON list; empty = open. Set by environment only,
+    # so that keys never show in a process list.
+    api_keys: Annotated[list[str], NoDecode] = Field(default_factory=list, repr=False)
+    metrics: bool = True  # GET /metrics; false answers 404, to keep the numbers off a public port
 
-    @field_validator("cors_origins", mode="before")
+    @field_validator("cors_origins", "api_keys", mode="before")
     @classmethod
     def _split_origins(cls, value: object) -> object:
         if isinstance(value, str):

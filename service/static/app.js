@@ -29,10 +29,10 @@ async function api(path, body, errorEl, { raw = false } = {}) {
   state.lastRequest = { path, body };
   showCurl();
   let response;
+  const headers = { "Content-Type": "application/json" };
+  if ($("api-key").value) headers["X-API-Key"] = $("api-key").value;
   try {
-    response = await fetch(API + path, {
-      method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
-    });
+    response = await fetch(API + path, { method: "POST", headers, body: JSON.stringify(body) });
   } catch (e) {
     errorEl.textContent = `The service did not answer (${e.message}). Is it running, and does it allow this page's origin?`;
     throw e;
@@ -40,7 +40,7 @@ async function api(path, body, errorEl, { raw = false } = {}) {
   if (!response.ok) {
     let detail = `${response.status} ${response.statusText}`;
     try { detail = (await response.json()).detail || detail; } catch (e) { /* not JSON */ }
-    errorEl.textContent = `${path}: ${detail}`;
+    errorEl.textContent = response.status === 401 ? `${detail} (type it in the API key field at the top)` : `${path}: ${detail}`;
     throw new Error(detail);
   }
   return raw ? response : response.json();
@@ -409,6 +409,10 @@ function drawVase() {
     g.fill();
   }
 }
+
+// The key lives for this browser tab only.
+$("api-key").value = sessionStorage.getItem("curve-vae-api-key") || "";
+$("api-key").addEventListener("change", () => sessionStorage.setItem("curve-vae-api-key", $("api-key").value));
 
 renderTriangle();
 render();

@@ -103,7 +103,7 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     draw(page, arc(500, 420, 250, np.pi, 2 * np.pi))  # a bowl, drawn left to right
     draw(page, arc(500, 250, 220, 0.9 * np.pi, 0.1 * np.pi))  # a hump
     page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 5")
-    assert page.locator("path.reconstruction").count() == 2
+    page.wait_for_function("document.querySelectorAll('path.reconstruction').length === 2")
 
     page.locator("#weight").fill("0.25")  # the slider
     page.wait_for_function("window.curveVae.result && window.curveVae.result.weights[1] === 0.25")
@@ -125,6 +125,7 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     page.check("#mode-triplet")
     draw(page, arc(500, 350, 150, 0.5 * np.pi, 2.3 * np.pi))  # a third curve
     page.wait_for_function("window.curveVae.curves.length === 3 && window.curveVae.strip.length === 10")
+    page.wait_for_function("document.querySelectorAll('#strip svg').length === 10")
     rows = page.locator("#strip .strip-row")
     assert [rows.nth(i).locator("svg").count() for i in range(rows.count())] == [1, 2, 3, 4]  # the grid as a triangle
     box = page.locator("#triangle").bounding_box()
@@ -220,3 +221,17 @@ def test_api_docs_work_offline(browser, server, path, text):
     page.wait_for_selector(".swagger-ui .info .title" if path == "/docs" else "h1", timeout=20_000)
     assert text in page.content()
     assert [url for url in outside if url != redoc_logo] == []
+
+
+def test_page_sends_the_api_key_the_user_types(browser, server_factory):
+    api = server_factory("--model-dir", str(SHIPPED), "--providers", "cpu", env={"CURVE_VAE_API_KEYS": "s3cret-key"})
+    api.wait_ready()
+    page, errors = open_page(browser, api.url + "/")  # the page itself loads without a key
+    page.click("#sample")
+    page.wait_for_function("document.getElementById('board-error').textContent.includes('API key')")
+    assert "type it in the API key field" in page.locator("#board-error").inner_text()
+    page.fill("#api-key", "s3cret-key")
+    page.click("#sample")
+    page.wait_for_function("window.curveVae.result !== null")
+    assert page.locator("#board-error").inner_text() == ""
+    assert [e for e in errors if "401" not in e] == []  # the browser logs the refused request itself; nothing else
