@@ -243,13 +243,34 @@ def _limiter(request: Request) -> anyio.CapacityLimiter | None:
 
 async def _run(request: Request, route: str, batch: int, work: Callable[[], Response]) -> Response:
     """Run `work` (inference and JSON rendering) in a worker thread, never on the event loop; timed, and at
-    most `inference_concurrency` at once."""
-    metrics: Metrics = request.app.state.metrics
+    most `inference_concurrency` at once.
+
+    Bounded both ways: with `inference_concurrency + max_queue` requests already in here, a new one is
+    answered 503 with Retry-After at once instead of joining an ever longer queue; one that takes longer
+    than `request_timeout` seconds (queueing included) is answered 504 (its thread finishes on its own).
+    """
+    settings: Settings = request.app.state.settings
+    state = request.app.state
+    if getattr(state, "pending", 0) >= settings.inference_concurrency + settings.max_queue:
+        raise HTTPException(
+            503,
+            f"busy: {state.pending} requests are running or queued (CURVE_VAE_INFERENCE_CONCURRENCY "
+            f"{settings.inference_concurrency} + CURVE_VAE_MAX_QUEUE {settings.max_queue}); retry in a moment",
+            headers={"Retry-After": "1"},
+        )
+    metrics: Metrics = state.metrics
     metrics.batch_size.labels(route).observe(batch)
+    state.pending = getattr(state, "pending", 0) + 1
     start = time.perf_counter()
     try:
-        return await anyio.to_thread.run_sync(work, limiter=_limiter(request))
+        with anyio.fail_after(settings.request_timeout or None):
+            return await anyio.to_thread.run_sync(work, limiter=_limiter(request), abandon_on_cancel=True)
+    except TimeoutError:
+        raise HTTPException(
+            504, f"the request took longer than {settings.request_timeout:g} s (CURVE_VAE_REQUEST_TIMEOUT); send less"
+        ) from None
     finally:
+        state.pending -= 1
         metrics.inference.labels(route).observe(time.perf_counter() - start)
 
 

@@ -35,6 +35,8 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--batch-size", "batch_size", int, "curves per ONNX run"),
     ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0 lets it choose"),
     ("--inference-concurrency", "inference_concurrency", int, "inferences running at once"),
+    ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
+    ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
 ]
 _CHOICES = {
     "providers": ["cpu", "cuda", "auto"],
@@ -85,6 +87,25 @@ def _log_config(level: str) -> dict[str, Any]:
     return config
 
 
+def _graceful_server_class() -> type:
+    import contextlib
+
+    import uvicorn
+
+    class GracefulServer(uvicorn.Server):
+        """uvicorn's server, but a stop by SIGTERM or SIGINT, once in-flight requests have finished, is a success
+        (exit 0): uvicorn would raise the signal again after shutting down, and exit -15 looks like a crash to an
+        orchestrator."""
+
+        @contextlib.contextmanager
+        def capture_signals(self):  # type: ignore[override]
+            with super().capture_signals():
+                yield
+                self._captured_signals.clear()
+
+    return GracefulServer
+
+
 def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
@@ -110,7 +131,11 @@ def run(args: argparse.Namespace) -> int:
         if settings.workers == 1:
             from service.app import create_app
 
-            uvicorn.run(create_app(settings), **common)  # type: ignore[arg-type]
+            config = uvicorn.Config(create_app(settings), **common)  # type: ignore[arg-type]
+            server = _graceful_server_class()(config)
+            server.run()
+            if not server.started:
+                return 3  # the app failed to start (uvicorn's own code for it)
         else:
             # Workers are fresh processes: they rebuild the same settings from the environment.
             os.environ.update(_as_env(settings))

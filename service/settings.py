@@ -33,6 +33,8 @@ class Settings(BaseSettings):
     providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
     intra_op_threads: int = Field(0, ge=0)  # onnxruntime threads per inference; 0 lets it choose
     inference_concurrency: int = Field(2, ge=1)  # inferences running at once; more only queue on a small CPU
+    max_queue: int = Field(64, ge=0)  # requests waiting for an inference slot; beyond them: 503 with Retry-After
+    request_timeout: float = Field(60.0, ge=0)  # seconds a request may take, queueing included (504); 0: no limit
     batch_size: int = Field(64, ge=1)  # curves per ONNX run: large requests are split to bound memory
     max_curves: int = Field(256, ge=1)  # curves (or latents, or interpolants) in one request or response
     max_points: int = Field(4096, ge=4)  # points per curve, in and out
