@@ -288,8 +288,19 @@ _ERR_EXAMPLES = {
         "curves[0][3][1]",
     ),
     503: (
-        "The model is not loaded yet (see GET /ready).",
+        "The model is not loaded yet (see GET /ready), or the server is busy: more requests than "
+        "CURVE_VAE_INFERENCE_CONCURRENCY + CURVE_VAE_MAX_QUEUE are running or queued (then with Retry-After).",
         "the model is not loaded yet; GET /ready answers 200 once it is",
+        None,
+    ),
+    401: (
+        "The server needs an API key (CURVE_VAE_API_KEYS) and the request sent none or a wrong one.",
+        "this service needs an API key: send Authorization: Bearer <key> or X-API-Key: <key>",
+        None,
+    ),
+    504: (
+        "The request took longer than CURVE_VAE_REQUEST_TIMEOUT seconds, queueing included.",
+        "the request took longer than 60 s (CURVE_VAE_REQUEST_TIMEOUT); send less",
         None,
     ),
 }
@@ -320,7 +331,7 @@ def _example(summary: str, value: dict[str, Any]) -> dict[str, Any]:
 
 
 _C1, _C2, _C3 = s.EXAMPLE_CURVE, s.EXAMPLE_CURVE_2, s.EXAMPLE_CURVE_3
-_POST_ERRORS = _errors(413, 422, 503)
+_POST_ERRORS = _errors(401, 413, 422, 503, 504)
 
 # --------------------------------------------------------------------------- routes
 

@@ -696,6 +696,12 @@ class CurveRuntime:
             raise InputError(
                 ("neighbours",), f"mode {mode} mixes each curve with {k - 1} others: at least {k - 1}, got {neighbours}"
             )
+        if neighbours is not None and neighbours > len(curves) - 1:
+            raise InputError(
+                ("neighbours",),
+                f"at most {len(curves) - 1} (each curve has {len(curves) - 1} others), got {neighbours}; "
+                "omit it to mix any curve with any other",
+            )
         prep = self.prepare(curves, frame, spacing)
         with np.errstate(all="ignore"):
             mean, _ = self.encode_model(prep.model)
@@ -704,7 +710,7 @@ class CurveRuntime:
         n = len(mean)
         distance = np.linalg.norm(mean[:, None, :] - mean[None, :, :], axis=-1)  # (n, n)
         np.fill_diagonal(distance, np.inf)  # never one's own partner
-        m = n - 1 if neighbours is None else min(neighbours, n - 1)
+        m = n - 1 if neighbours is None else neighbours
         pools = np.sort(np.argsort(distance, axis=1, kind="stable")[:, :m], axis=1)
         return AugmentPlan(prep=prep, mean=mean, k=k, seed=seed, pools=pools)
 

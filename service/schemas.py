@@ -328,7 +328,7 @@ class AugmentRequest(_Request):
         strict=True,
         description="Mix each anchor only with its `neighbours` nearest seed curves (Euclidean distance between "
         "latent means): near neighbours interpolate into better curves (paper §4). At least 1 for pairs, 2 for "
-        "triplets; more than the other curves means all of them. Omitted: any curve with any other.",
+        "triplets, at most the number of other curves. Omitted: any curve with any other.",
     )
     seed: Seed = None
     offset: int = Field(

@@ -97,8 +97,10 @@ def test_neighbours_restricts_partners_to_the_nearest_in_latent_space(client, cu
         nearest = np.argsort(d, axis=1)[:, :k]
         for anchor, *partners in out.json()["sources"]:
             assert set(partners) <= set(nearest[anchor].tolist()), (mode, k, anchor, partners)
-    wide = client.post("/augment", json={"curves": seeds, "count": 5, "neighbours": 50, "seed": 1}).json()
+    wide = client.post("/augment", json={"curves": seeds, "count": 5, "neighbours": 7, "seed": 1}).json()
     assert wide == client.post("/augment", json={"curves": seeds, "count": 5, "seed": 1}).json()  # all = no limit
+    too_many = client.post("/augment", json={"curves": seeds, "count": 5, "neighbours": 8, "seed": 1})
+    assert too_many.status_code == 422 and too_many.json()["detail"].startswith("neighbours: at most 7")
 
 
 def test_npy_output_loads_with_numpy_and_equals_the_json_pages(make_client, curves):

@@ -255,6 +255,13 @@ CASES = [
     ),
     pytest.param(
         "/augment",
+        {"curves": [C, C, C], "count": 2, "neighbours": 3},
+        422,
+        "neighbours: at most 2 (each curve has 2 others), got 3; omit it to mix any curve with any other",
+        id="augment-more-neighbours-than-curves",
+    ),
+    pytest.param(
+        "/augment",
         {"curves": [C, C, C], "count": 2, "mode": "triplet", "neighbours": 1},
         422,
         "neighbours: mode triplet mixes each curve with 2 others: at least 2, got 1",
