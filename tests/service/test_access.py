@@ -90,3 +90,19 @@ def test_keys_come_from_the_environment(monkeypatch):
     monkeypatch.setenv("CURVE_VAE_METRICS", "false")
     s = Settings()
     assert s.api_keys == ["a1", "b2"] and s.metrics is False and "a1" not in repr(s)
+
+
+def test_an_unexpected_failure_tells_nothing_of_the_inside(model_dir, runtime, monkeypatch):
+    from fastapi.testclient import TestClient
+
+    from service.app import create_app
+    from service.settings import Settings
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("failed in /srv/secret/models/decoder.onnx")
+
+    monkeypatch.setattr(runtime, "reconstruct", broken)
+    with TestClient(create_app(Settings(model_dir=model_dir), runtime=runtime), raise_server_exceptions=False) as c:
+        r = c.post("/reconstruct", json={"curves": [CURVE]})
+    assert r.status_code == 500
+    assert "secret" not in r.text and "Traceback" not in r.text and "decoder.onnx" not in r.text
