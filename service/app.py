@@ -33,6 +33,7 @@ from service.access import ApiKeyMiddleware
 from service.metrics import Metrics, MetricsMiddleware
 from service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
 from service.npy import chunk_bytes, npy_header, npy_size
+from service.openapi import state_bounds
 from service.payloads import augment_body, fit_body, frames_json, sample_body, with_metrics, with_output
 from service.runtime import (
     AugmentPlan,
@@ -1030,6 +1031,20 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
             ],
             max_age=600,
         )
+
+    def openapi() -> dict[str, Any]:
+        """FastAPI's schema, with the bounds of these settings and of the loaded model stated in it."""
+        if app.openapi_schema is None or getattr(app.state, "openapi_for", None) != runtime_dim():
+            app.openapi_schema = None
+            app.state.openapi_for = runtime_dim()
+            app.openapi_schema = state_bounds(FastAPI.openapi(app), settings, runtime_dim())
+        return app.openapi_schema
+
+    def runtime_dim() -> int | None:
+        rt = app.state.runtime
+        return rt.latent_dim if rt is not None else None
+
+    app.openapi = openapi  # type: ignore[method-assign]
     routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *app.routes)
     paths = [r.path for r in routes if hasattr(r, "path")]
     app.add_middleware(MetricsMiddleware, metrics=app.state.metrics, known_paths=paths)

@@ -813,7 +813,7 @@ class AugmentPlan:
 
 def fresh_seed() -> int:
     """A random seed for a request that gave none, reported back so the answer can be repeated."""
-    return int(np.random.SeedSequence().generate_state(1, np.uint64)[0])
+    return int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(11))  # 53 bits: exact in JSON
 
 
 def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:

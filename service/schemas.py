@@ -85,6 +85,10 @@ EXAMPLE_CURVE_2 = [[0.0, 0.0], [1.5, 0.5], [3.0, 2.0], [4.0, 4.0], [5.0, 6.5], [
 EXAMPLE_CURVE_3 = [[0.0, 4.0], [2.0, 5.0], [4.0, 4.0], [6.0, 2.0], [8.0, 1.0], [10.0, 2.0], [12.0, 4.0]]
 
 
+#: 2^53 - 1: the largest integer every JSON parser (JavaScript's included) holds exactly; seeds and offsets stay below.
+MAX_SAFE_INTEGER = 2**53 - 1
+
+
 class _Request(BaseModel):
     model_config = ConfigDict(extra="forbid")  # a misspelt field is an error, not silently ignored
 
@@ -234,7 +238,7 @@ class InterpolateRequest(_Request):
 
     @model_validator(mode="after")
     def _steps_or_weights(self) -> InterpolateRequest:
-        if self.steps is not None and self.weights is not None:
+        if {"steps", "weights"} <= self.model_fields_set:  # both given, even as null: the schema's "not required"
             raise PydanticCustomError("steps_and_weights", "give either steps or weights, not both")
         return self
 
@@ -250,7 +254,7 @@ Seed = Annotated[
     int | None,
     Field(
         ge=0,
-        lt=2**64,
+        le=MAX_SAFE_INTEGER,
         strict=True,
         description="Seed of the random draws: the same request and seed give the same answer. Omitted: fresh "
         "randomness, and the response reports the seed it drew.",
@@ -334,7 +338,7 @@ class AugmentRequest(_Request):
     offset: int = Field(
         0,
         ge=0,
-        lt=2**63,
+        le=MAX_SAFE_INTEGER,
         strict=True,
         description="Index of the first new curve in the seeded sequence. Item i depends only on (seed, i), so "
         "pages `offset`=0, 100, 200… of `count`=100 are the same curves as one request of `count`=300.",

@@ -81,3 +81,41 @@ def test_importing_the_app_loads_no_torch():
 def test_the_running_app_serves_the_same_schema_and_docs(client):
     assert client.get("/openapi.json").json() == openapi_spec()
     assert client.get("/docs").status_code == 200
+
+
+def test_the_live_schema_states_the_model_and_the_settings_bounds(make_client, runtime):
+    spec = make_client(max_curves=7, max_points=300, max_stream_curves=900).get("/openapi.json").json()["components"]
+    latents = spec["schemas"]["DecodeRequest"]["properties"]["latents"]
+    assert (
+        latents["maxItems"] == 7 and latents["items"]["minItems"] == latents["items"]["maxItems"] == runtime.latent_dim
+    )
+    curves = spec["schemas"]["ReconstructRequest"]["properties"]["curves"]
+    assert curves["maxItems"] == 7 and curves["items"]["maxItems"] == 300
+    assert spec["schemas"]["SampleRequest"]["properties"]["count"]["maximum"] == 7
+    assert spec["schemas"]["AugmentRequest"]["properties"]["count"]["maximum"] == 900
+    assert spec["schemas"]["InterpolateRequest"]["not"] == {"required": ["steps", "weights"]}
+
+
+def test_steps_and_weights_exclude_each_other_even_as_null(client):
+    c = [[0, 0], [1, 2], [2, 3], [3, 1]]
+    r = client.post("/interpolate", json={"curves": [c, c[::-1]], "steps": 3, "weights": None})
+    assert r.status_code == 422 and "either steps or weights" in r.json()["detail"]
+
+
+def test_the_live_schema_takes_the_latent_length_of_the_loaded_model(tmp_path):
+    import torch
+    from fastapi.testclient import TestClient
+
+    from service.app import create_app
+    from service.runtime import CurveRuntime
+    from service.settings import Settings
+    from training.export import export
+    from training.model import VAE, ModelConfig
+
+    torch.manual_seed(0)
+    export(VAE(ModelConfig(latent_dim=8)).eval(), tmp_path, model_size=100.0, weights=False)
+    runtime = CurveRuntime.load(tmp_path, providers="cpu")
+    with TestClient(create_app(Settings(model_dir=tmp_path), runtime=runtime)) as client:
+        latents = client.get("/openapi.json").json()["components"]["schemas"]["DecodeRequest"]["properties"]["latents"]
+        assert latents["items"]["minItems"] == latents["items"]["maxItems"] == 8
+        assert client.post("/decode", json={"latents": [[0.0] * 8]}).status_code == 200
