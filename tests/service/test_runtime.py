@@ -274,3 +274,33 @@ def test_cuda_that_falls_back_to_cpu_is_a_startup_error(model_dir, monkeypatch):
         CurveRuntime.load(model_dir, providers="cuda", warm_up=False)
     auto = CurveRuntime.load(model_dir, providers="auto", warm_up=False)  # auto accepts the fallback ...
     assert auto.providers == ["CPUExecutionProvider"]  # ... and reports it
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        pytest.param(lambda d: (d / "encoder.onnx").unlink(), r"encoder\.onnx is missing", id="missing-encoder"),
+        pytest.param(lambda d: (d / "prior.npz").unlink(), r"prior\.npz is missing", id="missing-prior"),
+        pytest.param(
+            lambda d: (d / "decoder.onnx").write_bytes((d / "decoder.onnx").read_bytes()[:1000]),
+            r"decoder\.onnx: sha256 .* does not match .* changed or truncated",
+            id="truncated-decoder",
+        ),
+    ],
+)
+def test_missing_or_truncated_model_files_stop_the_server_naming_the_file(model_dir, tmp_path, damage, message):
+    import re
+    import subprocess
+    import sys
+
+    copy = _copy(model_dir, tmp_path)
+    damage(copy)
+    with pytest.raises(ModelLoadError, match=message):
+        CurveRuntime.load(copy, providers="cpu")
+    serve = subprocess.run(
+        [sys.executable, "-m", "service.cli", "--model-dir", str(copy), "--port", "0"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert serve.returncode == 2 and re.search(message, serve.stderr), serve.stderr
