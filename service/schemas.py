@@ -14,6 +14,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validat
 from pydantic_core import PydanticCustomError
 
 FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # numbers only: no "1.5", no true
+
 Point = Annotated[tuple[FiniteFloat, FiniteFloat], Field(description="[x, y]")]
 
 
@@ -91,6 +92,18 @@ MAX_SAFE_INTEGER = 2**53 - 1
 
 class _Request(BaseModel):
     model_config = ConfigDict(extra="forbid")  # a misspelt field is an error, not silently ignored
+
+    @model_validator(mode="before")
+    @classmethod
+    def _integral_numbers(cls, data: Any) -> Any:
+        """139.0 is the integer 139 in JSON (and in JSON Schema's "integer"); 139.5, "139" and true stay errors."""
+        if not isinstance(data, dict):
+            return data
+        ints = {name for name, f in cls.model_fields.items() if f.annotation in (int, int | None)}
+        return {
+            k: int(v) if k in ints and isinstance(v, float) and v.is_integer() and abs(v) < 2**63 else v
+            for k, v in data.items()
+        }
 
 
 MetricsFlag = Annotated[

@@ -76,6 +76,10 @@ def test_schemathesis_finds_nothing_but_the_named_cross_field_rules(tmp_path):
     ]
     unexplained = []
     for name, text in failures:
+        if text.startswith("Runtime Error") and "site-packages/schemathesis/" in text:
+            # the tool's own generator broke on this operation (now and then, in its coverage phase): no finding
+            # about the service, and its other phases and operations still ran
+            continue
         if "ST202 Schema-valid request rejected" in text and "[422]" in text:
             if any(re.search(rule, text) for rule in CROSS_FIELD_RULES.values()):
                 continue

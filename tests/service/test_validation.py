@@ -488,3 +488,11 @@ def test_garbage_never_gives_5xx(client, path):
         )
         assert 400 <= r.status_code < 500, (body[:50], r.status_code, r.text)
         assert r.json()["detail"]
+
+
+def test_integral_numbers_are_integers_as_in_json_schema(client):
+    """JSON Schema's "integer" admits 3.0; so does the service, and 3.5 stays an error."""
+    ok = client.post("/sample", json={"count": 3.0, "seed": 7.0, "n_points": 50.0})
+    same = client.post("/sample", json={"count": 3, "seed": 7, "n_points": 50})
+    assert ok.status_code == 200 and ok.json() == same.json()
+    assert client.post("/sample", json={"count": 3.5}).json()["detail"] == "count: not an integer"
