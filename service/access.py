@@ -13,6 +13,8 @@ import hmac
 
 from starlette.types import ASGIApp, Receive, Scope, Send
 
+from service.errors import error_response
+
 #: Paths served without a key: probes must work for orchestrators, and the page must load to ask for the key.
 OPEN_PATHS = frozenset({"/health", "/ready", "/", "/docs", "/redoc", "/openapi.json"})
 OPEN_PREFIXES = ("/static/", "/docs-assets/")
@@ -52,8 +54,6 @@ class ApiKeyMiddleware:
         ):
             await self.app(scope, receive, send)
             return
-        from service.app import error_response  # the service's one error format
-
         missing = key_of(dict(scope["headers"])) is None
         msg = (
             "this service needs an API key: send Authorization: Bearer <key> or X-API-Key: <key>"

@@ -300,7 +300,7 @@ class SampleRequest(_Request):
         True,
         strict=True,
         description="Reject and redraw a curve that crosses itself or leaves the disc the data lies in (as the "
-        "paper's generator rejects self-intersecting curves), at most 50 draws per curve; the seed still decides "
+        "paper's generator rejects self-intersecting curves), at most 10 draws per curve; the seed still decides "
         "every curve. false: keep every draw.",
     )
     n_points: NPoints = None
@@ -319,7 +319,7 @@ class SampleResponse(CurvesResponse):
     seed: int = Field(description="The seed used: the request's, or the one drawn for it.")
     prior: Literal["learned", "standard"] = Field(description="The distribution the latents were drawn from.")
     rejected: int = Field(description="Draws rejected (self-intersecting or outside the disc) and drawn again.")
-    invalid: int = Field(description="Curves still invalid after 50 draws each (returned as drawn; normally 0).")
+    invalid: int = Field(description="Curves still invalid after 10 draws each (returned as drawn; normally 0).")
 
 
 class AugmentRequest(_Request):

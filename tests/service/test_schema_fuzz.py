@@ -56,6 +56,8 @@ def test_schemathesis_finds_nothing_but_the_named_cross_field_rules(tmp_path):
                 "1",
                 "-w",
                 "2",
+                "--request-timeout",
+                "60",
                 "--report",
                 "junit",
                 "--report-junit-path",

@@ -1,0 +1,132 @@
+"""What every model route shares: settings and runtime from app.state, the limits that depend on them, and
+the bounded, timed run of the work in a worker thread."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import Annotated
+
+import anyio
+import numpy as np
+from fastapi import Depends, Request
+from fastapi.responses import Response
+from starlette.exceptions import HTTPException
+
+from service import schemas as s
+from service.metrics import Metrics
+from service.runtime import (
+    CurveRuntime,
+    InputError,
+    Spline,
+    simplex_grid,
+    simplex_grid_size,
+)
+from service.settings import Settings
+
+DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
+WEIGHT_SUM_TOLERANCE = 1e-6
+
+
+def settings_of(request: Request) -> Settings:
+    return request.app.state.settings
+
+
+def runtime_of(request: Request) -> CurveRuntime:
+    if not request.app.state.ready or request.app.state.runtime is None:
+        raise HTTPException(503, "the model is not loaded yet; GET /ready answers 200 once it is")
+    return request.app.state.runtime
+
+
+SettingsDep = Annotated[Settings, Depends(settings_of)]
+RuntimeDep = Annotated[CurveRuntime, Depends(runtime_of)]
+
+
+def check_curves(curves: list[list[tuple[float, float]]], settings: Settings) -> list[np.ndarray]:
+    if len(curves) > settings.max_curves:
+        raise InputError(("curves",), f"at most {settings.max_curves} curves per request, got {len(curves)}")
+    for i, curve in enumerate(curves):
+        if len(curve) > settings.max_points:
+            raise InputError(("curves", i), f"at most {settings.max_points} points per curve, got {len(curve)}")
+    return [np.asarray(c, dtype=np.float64) for c in curves]
+
+
+def check_n_points(n_points: int | None, settings: Settings) -> None:
+    if n_points is not None and n_points > settings.max_points:
+        raise InputError(("n_points",), f"at most {settings.max_points}, got {n_points}")
+
+
+def check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
+    n = len(req.curves)
+    if req.weights is None:
+        steps = req.steps if req.steps is not None else DEFAULT_STEPS
+        rows = simplex_grid_size(n, steps)
+        if rows > settings.max_curves:
+            raise InputError(
+                ("steps",),
+                f"{steps} steps over {n} curves make {rows} curves; at most {settings.max_curves} per response",
+            )
+        return simplex_grid(n, steps)
+    if len(req.weights) > settings.max_curves:
+        raise InputError(("weights",), f"at most {settings.max_curves} rows, got {len(req.weights)}")
+    for r, row in enumerate(req.weights):
+        if len(row) != n:
+            raise InputError(("weights", r), f"expected {n} numbers, one per input curve, got {len(row)}")
+        try:
+            total = math.fsum(row)
+        except OverflowError:  # terms near the float limit
+            total = math.inf
+        if not abs(total - 1.0) <= WEIGHT_SUM_TOLERANCE:
+            raise InputError(("weights", r), f"weights must sum to 1, got {total:.9g}")
+    return np.array(req.weights, dtype=np.float64)
+
+
+def splines_wanted(output: str, runtime: CurveRuntime) -> list[Spline] | None:
+    """A list for the runtime to fill with splines when the request asks for them; None for points only."""
+    if output == "points":
+        return None
+    if not runtime.has_splines:
+        raise InputError(
+            ("output",),
+            f'"{output}" needs a model with a B-spline head, and this one has none (GET /model: spline is null); '
+            'ask for "points", or fit splines to the points with /fit',
+        )
+    return []
+
+
+def limiter_of(request: Request) -> anyio.CapacityLimiter | None:
+    return getattr(request.app.state, "limiter", None)  # set by the lifespan; None: anyio's default
+
+
+async def run_inference(request: Request, route: str, batch: int, work: Callable[[], Response]) -> Response:
+    """Run `work` (inference and JSON rendering) in a worker thread, never on the event loop; timed, and at
+    most `inference_concurrency` at once.
+
+    Bounded both ways: with `inference_concurrency + max_queue` requests already in here, a new one is
+    answered 503 with Retry-After at once instead of joining an ever longer queue; one that takes longer
+    than `request_timeout` seconds (queueing included) is answered 504 (its thread finishes on its own).
+    """
+    settings: Settings = request.app.state.settings
+    state = request.app.state
+    if getattr(state, "pending", 0) >= settings.inference_concurrency + settings.max_queue:
+        raise HTTPException(
+            503,
+            f"busy: {state.pending} requests are running or queued (CURVE_VAE_INFERENCE_CONCURRENCY "
+            f"{settings.inference_concurrency} + CURVE_VAE_MAX_QUEUE {settings.max_queue}); retry in a moment",
+            headers={"Retry-After": "1"},
+        )
+    metrics: Metrics = state.metrics
+    metrics.batch_size.labels(route).observe(batch)
+    state.pending = getattr(state, "pending", 0) + 1
+    start = time.perf_counter()
+    try:
+        with anyio.fail_after(settings.request_timeout or None):
+            return await anyio.to_thread.run_sync(work, limiter=limiter_of(request), abandon_on_cancel=True)
+    except TimeoutError:
+        raise HTTPException(
+            504, f"the request took longer than {settings.request_timeout:g} s (CURVE_VAE_REQUEST_TIMEOUT); send less"
+        ) from None
+    finally:
+        state.pending -= 1
+        metrics.inference.labels(route).observe(time.perf_counter() - start)

@@ -1,0 +1,82 @@
+"""The API's one error format and the handlers that produce it: a line naming the first problem, and the list."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from fastapi import Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse, Response
+from starlette.exceptions import HTTPException
+
+from service.runtime import (
+    InputError,
+    format_loc,
+)
+
+MAX_ERRORS_SHOWN = 20
+
+
+def error_response(
+    status: int, errors: Sequence[tuple[str, str]], *, detail: str | None = None, headers: dict[str, str] | None = None
+) -> JSONResponse:
+    """The one error body of the API: a line naming the first problem, and the list of all of them."""
+    items = [{"loc": loc, "msg": msg} for loc, msg in errors[:MAX_ERRORS_SHOWN]]
+    if detail is None:
+        loc, msg = errors[0]
+        detail = f"{loc}: {msg}" if loc else msg
+    return JSONResponse({"detail": detail, "errors": items}, status_code=status, headers=headers)
+
+
+def _validation_message(err: dict[str, Any], request: Request) -> tuple[str, str]:
+    loc = list(err["loc"])
+    if loc[:1] == ["body"]:
+        loc = loc[1:]
+    kind, ctx = err["type"], err.get("ctx") or {}
+    if kind == "json_invalid":
+        return "body", f"invalid JSON ({ctx.get('error', 'cannot parse')}) at position {loc[0] if loc else 0}"
+    if kind in ("model_attributes_type", "dict_type", "model_type") and not loc:
+        hint = ""
+        if "json" not in request.headers.get("content-type", "json"):
+            hint = "; send it with the header Content-Type: application/json"
+        return "body", "expected a JSON object" + hint
+    messages = {
+        "finite_number": "not a finite number",
+        "float_parsing": "not a number",
+        "float_type": "not a number",
+        "int_parsing": "not an integer",
+        "int_type": "not an integer",
+        "int_from_float": "not an integer",
+        "missing": "field required",
+        "extra_forbidden": "unknown field",
+    }
+    msg = messages.get(kind, err["msg"])
+    if kind == "float_type" and isinstance(err.get("input"), int) and not isinstance(err.get("input"), bool):
+        msg = "not a finite number: too large for a float"
+    if kind == "too_short" and len(loc) == 2 and loc[0] == "curves" and isinstance(loc[1], int):
+        msg = f"a curve needs at least 4 points, got {ctx.get('actual_length')}"
+    elif kind in ("too_short", "too_long") and len(loc) == 3 and loc[0] == "curves":
+        msg = f"a point is [x, y]: exactly 2 numbers, got {ctx.get('actual_length')}"
+    elif kind == "tuple_type" or (kind == "list_type" and len(loc) == 3 and loc[0] == "curves"):
+        msg = "a point is [x, y]: exactly 2 numbers"
+    return format_loc(loc), msg
+
+
+async def on_validation_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, RequestValidationError)
+    return error_response(422, [_validation_message(e, request) for e in exc.errors()])
+
+
+async def on_input_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, InputError)
+    return error_response(422, [(format_loc(exc.loc), exc.msg)])
+
+
+async def on_http_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, HTTPException)
+    if exc.status_code == 400 and exc.detail == "There was an error parsing the body":
+        # FastAPI's answer to bodies json.loads rejects with something other than a syntax error
+        # (an integer of over 4300 digits): the same 422 as any other unreadable JSON.
+        return error_response(422, [("body", "invalid JSON (cannot parse the body)")])
+    return error_response(exc.status_code, [], detail=str(exc.detail), headers=exc.headers)
