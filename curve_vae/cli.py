@@ -496,6 +496,24 @@ def cmd_revolve(a: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_triton(a: argparse.Namespace) -> int:
+    from curve_vae.triton import smoke_test, write_repository
+    from service.settings import DEFAULT_MODEL_DIR
+
+    folders = write_repository(
+        a.model_dir or DEFAULT_MODEL_DIR,
+        a.out,
+        prefix=a.prefix,
+        max_batch_size=a.max_batch_size,
+        max_queue_delay_us=a.max_queue_delay_us,
+        force=a.force,
+    )
+    for folder in folders:
+        shapes = ", ".join(f"{k} {list(v)}" for k, v in smoke_test(folder).items())
+        print(f"{folder}: config.pbtxt, 1/model.onnx (a batch of 3 runs: {shapes})")
+    return 0
+
+
 # -------------------------------------------------------------------------------- main
 
 
@@ -693,6 +711,17 @@ def build_parser() -> argparse.ArgumentParser:
         help="where that line is (default: through the profile's nearest point)",
     )
     s.set_defaults(func=cmd_revolve)
+
+    s = sub.add_parser("triton", help="write an NVIDIA Triton model repository of an exported model's graphs")
+    s.add_argument("--model-dir", default="", help="exported model directory (default: the shipped model, models/)")
+    s.add_argument("--out", required=True, help="the repository directory (model folders are created in it)")
+    s.add_argument("--prefix", default="curve_vae", help="model name prefix: PREFIX_encoder, PREFIX_decoder")
+    s.add_argument("--max-batch-size", type=int, default=256, help="Triton's max_batch_size (default: 256)")
+    s.add_argument(
+        "--max-queue-delay-us", type=int, default=2000, help="dynamic batching queue delay (default: 2000 µs)"
+    )
+    s.add_argument("--force", action="store_true", help="replace model folders that exist")
+    s.set_defaults(func=cmd_triton)
 
     s = sub.add_parser("serve", help="run the REST service on a model directory")
     try:
