@@ -2,6 +2,7 @@
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 
@@ -139,6 +140,13 @@ def test_ddp_two_cpu_processes(tmp_path):
         "1",
     ]
     proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    if proc.returncode != 0 and "terminate called without an active exception" in proc.stdout + proc.stderr:
+        # gloo's own threads abort a worker now and then on a loaded 2-core machine (seen once in four full runs,
+        # never in nine runs of this test alone): one more try from scratch, and a second failure of any kind fails
+        shutil.rmtree(tmp_path / "run", ignore_errors=True)
+        first = proc.stderr[-2000:]
+        proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+        assert proc.returncode == 0, f"first try:\n{first}\nsecond try:\n{proc.stdout[-2000:]}{proc.stderr[-4000:]}"
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
     rows = _log(tmp_path / "run")
     assert [r["epoch"] for r in rows] == [1, 2]  # one writer: rank 0
