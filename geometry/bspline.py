@@ -8,6 +8,7 @@ uniformly in the curve parameter. scipy evaluates the basis; batches are a matri
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.interpolate import BSpline, make_lsq_spline
@@ -50,10 +51,16 @@ def sample_bspline(ctrl: np.ndarray, n_points: int = 161, degree: int = 3) -> np
     ctrl: (n_ctrl, 2) or (batch, n_ctrl, 2). Returns (n_points, 2) or (batch, n_points, 2).
     """
     ctrl = np.asarray(ctrl, dtype=np.float64)
-    knots = clamped_uniform_knots(ctrl.shape[-2], degree)
+    return np.einsum("pc,...cd->...pd", _even_basis(ctrl.shape[-2], n_points, degree), ctrl)
+
+
+@lru_cache(maxsize=64)
+def _even_basis(n_ctrl: int, n_points: int, degree: int) -> np.ndarray:
+    """(n_points, n_ctrl) basis at evenly spaced parameters: the same for every curve, so built once (read-only)."""
     u = np.linspace(0.0, 1.0, n_points)
-    basis = BSpline.design_matrix(u, knots, degree).toarray()  # (n_points, n_ctrl)
-    return np.einsum("pc,...cd->...pd", basis, ctrl)
+    basis = BSpline.design_matrix(u, clamped_uniform_knots(n_ctrl, degree), degree).toarray()
+    basis.setflags(write=False)
+    return basis
 
 
 def spline_head(n_ctrl: int, n_points: int, degree: int = 3) -> tuple[np.ndarray, np.ndarray]:
@@ -86,7 +93,7 @@ def arc_length_params(control_points: np.ndarray, n_points: int, *, degree: int 
     interpolated linearly, which places points within ~1e-6 of the curve's length of even spacing.
     """
     u = np.linspace(0.0, 1.0, dense)
-    pts = evaluate_bspline(control_points, u, degree)
+    pts = sample_bspline(control_points, dense, degree)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
     if not s[-1] > 0:
         return np.linspace(0.0, 1.0, n_points)  # a spline collapsed to a point: any spacing is even

@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from service.model_files import file_sha256
 from service.prior import PRIOR_FILE
-from service.runtime import CurveRuntime, file_sha256
+from service.runtime import CurveRuntime
 from training.data import DataConfig, default_cache, generate_curves, load_or_generate
 from training.evaluate import sample_quality
 from training.prior import FIT_CURVES, fit_prior

@@ -122,6 +122,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     )
     app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
     app.state.metrics = Metrics()
+    app.state.pending = 0  # requests in deps.run_inference: running or waiting for an inference slot
     app.include_router(curves_router)
     app.include_router(design_router)
     app.include_router(ops_router)

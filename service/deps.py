@@ -109,7 +109,7 @@ async def run_inference(request: Request, route: str, batch: int, work: Callable
     """
     settings: Settings = request.app.state.settings
     state = request.app.state
-    if getattr(state, "pending", 0) >= settings.inference_concurrency + settings.max_queue:
+    if state.pending >= settings.inference_concurrency + settings.max_queue:
         raise HTTPException(
             503,
             f"busy: {state.pending} requests are running or queued (CURVE_VAE_INFERENCE_CONCURRENCY "
@@ -118,7 +118,7 @@ async def run_inference(request: Request, route: str, batch: int, work: Callable
         )
     metrics: Metrics = state.metrics
     metrics.batch_size.labels(route).observe(batch)
-    state.pending = getattr(state, "pending", 0) + 1
+    state.pending += 1
     start = time.perf_counter()
     try:
         with anyio.fail_after(settings.request_timeout or None):

@@ -14,13 +14,16 @@ trained on points evenly spaced in the B-spline parameter, so by default a curve
 are taken to be spaced that way and are interpolated along the index ("parameter"); a
 161-point curve then passes untouched and 50, 160 or 500 points of the same curve give
 the same model input. "arc_length" resamples evenly by arc length instead, for points
-spaced arbitrarily (hand-drawn strokes). Nothing here imports torch.
+spaced arbitrarily (hand-drawn strokes). Nothing here imports torch. Reading and checking model
+files is `service.model_files`; the learned latent distribution is `service.prior`.
+
+Length (~800 lines): one class whose methods share the sessions and the frame/length adaptation;
+issue 20 moves that adaptation into `geometry/` and the mixing weights and augment plans out,
+which is where this module should shrink next.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import logging
 import math
 from collections.abc import Iterator, Sequence
@@ -43,16 +46,17 @@ from geometry import (
     fit_frame,
     mse_per_curve,
     resample,
+    sample_bspline,
     self_intersects,
     smoothness,
 )
+from service.model_files import CUDA, ModelLoadError, graph_file, read_manifest, resolve_providers
 from service.prior import PRIOR_FILE, LatentPrior
 
 log = logging.getLogger(__name__)
 
 FrameMode = Literal["auto", "model"]
 Spacing = Literal["parameter", "arc_length"]
-CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
 _F32_MAX = float(np.finfo(np.float32).max)
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
 
@@ -73,10 +77,6 @@ class Sampled:
     invalid: int  # curves still not valid after max_draws (0 unless the distribution is far off)
 
 
-class ModelLoadError(RuntimeError):
-    """The model directory or the providers cannot serve: raised at startup, never per request."""
-
-
 class InputError(ValueError):
     """A well-formed request the model cannot process; `loc` names the field, curve and point."""
 
@@ -92,79 +92,6 @@ def format_loc(loc: Sequence[str | int]) -> str:
     for part in loc:
         out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
     return out or "body"
-
-
-# --------------------------------------------------------------------------- model files
-
-
-def file_sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
-def read_manifest(model_dir: str | Path) -> dict[str, Any]:
-    """manifest.json of an exported model, after checking the fields and graph checksums the service uses."""
-    root = Path(model_dir)
-    path = root / "manifest.json"
-    if not path.is_file():
-        raise ModelLoadError(
-            f"no model in {root}: {path.name} is missing (export one with training/export.py, "
-            "or point --model-dir / CURVE_VAE_MODEL_DIR at a directory holding encoder.onnx, "
-            "decoder.onnx and manifest.json)"
-        )
-    try:
-        manifest = json.loads(path.read_text())
-        n_points, latent_dim = int(manifest["n_points"]), int(manifest["latent_dim"])
-        model_size = float(manifest["frame"]["model_size"])
-        files = manifest["files"]
-    except (ValueError, KeyError, TypeError) as e:
-        raise ModelLoadError(f"{path}: not a usable manifest ({type(e).__name__}: {e})") from e
-    if n_points < 4 or latent_dim < 1 or not (math.isfinite(model_size) and model_size > 0):
-        raise ModelLoadError(
-            f"{path}: implausible n_points={n_points}, latent_dim={latent_dim}, model_size={model_size}"
-        )
-    names = [graph_file(manifest, graph) for graph in ("encoder", "decoder")]
-    if manifest.get("prior"):
-        names.append(str(manifest["prior"].get("file", PRIOR_FILE)))
-    for name in names:
-        file = root / name
-        if not file.is_file():
-            raise ModelLoadError(f"{file} is missing (listed in {path})")
-        expected = (files.get(name) or {}).get("sha256")
-        if not expected:
-            raise ModelLoadError(f"{path} carries no sha256 for {name}")
-        actual = file_sha256(file)
-        if actual != expected:
-            raise ModelLoadError(
-                f"{file}: sha256 {actual} does not match the manifest's {expected}; "
-                "the file was changed or truncated after export: re-export the model or restore the file"
-            )
-    return manifest
-
-
-def graph_file(manifest: dict[str, Any], graph: str) -> str:
-    return str(manifest.get("graphs", {}).get(graph, {}).get("file", f"{graph}.onnx"))
-
-
-def resolve_providers(choice: str) -> list[str]:
-    """onnxruntime provider list for "cpu", "cuda" or "auto"; "cuda" fails loudly when unavailable."""
-    available = ort.get_available_providers()
-    if choice == "cpu":
-        return [CPU]
-    if choice == "cuda":
-        if CUDA not in available:
-            raise ModelLoadError(
-                f"providers=cuda, but this onnxruntime ({ort.__version__}) offers only {available}: "
-                "install the GPU build (pip install 'curve-vae[gpu]', i.e. onnxruntime-gpu, in place of "
-                "onnxruntime) with CUDA 12 and cuDNN 9 libraries, or run with --providers cpu or auto"
-            )
-        return [CUDA, CPU]  # CPU takes any node CUDA has no kernel for
-    if choice == "auto":
-        return [CUDA, CPU] if CUDA in available else [CPU]
-    raise ModelLoadError(f"providers must be cpu, cuda or auto, got {choice!r}")
 
 
 # --------------------------------------------------------------------------- interpolation weights
@@ -444,15 +371,19 @@ class CurveRuntime:
                 curve = at_fractions(curve, fractions)
             return frame.from_model(curve, self.model_size) if frame is not None else curve
         c = np.asarray(ctrl, np.float64)
-        if n_points is not None:
-            u = np.linspace(0.0, 1.0, n_points) if spacing == "parameter" else arc_length_params(c, n_points)
-        elif fractions is not None:
+        if n_points is not None and spacing == "arc_length":
+            u = arc_length_params(c, n_points)
+        elif n_points is None and fractions is not None:
             u = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
-        else:
-            u = np.linspace(0.0, 1.0, self.n_points)
+        else:  # evenly in the parameter: the basis is the same for every curve (cached by sample_bspline)
+            u = None
+            count = n_points or self.n_points
         if frame is not None:
             c = frame.from_model(c, self.model_size)
-        curve = evaluate_bspline(c, u, self.spline_degree)
+        if u is None:
+            curve, u = sample_bspline(c, count, self.spline_degree), np.linspace(0.0, 1.0, count)
+        else:
+            curve = evaluate_bspline(c, u, self.spline_degree)
         if splines is not None:
             assert self.knots is not None
             splines.append(Spline(c, self.knots, self.spline_degree, u))
@@ -485,6 +416,20 @@ class CurveRuntime:
         _check_range(z, "latents")
         with np.errstate(all="ignore"):
             out, ctrl = self.decode_model_splines(z)
+        return self._place(out, ctrl, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
+
+    def _place(
+        self,
+        out: np.ndarray,
+        ctrl: np.ndarray | None,
+        *,
+        frames: Sequence[Frame] | None,
+        n_points: int | None,
+        spacing: Spacing,
+        splines: list[Spline] | None,
+    ) -> np.ndarray:
+        """Decoded curves (B, n_points_model, 2) (and control points) -> the caller's frames and length, checked."""
+        with np.errstate(all="ignore"):
             _check_finite(
                 out, "latents", "decodes to non-finite coordinates: the latent is far outside the training range"
             )
@@ -652,9 +597,17 @@ class CurveRuntime:
 
         z = np.array([draw(i) for i in range(count)]).reshape(count, self.latent_dim)
         draws, ok, todo = np.ones(count, np.int64), np.zeros(count, bool), np.arange(count)
-        while valid and len(todo):
+        out = np.zeros((count, self.n_points, 2), np.float32)
+        ctrl = np.zeros((count, len(self.knots) - self.spline_degree - 1, 2), np.float32) if self.has_splines else None
+        while len(todo):  # each draw is decoded once; its curve is kept until the item draws again
             with np.errstate(all="ignore"):
-                good = self.plausible(self.decode_model(z[todo]).astype(np.float64))
+                decoded, points = self.decode_model_splines(z[todo])
+            out[todo] = decoded
+            if ctrl is not None and points is not None:
+                ctrl[todo] = points
+            if not valid:
+                break
+            good = self.plausible(decoded.astype(np.float64))
             ok[todo[good]] = True
             todo = todo[~good & (draws[todo] < max_draws)]
             for i in todo:
@@ -662,7 +615,7 @@ class CurveRuntime:
                 draws[i] += 1
         invalid = int((~ok).sum()) if valid else 0
         frames = [frame] * count if frame else None
-        curves = self.decode(z, n_points=n_points, spacing=spacing, frames=frames, splines=splines)
+        curves = self._place(out, ctrl, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
         return Sampled(z, curves, chosen, rejected=int(draws.sum() - count), invalid=invalid)
 
     def plausible(self, curves: np.ndarray) -> np.ndarray:

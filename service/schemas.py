@@ -3,7 +3,11 @@
 Only what a schema can check on its own lives here (finite numbers, [x, y] pairs, ≥ 4
 points, ≥ 2 distinct points, either `steps` or `weights`). Limits that come from the
 settings or the loaded model (curves per request, points per curve, latent size, weight
-row length) are checked in `service.app`, with the same error format.
+row length) are checked in `service.deps`, with the same error format, and stated in the
+published schema by `service.openapi.state_bounds`.
+
+Length (~490 lines): every request and response body in one place, as the OpenAPI page groups
+them; the field docs are most of it.
 """
 
 from __future__ import annotations

@@ -2,6 +2,9 @@
 
 Works on a torch checkpoint or on an exported model directory (ONNX, as the service runs
 it), so the shipped artefacts are measured exactly as users receive them.
+
+Length (~430 lines): the reports and the figures drawn from them; the figures (plot_*) are the
+part to move into their own module when it grows again (issue 20).
 """
 
 from __future__ import annotations

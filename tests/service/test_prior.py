@@ -72,11 +72,12 @@ def test_a_model_without_a_prior_says_so(raw_model_dir, tmp_path):
 
 @pytest.mark.parametrize("prior", ["learned", "standard"])
 def test_rejection_keeps_the_seed_in_charge(runtime, monkeypatch, prior):
-    """Every draw is decoded once; rejected ones are drawn again from the item's own generator, so the same seed
-    gives the same curves and a larger count extends a smaller one, rejections and all."""
+    """Every draw is decoded once (and only once: the curves returned are the draws' own); rejected ones are drawn
+    again from the item's own generator, so the same seed gives the same curves and a larger count extends a
+    smaller one, rejections and all."""
     decoded: list[int] = []
-    decode = runtime.decode_model
-    monkeypatch.setattr(runtime, "decode_model", lambda z: decoded.append(len(z)) or decode(z))
+    decode = runtime.decode_model_splines
+    monkeypatch.setattr(runtime, "decode_model_splines", lambda z: decoded.append(len(z)) or decode(z))
     made = runtime.sample(12, seed=7, prior=prior, max_draws=5)
     assert sum(decoded) == 12 + made.rejected and made.rejected > 0  # an untrained decoder scribbles
     ok = runtime.plausible(runtime.decode_model(made.latents).astype(np.float64))
