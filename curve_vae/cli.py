@@ -35,6 +35,13 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--n-val", type=int, default=2_000, help="validation curves (default: 2000)")
     g.add_argument("--n-test", type=int, default=1_000, help="test curves (default: 1000)")
     g.add_argument("--data-seed", type=int, default=0, help="seed of the data set (default: 0)")
+    g.add_argument(
+        "--mix",
+        choices=("paper", "broad"),
+        default="paper",
+        help="training curves: the paper's generator, or the broad mix of training/families.py (any spacing, "
+        "other shapes, posed as the service poses curves); the test split is the paper's either way (default: paper)",
+    )
 
 
 def _data_path(a: argparse.Namespace, config: Any) -> Path:
@@ -47,7 +54,7 @@ def _data_path(a: argparse.Namespace, config: Any) -> Path:
 def _data_config(a: argparse.Namespace):
     from training.data import DataConfig
 
-    return DataConfig(n_train=a.n_train, n_val=a.n_val, n_test=a.n_test, seed=a.data_seed)
+    return DataConfig(n_train=a.n_train, n_val=a.n_val, n_test=a.n_test, seed=a.data_seed, mix=a.mix)
 
 
 # ------------------------------------------------------------------------------ dataset
@@ -409,7 +416,13 @@ def cmd_augment(a: argparse.Namespace) -> int:
     runtime = _runtime(a)
     seed = fresh_seed() if a.seed is None else a.seed
     plan = runtime.plan_augment(
-        read_curves(a.input), mode=a.mode, seed=seed, neighbours=a.neighbours, frame=a.frame, spacing=a.spacing
+        read_curves(a.input),
+        mode=a.mode,
+        seed=seed,
+        neighbours=a.neighbours,
+        frame=a.frame,
+        spacing=a.spacing,
+        pose=a.pose,
     )
     start, stop = a.offset, a.offset + a.count
     if a.output.endswith(".npy"):  # streamed chunk by chunk: any count in bounded memory
@@ -670,6 +683,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--offset", type=int, default=0, help="index of the first curve in the seeded sequence (default: 0)")
     s.add_argument(
         "--frame", choices=["auto", "model"], default="auto", help="frame of the seed curves (default: auto)"
+    )
+    s.add_argument(
+        "--pose",
+        choices=["auto", "as_is"],
+        default="auto",
+        help="auto: each seed curve is encoded in the pose (turn, mirror, direction) it reconstructs best in, and "
+        "new curves come back in their sources' poses; as_is: as oriented (default: auto)",
     )
     _add_model_options(s)
     s.set_defaults(func=cmd_augment)

@@ -16,7 +16,16 @@ from geometry.bspline import (
     sample_bspline,
     spline_head,
 )
-from geometry.frame import Frame, arc_fractions, at_fractions, blend_frames, fit_frame, resample
+from geometry.frame import (
+    Frame,
+    arc_fractions,
+    at_fractions,
+    blend_frames,
+    fit_frame,
+    pose_frames,
+    resample,
+    signed_turning,
+)
 from geometry.mesh import Mesh, revolve
 from geometry.metrics import (
     curve_length,
@@ -41,11 +50,13 @@ __all__ = [
     "fit_bspline_auto",
     "fit_frame",
     "mse_per_curve",
+    "pose_frames",
     "random_control_points",
     "resample",
     "revolve",
     "sample_bspline",
     "self_intersects",
+    "signed_turning",
     "smoothness",
     "spline_head",
     "turning_angles",

@@ -2,8 +2,10 @@
 
 The model works in the paper's 128×128 plane. A caller's curve may live anywhere at any
 size and have any number of points; `fit_frame` finds the similarity (shift + uniform
-scale, no rotation) that maps its bounding box onto the model's, and `resample` moves it
-to the model's point count by arc length. Both are exactly invertible up to float error.
+scale) that maps its bounding box onto the model's, and `resample` moves it to the model's
+point count by arc length. A frame may also carry a pose — a rotation, a mirror image and a
+reversal of the point order — that brings the curve into the orientation the model was
+trained on (`pose_frames`). All of it is exactly invertible up to float error.
 """
 
 from __future__ import annotations
@@ -18,20 +20,46 @@ MODEL_CENTER = (64.0, 64.0)
 
 @dataclass(frozen=True)
 class Frame:
-    """Where a curve lives: the centre of its bounding box and its larger side."""
+    """Where a curve lives and how it is turned: the centre of its bounding box and its larger side; and the pose
+    that takes it to the model — mirror x about the centre (`mirror`), then turn by `rotation` radians
+    counter-clockwise, with the point order reversed (`reverse`). The default pose is the identity."""
 
     center: tuple[float, float]
     size: float
+    rotation: float = 0.0
+    mirror: bool = False
+    reverse: bool = False
+
+    @property
+    def posed(self) -> bool:
+        return bool(self.rotation or self.mirror or self.reverse)
+
+    def _linear(self) -> np.ndarray:
+        """The 2×2 map of the pose (row vectors: p @ M), mirror first."""
+        c, s = np.cos(self.rotation), np.sin(self.rotation)
+        m = np.array([[c, s], [-s, c]])
+        return np.array([[-1.0, 0.0], [0.0, 1.0]]) @ m if self.mirror else m
 
     def to_model(self, pts: np.ndarray, model_size: float) -> np.ndarray:
         """Map points of this frame into the model plane, bounding box size `model_size`."""
-        c = np.asarray(self.center)
-        return (np.asarray(pts, np.float64) - c) * (model_size / self.size) + np.asarray(MODEL_CENTER)
+        p = np.asarray(pts, np.float64) - np.asarray(self.center)
+        if self.posed:
+            p = p @ self._linear()
+            p = p[::-1] if self.reverse else p
+        return p * (model_size / self.size) + np.asarray(MODEL_CENTER)
 
     def from_model(self, pts: np.ndarray, model_size: float) -> np.ndarray:
-        """Inverse of `to_model`."""
-        c = np.asarray(self.center)
-        return (np.asarray(pts, np.float64) - np.asarray(MODEL_CENTER)) * (self.size / model_size) + c
+        """Inverse of `to_model` (points in the model's order come back in the caller's)."""
+        p = (np.asarray(pts, np.float64) - np.asarray(MODEL_CENTER)) * (self.size / model_size)
+        if self.posed:
+            p = p @ self._linear().T  # orthogonal: the inverse is the transpose
+            p = p[::-1] if self.reverse else p
+        return p + np.asarray(self.center)
+
+    def to_caller_params(self, u: np.ndarray) -> np.ndarray:
+        """Parameters of points in the model's order -> the same points' parameters in the caller's order."""
+        u = np.asarray(u, np.float64)
+        return (1.0 - u)[::-1] if self.reverse else u
 
 
 def fit_frame(points: np.ndarray) -> Frame:
@@ -48,15 +76,90 @@ def fit_frame(points: np.ndarray) -> Frame:
 def blend_frames(frames: list[Frame], weights: np.ndarray) -> list[Frame]:
     """Affine blend of frames, one per weight row: the frame an interpolant is returned in.
 
-    weights: (rows, len(frames)), each row summing to 1.
+    weights: (rows, len(frames)), each row summing to 1. Centres and sizes blend linearly;
+    mirror and order, which do not blend, come from the heaviest frame of each row, and
+    rotations blend as weighted unit vectors (the shorter way round) over the frames that
+    mirror as it does: a turn means another thing in a mirrored frame. A curve and its own
+    reversal get frames that differ in order alone, so every blend of the two is the curve.
     """
     centers = np.array([f.center for f in frames])  # (k, 2)
     sizes = np.array([f.size for f in frames])  # (k,)
+    turns = np.array([[np.cos(f.rotation), np.sin(f.rotation)] for f in frames])  # (k, 2)
     w = np.asarray(weights, dtype=np.float64)
+    mirrors = np.array([f.mirror for f in frames])
     out_c, out_s = w @ centers, w @ sizes
     # An extrapolating row could drive the size to zero or below; keep the frame invertible.
     out_s = np.maximum(out_s, 1e-12 * sizes.max())
-    return [Frame(center=(float(c[0]), float(c[1])), size=float(s)) for c, s in zip(out_c, out_s)]
+    out = []
+    for row, c, s in zip(w, out_c, out_s):
+        lead = frames[int(np.argmax(row))]
+        t = (row * (mirrors == lead.mirror)) @ turns
+        rotation = float(np.arctan2(t[1], t[0])) if np.hypot(*t) > 1e-12 else lead.rotation
+        out.append(Frame((float(c[0]), float(c[1])), float(s), rotation, lead.mirror, lead.reverse))
+    return out
+
+
+#: Directions (radians) the chord of a posed curve is turned to: the paper's generator draws curves whose chord
+#: (first point -> last) points into the lower half-plane, about straight down, and which turn counter-clockwise.
+POSE_CHORDS = (-np.pi / 2, -np.pi / 4, -3 * np.pi / 4)
+#: A chord shorter than this share of the bounding box marks a closed-looking curve (see pose_frames).
+CLOSED = 0.05
+
+
+def signed_turning(points: np.ndarray) -> float:
+    """Total signed turning of a polyline (n, 2), radians: positive when it turns counter-clockwise overall."""
+    d = np.diff(np.asarray(points, np.float64), axis=0)
+    d = d[np.linalg.norm(d, axis=1) > 0]
+    if len(d) < 2:
+        return 0.0
+    cross = d[:-1, 0] * d[1:, 1] - d[:-1, 1] * d[1:, 0]
+    dot = (d[:-1] * d[1:]).sum(axis=1)
+    return float(np.arctan2(cross, dot).sum())
+
+
+def chord_heading(points: np.ndarray) -> float:
+    """Direction (radians) of a curve's chord, first point -> last. For a closed or nearly closed loop (an airfoil)
+    the direction its opening would have: a counter-clockwise loop that starts on its right has its chord pointing
+    down, as the paper's curves do."""
+    pts = np.asarray(points, np.float64)
+    chord = pts[-1] - pts[0]
+    if np.hypot(*chord) >= CLOSED * np.ptp(pts, axis=0).max():
+        return float(np.arctan2(chord[1], chord[0]))
+    out = pts[0] - pts.mean(axis=0)
+    return float(np.arctan2(out[1], out[0])) - np.pi / 2
+
+
+def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> list[Frame]:
+    """Candidate frames that bring a curve into the model's pose, best guess first.
+
+    Each mirrors a clockwise curve, then turns its chord to one of the first `chords` of
+    `POSE_CHORDS`. With `flips`, each also comes reversed and mirrored across its chord's
+    normal: the same two moves leave chord and turning as they were, so only with both
+    does a curve and its reversal, mirror image or rotation get the same set of candidates.
+    """
+    fit_frame(points)  # raises ValueError when all points coincide
+    pts = np.asarray(points, np.float64)
+    mirror = signed_turning(pts) < 0
+    heading = chord_heading(pts * ([-1.0, 1.0] if mirror else 1.0))
+    poses = []
+    for target in POSE_CHORDS[:chords]:
+        turn = float(np.angle(np.exp(1j * (target - heading))))
+        poses.append((turn, mirror, False))
+        if flips:
+            # Reflect across the line normal to the chord (S), then reverse: chord and turning stay as they were.
+            # As a pose, S·R(turn)·M^mirror = R(turn')·M^(not mirror), so R(turn') = S·R(turn)·M.
+            n = np.array([np.cos(target), np.sin(target)])
+            c, s = np.cos(turn), np.sin(turn)
+            a = (np.eye(2) - 2 * np.outer(n, n)) @ np.array([[c, -s], [s, c]]) @ np.diag([-1.0, 1.0])
+            poses.append((float(np.arctan2(a[1, 0], a[0, 0])), not mirror, True))
+    out = []
+    for turn, mir, rev in poses:
+        linear = Frame((0.0, 0.0), 1.0, rotation=turn, mirror=mir)._linear()
+        q = pts @ linear  # the bounding box is taken in the model's orientation
+        lo, hi = q.min(axis=0), q.max(axis=0)
+        center = ((lo + hi) / 2) @ linear.T
+        out.append(Frame((float(center[0]), float(center[1])), float((hi - lo).max()), turn, mir, rev))
+    return out
 
 
 def arc_fractions(points: np.ndarray) -> np.ndarray:

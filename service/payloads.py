@@ -19,7 +19,11 @@ def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
     """Frames as the API reports them; None for frame "model"."""
     if not frames or frames[0] is None:
         return None
-    return [{"center": list(f.center), "size": f.size} for f in frames if f is not None]
+    return [
+        {"center": list(f.center), "size": f.size, "rotation": f.rotation, "mirror": f.mirror, "reverse": f.reverse}
+        for f in frames
+        if f is not None
+    ]
 
 
 def with_metrics(body: dict[str, Any], curves: Sequence[np.ndarray], wanted: bool) -> dict[str, Any]:

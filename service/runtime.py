@@ -45,6 +45,7 @@ from geometry import (
     evaluate_bspline,
     fit_frame,
     mse_per_curve,
+    pose_frames,
     resample,
     sample_bspline,
     self_intersects,
@@ -57,6 +58,10 @@ log = logging.getLogger(__name__)
 
 FrameMode = Literal["auto", "model"]
 Spacing = Literal["parameter", "arc_length"]
+PoseMode = Literal["auto", "as_is"]
+#: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
+#: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
+POSE_CHORDS = 3
 _F32_MAX = float(np.finfo(np.float32).max)
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
 
@@ -133,6 +138,11 @@ class Prepared:
         np.ndarray | None
     ]  # where each input point sits along the model's points, in [0, 1]; None: same points
     inputs: list[np.ndarray]  # the caller's curves, float64
+    # With pose "auto", the curves are already encoded and decoded (that is how the pose is chosen):
+    mean: np.ndarray | None = None  # (B, latent_dim)
+    log_var: np.ndarray | None = None
+    decoded: np.ndarray | None = None  # (B, n_points, 2) model plane
+    ctrl: np.ndarray | None = None  # (B, n_ctrl, 2) with a B-spline head
 
 
 @dataclass(frozen=True)
@@ -311,38 +321,89 @@ class CurveRuntime:
     # ----------------------------------------------------------------------- caller's curves
 
     def prepare(
-        self, curves: Sequence[np.ndarray], frame: FrameMode = "auto", spacing: Spacing = "parameter"
+        self,
+        curves: Sequence[np.ndarray],
+        frame: FrameMode = "auto",
+        spacing: Spacing = "parameter",
+        pose: PoseMode = "auto",
     ) -> Prepared:
-        """Bring caller curves (each (n_i, 2), n_i ≥ 4) to the model's frame and point count."""
-        model, frames, fractions, inputs = [], [], [], []
+        """Bring caller curves (each (n_i, 2), n_i ≥ 4) to the model's frame and point count.
+
+        pose "auto" (frame "auto" only): each curve is tried in the poses of `geometry.pose_frames` — so a
+        curve, its reversal, mirror image and rotations all get the same candidates — encoded and decoded in
+        each, and the pose whose reconstruction is closest to the input is kept, with its latent.
+        """
+        posing = frame == "auto" and pose == "auto"
+        rows, owner, frames, fractions, inputs = [], [], [], [], []
         with np.errstate(all="ignore"):
             for i, c in enumerate(curves):
                 pts = np.asarray(c, dtype=np.float64)
+                inputs.append(pts)
                 try:
-                    f = fit_frame(pts) if frame == "auto" else None
+                    candidates: list[Frame | None] = (
+                        list(pose_frames(pts, chords=POSE_CHORDS))
+                        if posing
+                        else [fit_frame(pts) if frame == "auto" else None]
+                    )
                 except ValueError as e:  # all points coincide
                     raise InputError(("curves", i), str(e)) from e
-                m = f.to_model(pts, self.model_size) if f is not None else pts
-                fraction = None
-                if spacing == "arc_length":
-                    fraction = arc_fractions(m)
-                    m = resample(m, self.n_points)
-                elif len(pts) != self.n_points:
-                    fraction = np.linspace(0.0, 1.0, len(pts))
-                    m = resample(m, self.n_points, spacing=spacing)
-                if not (np.abs(m) <= _F32_MAX).all():  # also false for inf and nan
-                    raise InputError(
-                        ("curves", i),
-                        "its extent is too small or too large to map to the model's frame"
-                        if f is not None
-                        else 'coordinates beyond float32 range; use frame "auto"',
-                    )
-                model.append(m)
-                frames.append(f)
-                fractions.append(fraction)
-                inputs.append(pts)
-        batch = np.stack(model).astype(np.float32) if model else np.zeros((0, self.n_points, 2), np.float32)
-        return Prepared(batch, frames, fractions, inputs)
+                for f in candidates:
+                    m, fraction = self._to_model_points(pts, f, spacing, i)
+                    rows.append(m)
+                    owner.append(i)
+                    frames.append(f)
+                    fractions.append(fraction)
+        batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, self.n_points, 2), np.float32)
+        if not posing:
+            return Prepared(batch, frames, fractions, inputs)
+        with np.errstate(all="ignore"):
+            mean, log_var = self.encode_model(batch)
+            _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+            decoded, ctrl = self.decode_model_splines(mean)
+            err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
+        owners = np.asarray(owner)
+        best = [int(np.flatnonzero(owners == i)[np.argmin(err[owners == i])]) for i in range(len(inputs))]
+        return Prepared(
+            batch[best],
+            [frames[b] for b in best],
+            [fractions[b] for b in best],
+            inputs,
+            mean[best],
+            log_var[best],
+            decoded[best],
+            None if ctrl is None else ctrl[best],
+        )
+
+    def _to_model_points(
+        self, pts: np.ndarray, f: Frame | None, spacing: Spacing, i: int
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """One caller curve -> its model-plane points (n_points, 2) and where its own points sit along them."""
+        m = f.to_model(pts, self.model_size) if f is not None else pts
+        fraction = None
+        if spacing == "arc_length":
+            fraction = arc_fractions(m)
+            m = resample(m, self.n_points)
+        elif len(pts) != self.n_points:
+            fraction = np.linspace(0.0, 1.0, len(pts))
+            m = resample(m, self.n_points, spacing=spacing)
+        if not (np.abs(m) <= _F32_MAX).all():  # also false for inf and nan
+            raise InputError(
+                ("curves", i),
+                "its extent is too small or too large to map to the model's frame"
+                if f is not None
+                else 'coordinates beyond float32 range; use frame "auto"',
+            )
+        return m, fraction
+
+    def _encoded(self, prep: Prepared) -> tuple[np.ndarray, np.ndarray]:
+        """Latent means and log-variances of prepared curves (computed once)."""
+        if prep.mean is not None and prep.log_var is not None:
+            return prep.mean, prep.log_var
+        with np.errstate(all="ignore"):
+            mean, log_var = self.encode_model(prep.model)
+        _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+        _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
+        return mean, log_var
 
     def _to_caller(
         self,
@@ -378,26 +439,29 @@ class CurveRuntime:
         else:  # evenly in the parameter: the basis is the same for every curve (cached by sample_bspline)
             u = None
             count = n_points or self.n_points
-        if frame is not None:
-            c = frame.from_model(c, self.model_size)
         if u is None:
             curve, u = sample_bspline(c, count, self.spline_degree), np.linspace(0.0, 1.0, count)
         else:
             curve = evaluate_bspline(c, u, self.spline_degree)
+        if frame is not None:  # a similarity maps a spline's points as it maps its control points
+            curve, c = frame.from_model(curve, self.model_size), frame.from_model(c, self.model_size)
+            u = frame.to_caller_params(u)
         if splines is not None:
             assert self.knots is not None
             splines.append(Spline(c, self.knots, self.spline_degree, u))
         return curve
 
     def encode(
-        self, curves: Sequence[np.ndarray], *, frame: FrameMode = "auto", spacing: Spacing = "parameter"
+        self,
+        curves: Sequence[np.ndarray],
+        *,
+        frame: FrameMode = "auto",
+        spacing: Spacing = "parameter",
+        pose: PoseMode = "auto",
     ) -> tuple[np.ndarray, np.ndarray, list[Frame | None]]:
-        """Latent mean and log-variance of each curve, and the frame each was mapped from."""
-        prep = self.prepare(curves, frame, spacing)
-        with np.errstate(all="ignore"):
-            mean, log_var = self.encode_model(prep.model)
-        _check_finite(mean, "curves", _ENCODE_OVERFLOW)
-        _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
+        """Latent mean and log-variance of each curve, and the frame (with its pose) each was mapped from."""
+        prep = self.prepare(curves, frame, spacing, pose)
+        mean, log_var = self._encoded(prep)
         return mean, log_var, prep.frames
 
     def decode(
@@ -456,17 +520,20 @@ class CurveRuntime:
         n_points: int | None = None,
         spacing: Spacing = "parameter",
         splines: list[Spline] | None = None,
+        pose: PoseMode = "auto",
     ) -> tuple[list[np.ndarray], np.ndarray]:
         """Encode the means, decode them; the curves in the caller's frame and their MSE (paper eq. 4) there.
 
         The MSE compares each input with its reconstruction at the input's own points,
         whatever `n_points` asks for the returned curves.
         """
-        prep = self.prepare(curves, frame, spacing)
+        prep = self.prepare(curves, frame, spacing, pose)
         with np.errstate(all="ignore"):
-            mean, _ = self.encode_model(prep.model)
-            _check_finite(mean, "curves", _ENCODE_OVERFLOW)
-            out, ctrl = self.decode_model_splines(mean)
+            if prep.decoded is not None:
+                out, ctrl = prep.decoded, prep.ctrl
+            else:
+                mean, _ = self._encoded(prep)
+                out, ctrl = self.decode_model_splines(mean)
             results, mse = [], np.empty(len(out))
             for i, o in enumerate(out):
                 c = None if ctrl is None else ctrl[i]
@@ -493,6 +560,7 @@ class CurveRuntime:
         n_points: int | None = None,
         spacing: Spacing = "parameter",
         splines: list[Spline] | None = None,
+        pose: PoseMode = "auto",
     ) -> tuple[np.ndarray, list[Frame | None]]:
         """Decode affine combinations of the curves' latent means (paper eqs. 9, 10), one per weight row.
 
@@ -500,10 +568,8 @@ class CurveRuntime:
         comes back in the same blend of the inputs' frames. Length: n_points; else the
         inputs' common length, at the blend of their points' positions; else the model's.
         """
-        prep = self.prepare(curves, frame, spacing)
-        with np.errstate(all="ignore"):
-            mean, _ = self.encode_model(prep.model)
-        _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+        prep = self.prepare(curves, frame, spacing, pose)
+        mean, _ = self._encoded(prep)
         return self._mix(prep, mean.astype(np.float64), np.asarray(weights, np.float64), n_points, spacing, splines)
 
     def _mix(
@@ -636,6 +702,7 @@ class CurveRuntime:
         neighbours: int | None = None,
         frame: FrameMode = "auto",
         spacing: Spacing = "parameter",
+        pose: PoseMode = "auto",
     ) -> AugmentPlan:
         """Encode the seed curves once and fix who may be mixed with whom; see `AugmentPlan`.
 
@@ -656,11 +723,8 @@ class CurveRuntime:
                 f"at most {len(curves) - 1} (each curve has {len(curves) - 1} others), got {neighbours}; "
                 "omit it to mix any curve with any other",
             )
-        prep = self.prepare(curves, frame, spacing)
-        with np.errstate(all="ignore"):
-            mean, _ = self.encode_model(prep.model)
-        _check_finite(mean, "curves", _ENCODE_OVERFLOW)
-        mean = mean.astype(np.float64)
+        prep = self.prepare(curves, frame, spacing, pose)
+        mean = self._encoded(prep)[0].astype(np.float64)
         n = len(mean)
         distance = np.linalg.norm(mean[:, None, :] - mean[None, :, :], axis=-1)  # (n, n)
         np.fill_diagonal(distance, np.inf)  # never one's own partner
@@ -712,6 +776,7 @@ class CurveRuntime:
         frame: FrameMode = "auto",
         n_points: int | None = None,
         spacing: Spacing = "parameter",
+        pose: PoseMode = "auto",
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
         """`count` random interpolants of the curves, items offset … offset+count-1 of the seeded
         sequence: data augmentation with the VAE (paper §4).
@@ -727,6 +792,7 @@ class CurveRuntime:
             neighbours=neighbours,
             frame=frame,
             spacing=spacing,
+            pose=pose,
         )
         return self.augment_batch(plan, offset, offset + count, n_points=n_points, spacing=spacing)
 

@@ -17,6 +17,8 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import PydanticCustomError
 
+from geometry import Frame
+
 FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # numbers only: no "1.5", no true
 
 Point = Annotated[tuple[FiniteFloat, FiniteFloat], Field(description="[x, y]")]
@@ -44,6 +46,20 @@ FrameMode = Annotated[
             '"auto": each curve is shifted and uniformly scaled into the model\'s frame and results are '
             'mapped back, so curves may be anywhere at any size. "model": coordinates are already in the '
             "paper's 128×128 plane (curves about 100 units across, centred on (64, 64)) and pass untouched."
+        )
+    ),
+]
+
+PoseMode = Annotated[
+    Literal["auto", "as_is"],
+    Field(
+        description=(
+            '"auto" (default, with frame "auto"): each curve is tried in six poses — mirrored if it turns '
+            "clockwise, its chord (first point to last) turned to -90°, -45° or -135°, each also reversed and "
+            "mirrored across the chord — and the pose whose reconstruction is closest to the input is kept, so a "
+            "curve, its reversal, mirror image and any rotation give the same curve back (6× the inference). "
+            'Results come back in the caller\'s pose. "as_is": the curve is encoded as it is oriented. With frame '
+            '"model" curves are always taken as they are.'
         )
     ),
 ]
@@ -146,12 +162,21 @@ MetricsOut = Annotated[
 
 
 class FrameInfo(BaseModel):
-    """Where a curve lives: centre of its bounding box and its larger side."""
+    """Where a curve lives: centre of its bounding box and its larger side; and the pose that turned it into the
+    model's orientation (pose "auto"). Mapping into a frame applies the pose's inverse: rotation, mirror and order."""
 
     center: tuple[FiniteFloat, FiniteFloat] = Field(description="Bounding-box centre [x, y].")
     size: Annotated[
         float, Field(gt=0, strict=True, allow_inf_nan=False, description="Larger side of the bounding box.")
     ]
+    rotation: FiniteFloat = Field(
+        0.0, description="Radians, counter-clockwise, the curve was turned by (after `mirror`) to reach the model."
+    )
+    mirror: bool = Field(False, strict=True, description="Whether it was mirrored (x -> -x about `center`) first.")
+    reverse: bool = Field(False, strict=True, description="Whether the curve's point order was reversed.")
+
+    def frame(self) -> Frame:
+        return Frame(self.center, self.size, self.rotation, self.mirror, self.reverse)
 
 
 class EncodeRequest(_Request):
@@ -159,6 +184,7 @@ class EncodeRequest(_Request):
 
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
     frame: FrameMode = "auto"
+    pose: PoseMode = "auto"
     spacing: SpacingMode = "parameter"
 
 
@@ -214,6 +240,7 @@ class ReconstructRequest(_Request):
 
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
     frame: FrameMode = "auto"
+    pose: PoseMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
     output: OutputMode = "points"
@@ -248,6 +275,7 @@ class InterpolateRequest(_Request):
         "extrapolate). One interpolant per row.",
     )
     frame: FrameMode = "auto"
+    pose: PoseMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
     output: OutputMode = "points"
@@ -367,6 +395,7 @@ class AugmentRequest(_Request):
         "the same request with format json (paged) gives the sources and weights.",
     )
     frame: FrameMode = "auto"
+    pose: PoseMode = "auto"
     spacing: SpacingMode = "parameter"
     n_points: NPoints = None
     output: OutputMode = "points"

@@ -13,6 +13,7 @@ from geometry import random_control_points, sample_bspline, self_intersects
 from training.io import atomic_path
 
 FORMAT_VERSION = 1
+MIXES = ("paper", "broad")
 
 
 @dataclass(frozen=True)
@@ -25,6 +26,14 @@ class DataConfig:
     n_points: int = 161  # samples per curve, evenly spaced in the curve parameter
     radius: float = 64.0  # control points lie in this circle ...
     center: tuple[float, float] = (64.0, 64.0)  # ... centred in the 128×128 plane
+    # "paper": every split is the paper's curves. "broad": training and validation curves come from the broad
+    # mix of training/families.py (any spacing, shapes beyond the paper's, in the service's pose and frame);
+    # the test split stays the paper's, the one eq. 4's MSE is reported on.
+    mix: str = "paper"
+
+    def __post_init__(self) -> None:
+        if self.mix not in MIXES:
+            raise ValueError(f"mix must be one of {', '.join(MIXES)}, got {self.mix!r}")
 
 
 def generate_curves(
@@ -77,6 +86,11 @@ class CurveDataset:
             center=config.center,
         )
         a, b = config.n_train, config.n_train + config.n_val
+        if config.mix == "broad":
+            from training.families import broad_mix
+
+            mixed = broad_mix(b, config.seed + 1, n_points=config.n_points)
+            return cls(config, mixed[:a], mixed[a:b], curves[b:], ctrl[b:])
         return cls(config, curves[:a], curves[a:b], curves[b:], ctrl[b:])
 
     def save(self, path: str | Path) -> None:

@@ -15,7 +15,6 @@ import numpy as np
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import JSONResponse, Response, StreamingResponse
 
-from geometry import Frame
 from service import schemas as s
 from service.api_docs import C1, C2, C3, POST_ERRORS, curl_sample, example
 from service.deps import (
@@ -70,7 +69,7 @@ async def encode(
     curves = check_curves(req.curves, settings)
 
     def work() -> Response:
-        mean, log_var, frames = runtime.encode(curves, frame=req.frame, spacing=req.spacing)
+        mean, log_var, frames = runtime.encode(curves, frame=req.frame, spacing=req.spacing, pose=req.pose)
         return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": frames_json(frames)})
 
     return await run_inference(request, "/encode", len(curves), work)
@@ -113,7 +112,7 @@ async def decode(
     if req.frames is not None and len(req.frames) != len(req.latents):
         raise InputError(("frames",), f"expected one frame per latent ({len(req.latents)}), got {len(req.frames)}")
     check_n_points(req.n_points, settings)
-    frames = [Frame(center=f.center, size=f.size) for f in req.frames] if req.frames else None
+    frames = [f.frame() for f in req.frames] if req.frames else None
 
     splines = splines_wanted(req.output, runtime)
 
@@ -159,7 +158,7 @@ async def reconstruct(
 
     def work() -> Response:
         out, mse = runtime.reconstruct(
-            curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines
+            curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines, pose=req.pose
         )
         body = with_metrics({"curves": [c.tolist() for c in out], "mse": mse.tolist()}, out, req.metrics)
         return JSONResponse(with_output(body, splines, req.output))
@@ -213,7 +212,7 @@ async def interpolate(
 
     def work() -> Response:
         out, frames = runtime.interpolate(
-            curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines
+            curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines, pose=req.pose
         )
         body = {"weights": weights.tolist(), "curves": out.tolist(), "frames": frames_json(frames)}
         return JSONResponse(with_output(with_metrics(body, out, req.metrics), splines, req.output))
@@ -257,7 +256,7 @@ async def sample(
         raise InputError(("count",), f"at most {settings.max_curves}, got {req.count}")
     check_n_points(req.n_points, settings)
     seed = fresh_seed() if req.seed is None else req.seed
-    frame = Frame(center=req.frame.center, size=req.frame.size) if req.frame else None
+    frame = req.frame.frame() if req.frame else None
 
     splines = splines_wanted(req.output, runtime)
 
@@ -351,7 +350,13 @@ async def augment(
 
     def plan() -> AugmentPlan:
         return runtime.plan_augment(
-            curves, mode=req.mode, seed=seed, neighbours=req.neighbours, frame=req.frame, spacing=req.spacing
+            curves,
+            mode=req.mode,
+            seed=seed,
+            neighbours=req.neighbours,
+            frame=req.frame,
+            spacing=req.spacing,
+            pose=req.pose,
         )
 
     if req.format == "npy":

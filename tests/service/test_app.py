@@ -16,12 +16,21 @@ CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 
 def test_encode(client, curves, runtime):
     c = curves(2, 100) * 0.5 + 300
-    r = client.post("/encode", json={"curves": c.tolist()})
+    r = client.post("/encode", json={"curves": c.tolist(), "pose": "as_is"})
     assert r.status_code == 200
     body = r.json()
     assert np.shape(body["mean"]) == np.shape(body["log_var"]) == (2, 32)
-    assert body["frames"] == [{"center": list(fit_frame(x).center), "size": fit_frame(x).size} for x in c]
-    mean, _, _ = runtime.encode(list(c))
+    assert body["frames"] == [
+        {
+            "center": list(fit_frame(x).center),
+            "size": fit_frame(x).size,
+            "rotation": 0.0,
+            "mirror": False,
+            "reverse": False,
+        }
+        for x in c
+    ]
+    mean, _, _ = runtime.encode(list(c), pose="as_is")
     np.testing.assert_allclose(body["mean"], mean, rtol=1e-6)
 
 

@@ -1,0 +1,61 @@
+"""Pose "auto": a curve, its reversal, mirror image and rotations come back as the same curve, moved alike."""
+
+import numpy as np
+import pytest
+
+from geometry import sample_bspline
+
+
+def _rot(a: float) -> np.ndarray:
+    return np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+
+
+def _stroke() -> np.ndarray:
+    """An S-shaped stroke from corner to corner, drawn left to right: nothing like the paper's curves' pose."""
+    ctrl = np.array([[0.0, 0.0], [40.0, 5.0], [10.0, 50.0], [60.0, 60.0], [90.0, 40.0], [100.0, 90.0]])
+    return sample_bspline(ctrl[None], 120)[0]
+
+
+MOVES = {
+    "reversed": (lambda c: c[::-1], lambda c: c[::-1]),
+    "mirrored": (lambda c: c * [-1.0, 1.0], lambda c: c * [-1.0, 1.0]),
+    "rotated 130°": (lambda c: c @ _rot(np.radians(130)), lambda c: c @ _rot(np.radians(130)).T),
+}
+
+
+@pytest.mark.parametrize("move", MOVES)
+def test_reconstruction_does_not_care_about_the_move(shipped_runtime, move):
+    c = _stroke()
+    there, back = MOVES[move]
+    (own,), _ = shipped_runtime.reconstruct([c])
+    (moved,), _ = shipped_runtime.reconstruct([there(c)])
+    np.testing.assert_allclose(back(moved), own, atol=1e-3 * np.ptp(c))
+
+
+def test_pose_auto_beats_as_is_on_a_stroke_unlike_the_papers_curves(shipped_runtime):
+    c = _stroke()
+    diag = np.hypot(*np.ptp(c, axis=0))
+    _, auto = shipped_runtime.reconstruct([c])
+    _, as_is = shipped_runtime.reconstruct([c], pose="as_is")
+    assert np.sqrt(2 * auto[0]) / diag < 0.02  # within 2% of the diagonal (eq. 4 MSE averages both coordinates)
+    assert auto[0] < as_is[0] / 4
+
+
+def test_interpolating_a_curve_with_its_reversal_gives_the_curve(shipped_runtime):
+    c = _stroke()
+    (own,), _ = shipped_runtime.reconstruct([c], n_points=len(c))
+    w = np.array([[1.0, 0.0], [0.7, 0.3], [0.5, 0.5], [0.2, 0.8]])
+    out, frames = shipped_runtime.interpolate([c, c[::-1]], w)
+    mine = shipped_runtime.encode([c])[2][0]
+    for curve, frame in zip(out, frames):  # in the order of the heavier source
+        np.testing.assert_allclose(curve if frame.reverse == mine.reverse else curve[::-1], own, atol=1e-6 * np.ptp(c))
+
+
+def test_spline_output_matches_the_points_in_a_reversed_pose(shipped_runtime):
+    c = _stroke()[::-1] * [1.0, -1.0]
+    splines = []
+    (pts,), _ = shipped_runtime.reconstruct([c], splines=splines)
+    s = splines[0]
+    from geometry import evaluate_bspline
+
+    np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params, s.degree), pts, atol=1e-9)

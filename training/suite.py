@@ -1,0 +1,107 @@
+"""The evaluation suite of curve families: how a model does on the curves people send, through the service's own
+runtime (frames, resampling, pose), exactly as users receive it.
+
+Sets, each measured by relative RMSE (RMSE over the input's own points ÷ its bounding-box diagonal), roughness
+of the reconstruction ÷ the input's, and the share of reconstructions that cross themselves:
+
+- the paper's test curves as generated, resampled by arc length, reversed, mirrored and rotated (any angle);
+- each training family of training/families.py, fresh curves at random spacings and poses;
+- HELD_OUT families, never trained on: generalisation, not memory;
+- real airfoils (the UIUC database, read from aerosandbox's wheel when data/ has it).
+
+Torch-free: it needs only a model directory.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from geometry import resample, self_intersects, smoothness
+from training.families import HELD_OUT, TRAIN_FAMILIES, draw_family
+
+AIRFOIL_WHEEL = Path("data/aerosandbox-4.2.10-py3-none-any.whl")
+
+
+def random_moves(curves: list[np.ndarray], rng: np.random.Generator) -> list[np.ndarray]:
+    """Each curve turned by a random angle, mirrored or reversed at random: a user's drawing in any pose."""
+    out = []
+    for c in curves:
+        a = rng.uniform(0, 2 * np.pi)
+        rot = np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+        c = (c * ([-1.0, 1.0] if rng.random() < 0.5 else 1.0)) @ rot
+        out.append(c[::-1] if rng.random() < 0.5 else c)
+    return out
+
+
+def suite_sets(test_curves: np.ndarray, count: int = 200, seed: int = 2024) -> dict[str, tuple[str, list[np.ndarray]]]:
+    """name -> (kind, curves): kind "paper", "trained" or "held out"/"real" families."""
+    rng = np.random.default_rng(seed)
+    paper = [np.asarray(c, np.float64) for c in test_curves[:count]]
+    angle = rng.uniform(0, 2 * np.pi, len(paper))
+    sets: dict[str, tuple[str, list[np.ndarray]]] = {
+        "paper": ("paper", paper),
+        "paper, arc-length spacing": ("paper", [resample(c, len(c)) for c in paper]),
+        "paper, reversed": ("paper", [c[::-1] for c in paper]),
+        "paper, mirrored": ("paper", [c * [-1.0, 1.0] for c in paper]),
+        "paper, rotated": (
+            "paper",
+            [c @ np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]]) for c, a in zip(paper, angle)],
+        ),
+    }
+    for name, fam in TRAIN_FAMILIES.items():
+        if name != "paper":
+            drawn = draw_family(fam, count, rng, model_size=None).astype(np.float64)
+            sets[name] = ("trained", random_moves(list(drawn), rng))
+    for name, fam in HELD_OUT.items():
+        drawn = draw_family(fam, count, rng, model_size=None).astype(np.float64)
+        sets[name] = ("held out", random_moves(list(drawn), rng))
+    if AIRFOIL_WHEEL.exists():
+        from training.airfoils import load_airfoils
+
+        sets["airfoils (UIUC)"] = ("real", load_airfoils(AIRFOIL_WHEEL, count, seed=seed))
+    return sets
+
+
+def relative_rmse(inputs: list[np.ndarray], outputs: list[np.ndarray]) -> np.ndarray:
+    """RMSE over each input's own points ÷ its bounding-box diagonal."""
+    return np.array(
+        [np.sqrt(((a - b) ** 2).sum(-1).mean()) / np.hypot(*np.ptp(a, axis=0)) for a, b in zip(inputs, outputs)]
+    )
+
+
+def measure(runtime: Any, curves: list[np.ndarray], **options: Any) -> dict[str, float]:
+    """One set through `runtime.reconstruct` (options: spacing, pose, …): its row of the suite's table."""
+    out, _ = runtime.reconstruct(curves, **options)
+    rel = relative_rmse(curves, out)
+    rough_in = np.array([smoothness(c)["roughness"] for c in curves])
+    rough_out = np.array([smoothness(o)["roughness"] for o in out])
+    return {
+        "n_curves": len(curves),
+        "rel_rmse_mean": float(rel.mean()),
+        "rel_rmse_p95": float(np.percentile(rel, 95)),
+        "rel_rmse_max": float(rel.max()),
+        "roughness_ratio": float(rough_out.mean() / max(rough_in.mean(), 1e-12)),
+        "self_intersecting": float(np.mean([bool(self_intersects(o)) for o in out])),
+    }
+
+
+def run_suite(runtime: Any, test_curves: np.ndarray, *, count: int = 200, **options: Any) -> dict[str, Any]:
+    """Every set of `suite_sets` measured with the given request options."""
+    return {
+        name: {"kind": kind, **measure(runtime, curves, **options)}
+        for name, (kind, curves) in suite_sets(test_curves, count).items()
+    }
+
+
+def format_suite(report: dict[str, Any]) -> str:
+    """The suite as a text table."""
+    lines = [f"{'set':28s} {'kind':9s} {'rel RMSE':>9s} {'p95':>7s} {'max':>7s} {'rough×':>7s} {'crossing':>8s}"]
+    for name, r in report.items():
+        lines.append(
+            f"{name:28s} {r['kind']:9s} {100 * r['rel_rmse_mean']:8.2f}% {100 * r['rel_rmse_p95']:6.2f}% "
+            f"{100 * r['rel_rmse_max']:6.2f}% {r['roughness_ratio']:7.2f} {100 * r['self_intersecting']:7.1f}%"
+        )
+    return "\n".join(lines)
