@@ -38,7 +38,7 @@ def _validation_message(err: dict[str, Any], request: Request) -> tuple[str, str
         return "body", f"invalid JSON ({ctx.get('error', 'cannot parse')}) at position {loc[0] if loc else 0}"
     if kind in ("model_attributes_type", "dict_type", "model_type") and not loc:
         hint = ""
-        if "json" not in request.headers.get("content-type", "json"):
+        if "json" not in request.headers.get("content-type", ""):
             hint = "; send it with the header Content-Type: application/json"
         return "body", "expected a JSON object" + hint
     messages = {
@@ -63,9 +63,31 @@ def _validation_message(err: dict[str, Any], request: Request) -> tuple[str, str
     return format_loc(loc), msg
 
 
+def _is_number(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _one_unwrapped_curve(body: Any) -> bool:
+    """Whether `curves` holds the points of a single curve ([[x, y], …]) instead of a list of curves."""
+    curves = body.get("curves") if isinstance(body, dict) else None
+    return (
+        isinstance(curves, list)
+        and len(curves) > 0
+        and all(isinstance(p, list) and len(p) == 2 and all(_is_number(v) for v in p) for p in curves)
+    )
+
+
+UNWRAPPED = 'expected a list of curves, got one curve\'s points: wrap it in a list, {"curves": [[[x, y], [x, y], ...]]}'
+
+
 async def on_validation_error(request: Request, exc: Exception) -> Response:
     assert isinstance(exc, RequestValidationError)
-    return error_response(422, [_validation_message(e, request) for e in exc.errors()])
+    errors = exc.errors()
+    if _one_unwrapped_curve(getattr(exc, "body", None)) and any(
+        list(e["loc"])[1:2] == ["curves"] and len(e["loc"]) == 4 for e in errors
+    ):
+        return error_response(422, [("curves", UNWRAPPED)])
+    return error_response(422, [_validation_message(e, request) for e in errors])
 
 
 async def on_input_error(request: Request, exc: Exception) -> Response:

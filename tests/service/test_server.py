@@ -180,3 +180,48 @@ def test_flags_override_the_environment(monkeypatch):
         parser.parse_args(["--port", "9002", "--cors-origins", "https://a.example,https://b"])
     )
     assert (settings.port, settings.workers, settings.cors_origins) == (9002, 3, ["https://a.example", "https://b"])
+
+
+def test_an_oversized_body_from_the_standard_library_client_gets_the_413(live_server):
+    """urllib sends the whole body before it reads the answer: the server reads the rest and drops it, then answers."""
+    import urllib.error
+    import urllib.request
+
+    body = json.dumps({"curves": [np.linspace(0, 1, 8000).reshape(-1, 2).tolist()] * 40}).encode()  # ~3 MB
+    assert len(body) > 10 * 200_000  # far over the server's --max-body-bytes
+    req = urllib.request.Request(
+        f"{live_server.url}/encode", data=body, headers={"Content-Type": "application/json"}, method="POST"
+    )
+    with pytest.raises(urllib.error.HTTPError) as err:
+        urllib.request.urlopen(req, timeout=30)
+    assert err.value.code == 413
+    assert "exceeds the limit of 200000 bytes" in json.loads(err.value.read())["detail"]
+    assert httpx.get(f"{live_server.url}/health").status_code == 200
+
+
+def test_an_oversized_body_after_expect_100_continue_is_refused_unread(live_server):
+    """curl asks before sending a large body: the 413 comes at once and the body is never sent."""
+    if shutil.which("curl") is None:
+        pytest.skip("curl is not installed")
+    out = subprocess.run(
+        [
+            "curl",
+            "-s",
+            "-o",
+            "/dev/null",
+            "-w",
+            "%{http_code} %{size_upload}",
+            "-H",
+            "Content-Type: application/json",
+            "-H",
+            "Expect: 100-continue",
+            "--data-binary",
+            "@-",
+            f"{live_server.url}/encode",
+        ],
+        input=b"[" + b"0," * 1_000_000 + b"0]",
+        capture_output=True,
+        timeout=30,
+    )
+    code, uploaded = out.stdout.decode().split()
+    assert code == "413" and float(uploaded) < 2_000_000

@@ -496,3 +496,16 @@ def test_integral_numbers_are_integers_as_in_json_schema(client):
     same = client.post("/sample", json={"count": 3, "seed": 7, "n_points": 50})
     assert ok.status_code == 200 and ok.json() == same.json()
     assert client.post("/sample", json={"count": 3.5}).json()["detail"] == "count: not an integer"
+
+
+@pytest.mark.parametrize("path", ["/encode", "/reconstruct", "/interpolate", "/augment"])
+def test_one_curve_not_wrapped_in_a_list_gets_one_error_that_says_wrap_it(client, path):
+    r = client.post(path, json={"curves": [[0, 0], [1, 2], [2, 3], [3, 1]]})
+    assert r.status_code == 422
+    body = r.json()
+    assert len(body["errors"]) == 1 and "wrap it in a list" in body["detail"], body
+
+
+def test_a_body_without_content_type_gets_the_header_hint(client):
+    r = client.post("/encode", content=json.dumps({"curves": [C]}).encode(), headers={"Content-Type": ""})
+    assert r.status_code == 422 and "Content-Type: application/json" in r.json()["detail"], r.json()
