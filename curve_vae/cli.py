@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from curve_vae.files import refuse_overwrite
+from curve_vae.progress import bar, counted, shown
 
 DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
 DEFAULT_MODELS = "models"
@@ -168,7 +169,7 @@ def cmd_train(a: argparse.Namespace) -> int:
         cfg,
         data_cache=_data_path(a, _data_config(a)),
         resume=a.resume,
-        progress=not a.no_progress,
+        progress=shown(a.no_progress),
         stop_after=a.stop_after,
         init_from=a.init_from or None,
     )
@@ -408,6 +409,8 @@ def cmd_sample(a: argparse.Namespace) -> int:
 
 
 def cmd_augment(a: argparse.Namespace) -> int:
+    import numpy as np
+
     from curve_vae.files import read_curves, write_npy_chunks, write_output
     from service.payloads import augment_body
     from service.runtime import fresh_seed
@@ -425,19 +428,28 @@ def cmd_augment(a: argparse.Namespace) -> int:
         pose=a.pose,
     )
     start, stop = a.offset, a.offset + a.count
-    if a.output.endswith(".npy"):  # streamed chunk by chunk: any count in bounded memory
-        if a.metrics:
-            raise ValueError("--metrics needs a JSON output: a .npy file holds the curves alone")
-        shape = (a.count, runtime.mix_length(plan.prep, a.n_points), 2)
-        write_npy_chunks(
-            a.output, shape, runtime.augment_chunks(plan, start, stop, n_points=a.n_points, spacing=a.spacing)
-        )
-    else:
-        out, sources, weights, frames = runtime.augment_batch(plan, start, stop, n_points=a.n_points, spacing=a.spacing)
-        shape = out.shape
-        write_output(
-            a.output, augment_body(out, sources, weights, frames, seed=seed, offset=a.offset, metrics=a.metrics)
-        )
+    step = runtime.batch_size
+    with bar(a.count, "augment", enabled=shown(a.no_progress)) as progress:
+        if a.output.endswith(".npy"):  # streamed chunk by chunk: any count in bounded memory
+            if a.metrics:
+                raise ValueError("--metrics needs a JSON output: a .npy file holds the curves alone")
+            shape = (a.count, runtime.mix_length(plan.prep, a.n_points), 2)
+            chunks = runtime.augment_chunks(plan, start, stop, n_points=a.n_points, spacing=a.spacing, chunk=step)
+            write_npy_chunks(a.output, shape, counted(chunks, progress))
+        else:
+            parts = []
+            for i in range(start, stop, step):
+                parts.append(
+                    runtime.augment_batch(plan, i, min(i + step, stop), n_points=a.n_points, spacing=a.spacing)
+                )
+                progress.update(len(parts[-1][0]))
+            out = np.concatenate([p[0] for p in parts]) if parts else np.zeros((0, runtime.n_points, 2))
+            sources = np.concatenate([p[1] for p in parts]) if parts else np.zeros((0, 2), np.int64)
+            weights = np.concatenate([p[2] for p in parts]) if parts else np.zeros((0, 2))
+            frames = [f for p in parts for f in p[3]]
+            shape = out.shape
+            body = augment_body(out, sources, weights, frames, seed=seed, offset=a.offset, metrics=a.metrics)
+            write_output(a.output, body)
     print(f"{a.output}: {a.count} new curves of {shape[1]} points ({a.mode}s), seed {seed}", file=sys.stderr)
     return 0
 
@@ -472,6 +484,7 @@ def _add_generate_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--metrics", action="store_true", help="add smoothness, self-intersection and length per curve (JSON only)"
     )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar (none either when not on a terminal)")
 
 
 # ------------------------------------------------------------------------ fit, revolve
@@ -555,7 +568,11 @@ def build_parser() -> argparse.ArgumentParser:
         default=0,
         help="stop after this many epochs of this call; resume later (default: 0 = run to --epochs)",
     )
-    s.add_argument("--no-progress", action="store_true", help="no progress bar; one line per epoch")
+    s.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress bar (none either when stderr is not a terminal); one line per epoch",
+    )
     s.add_argument(
         "--init-from",
         default="",

@@ -10,8 +10,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import platform
 import time
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -71,9 +75,25 @@ def sha256(path: str | Path) -> str:
     return h.hexdigest()
 
 
+@contextmanager
+def _quiet_exporter() -> Iterator[None]:
+    """Silence what the exporter says that no user can act on: torchvision being absent (its detection ops are not
+    used here) and a deprecation inside torch's own pytree code. Real problems still raise."""
+    registry = logging.getLogger("torch.onnx._internal.exporter._registration")
+    level = registry.level
+    registry.setLevel(logging.ERROR)
+    try:
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=r".*isinstance\(treespec, LeafSpec\).*", category=FutureWarning)
+            yield
+    finally:
+        registry.setLevel(level)
+
+
 def _export(module: nn.Module, example: torch.Tensor, path: Path, in_name: str, out_names: list[str]) -> None:
     batch = torch.export.Dim("batch", min=1, max=1 << 20)
-    with atomic_path(path) as tmp:
+    module = module.eval()  # inference graphs: BatchNorm on its running statistics
+    with atomic_path(path) as tmp, _quiet_exporter():
         program = torch.onnx.export(
             module,
             (example,),

@@ -156,8 +156,8 @@ def train_one_epoch(
         n_batches += 1
         for k, v in terms.items():
             sums[k] = sums.get(k, 0.0) + float(v.detach())
-        if bar is not None:
-            bar.update(len(x))
+        if bar is not None:  # a time-budgeted run's bar counts seconds of the budget; an epoch's, curves
+            bar.update(min(clock.elapsed(), clock.budget) - bar.n if clock is not None and clock.budget > 0 else len(x))
             if n_batches % 10 == 0:
                 bar.set_postfix({k: f"{sums[k] / n_batches:.4g}" for k in ("loss", "mse", "kl", "lap")})
     return {**{k: v / max(1, n_batches) for k, v in sums.items()}, "steps": n_batches}
@@ -331,11 +331,25 @@ def train(
             )
 
         end = cfg.epochs if not stop_after else min(cfg.epochs, state.epoch + stop_after)
+        budget_bar = (  # a time-budgeted run ends with its budget, not after an epoch count: its bar shows time
+            tqdm(
+                total=round(cfg.time_budget),
+                initial=round(min(state.trained_seconds, cfg.time_budget)),
+                desc="time budget",
+                unit="s",
+                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total:.0f} s{postfix}",
+                disable=not progress or rank != 0,
+                leave=False,
+                dynamic_ncols=True,
+            )
+            if cfg.time_budget > 0
+            else None
+        )
         while state.epoch < end:
             t0 = time.perf_counter()
             perm = torch.from_numpy(gen.permutation(len(data)))  # same on every rank
             order = perm[rank::world][: steps_per_epoch * (cfg.batch_size // world)]
-            bar = tqdm(
+            bar = budget_bar or tqdm(
                 total=len(order),
                 desc=f"epoch {state.epoch + 1}/{cfg.epochs}",
                 unit="curve",
@@ -345,7 +359,8 @@ def train(
             )
             with clock:
                 terms = train_one_epoch(net, data, order, opt, sched, cfg, device, bar=bar, clock=clock)
-            bar.close()
+            if budget_bar is None:
+                bar.close()
             train_time = time.perf_counter() - t0
             state.trained_seconds = clock.spent
             val_mse = validation_mse(model, val, device=device)
@@ -403,6 +418,8 @@ def train(
                 if rank == 0:
                     print(f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs", flush=True)
                 break
+        if budget_bar is not None:
+            budget_bar.close()
         return state
     finally:
         if distributed and dist.is_initialized():
