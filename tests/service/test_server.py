@@ -225,3 +225,59 @@ def test_an_oversized_body_after_expect_100_continue_is_refused_unread(live_serv
     )
     code, uploaded = out.stdout.decode().split()
     assert code == "413" and float(uploaded) < 2_000_000
+
+
+def _shown_scalars(block: str) -> list[tuple[str, str]]:
+    """The `"key":value` pairs with a literal number or string that a block's `# {...}` answer line shows."""
+    shown = "\n".join(line[2:] for line in block.splitlines() if line.startswith("# {"))
+    return re.findall(r'"(\w+)":(-?\d[\d.e-]*|"[^"]*")(?=[,}\]])', shown)
+
+
+def _first(answer, key: str):
+    """The first value of `key` in a JSON answer, depth first."""
+    if isinstance(answer, dict):
+        if key in answer:
+            return answer[key]
+        answer = list(answer.values())
+    if isinstance(answer, list):
+        for item in answer:
+            found = _first(item, key)
+            if found is not None:
+                return found
+    return None
+
+
+@pytest.fixture(scope="module")
+def shipped_server():
+    from tests.service.conftest import SHIPPED, LiveServer
+
+    if not (SHIPPED / "manifest.json").is_file():
+        pytest.skip("no shipped model")
+    server = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
+    try:
+        server.wait_ready()
+        yield server
+    finally:
+        server.stop()
+
+
+SHOWN = [b for b in _curl_blocks() if _shown_scalars(b) and "-o " not in b and "%{http_code}" not in b]
+
+
+@pytest.mark.skipif(shutil.which("curl") is None, reason="curl is not installed")
+@pytest.mark.parametrize("block", SHOWN, ids=lambda b: b.split("http://127.0.0.1:8000")[1].split()[0])
+def test_readme_answers_show_what_the_shipped_model_answers(shipped_server, block, tmp_path):
+    """Every number and string a README example shows in its answer is what the shipped model answers, to the
+    digits shown."""
+    command = block.replace("http://127.0.0.1:8000", shipped_server.url)
+    out = subprocess.run(["bash", "-c", command], capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    answer = json.loads(out.stdout)
+    for key, shown in _shown_scalars(block):
+        actual = _first(answer, key)
+        if shown.startswith('"'):
+            assert actual == shown.strip('"'), (key, shown, actual)
+            continue
+        digits = shown.split("e")[0].split(".")[1] if "." in shown.split("e")[0] else ""
+        exponent = int(shown.split("e")[1]) if "e" in shown else 0
+        unit = 10.0 ** (exponent - len(digits))
+        assert isinstance(actual, (int, float)) and abs(actual - float(shown)) <= unit, (key, shown, actual)
