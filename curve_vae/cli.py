@@ -200,7 +200,7 @@ def cmd_train(a: argparse.Namespace) -> int:
 
 
 def cmd_export(a: argparse.Namespace) -> int:
-    from training.data import DataConfig, load_or_generate
+    from training.data import DataConfig, generate_curves, load_or_generate
     from training.evaluate import onnx_codec, run_evaluation
     from training.export import export, model_size_of
     from training.io import atomic_write_text
@@ -246,13 +246,18 @@ def cmd_export(a: argparse.Namespace) -> int:
 
         from training.prior import FIT_CURVES, fit_prior
 
-        fit_on = ds.train[:FIT_CURVES]
+        # /sample draws the paper's curves: with the broad mix, the prior is fitted to the paper's training curves
+        fit_on = (
+            ds.train[:FIT_CURVES]
+            if data_cfg.mix == "paper"
+            else generate_curves(min(FIT_CURVES, data_cfg.n_train), data_cfg.seed, n_points=data_cfg.n_points)[0]
+        )
         with torch.no_grad():
             means = np.concatenate(
                 [model.encoder(torch.from_numpy(fit_on[i : i + 500]))[0].numpy() for i in range(0, len(fit_on), 500)]
             )
         prior = fit_prior(means, components=a.prior_components)
-        prior_info = {"fitted_on": f"latent means of the first {len(fit_on)} training curves"}
+        prior_info = {"fitted_on": f"latent means of the first {len(fit_on)} training curves of the paper's data set"}
         print(f"fitted a {a.prior_components}-component latent prior to {len(fit_on)} training curves")
     manifest = export(
         model,
@@ -266,8 +271,6 @@ def cmd_export(a: argparse.Namespace) -> int:
     )
     print(f"exported {a.checkpoint} → {a.out}/encoder.onnx, decoder.onnx, vae.pt, manifest.json")
     if a.evaluate:
-        from training.data import generate_curves
-
         fresh, _ = generate_curves(1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
         from service.runtime import CurveRuntime
 
@@ -279,6 +282,7 @@ def cmd_export(a: argparse.Namespace) -> int:
             Path(a.out) / "report",
             figures=False,
             runtime=CurveRuntime.load(a.out, providers="cpu"),
+            suite_count=a.suite_count,
         )
         manifest["metrics"] = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
         atomic_write_text(Path(a.out) / "manifest.json", json.dumps(manifest, indent=2) + "\n")
@@ -286,6 +290,10 @@ def cmd_export(a: argparse.Namespace) -> int:
         (Path(a.out) / "report").rmdir()
         for name, r in report["test_sets"].items():
             print(f"{name}: MSE {r['mse']:.4f} (median {r['mse_median']:.4f}) over {r['n_curves']} curves")
+        if "families" in report:
+            from training.suite import format_suite
+
+            print(format_suite(report["families"]))
     return 0
 
 
@@ -342,7 +350,9 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
             1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points
         )[0]
     log = Path(a.checkpoint).parent / "log.jsonl" if a.checkpoint else None
-    report = run_evaluation(enc, dec, sets, a.out, log_path=log, figures=not a.no_figures, runtime=runtime)
+    report = run_evaluation(
+        enc, dec, sets, a.out, log_path=log, figures=not a.no_figures, runtime=runtime, suite_count=a.suite_count
+    )
     for name, r in report["test_sets"].items():
         s_in, s_out = r["smoothness_input"]["roughness"], r["smoothness_output"]["roughness"]
         print(
@@ -364,11 +374,27 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
                 f"roughness {kept['roughness']:.3f}°, coverage {kept['coverage_vs_real']:.2f}×, "
                 f"precision {kept['precision_vs_real']:.2f}× of real curves'"
             )
+    if "families" in report:
+        from training.suite import format_suite
+
+        print("curve families (relative RMSE: RMSE ÷ bounding-box diagonal, through the service's runtime):")
+        print(format_suite(report["families"]))
     print(f"report: {Path(a.out) / 'report.json'}")
     return 0
 
 
 # ------------------------------------------------------------------- sample, augment
+
+
+def _add_suite_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--suite-count",
+        type=int,
+        default=200,
+        help="curves per set of the family suite (training/suite.py: the paper's curves moved and respaced, "
+        "other families, held-out ones, real airfoils where data/ has aerosandbox's wheel); 0 skips it "
+        "(default: 200)",
+    )
 
 
 def _runtime(a: argparse.Namespace):
@@ -621,6 +647,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=True,
         help="measure the exported graphs on both test sets and store the metrics in the manifest (default: on)",
     )
+    _add_suite_option(s)
     s.set_defaults(func=cmd_export)
 
     s = sub.add_parser(
@@ -659,6 +686,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", default="runs/evaluation", help="report.json and figures go here (default: runs/evaluation)"
     )
     s.add_argument("--no-figures", action="store_true", help="write only report.json")
+    _add_suite_option(s)
     s.set_defaults(func=cmd_evaluate)
 
     s = sub.add_parser("sample", help="new curves from the latent prior, offline (as POST /sample)")

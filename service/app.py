@@ -1,4 +1,4 @@
-"""The REST service: `create_app(settings)` builds a FastAPI app serving the VAE (v1 contract, DESIGN.md).
+"""The REST service: `create_app(settings)` builds a FastAPI app serving the VAE (v1 contract, docs/ARCHITECTURE.md).
 
 This module holds the lifespan (the model is loaded once per worker process, never at import
 time) and the app factory; the rest lives by concern:

@@ -19,8 +19,8 @@ TINY_DATA = ["--n-train", "256", "--n-val", "64", "--n-test", "64"]
 TINY = {
     "dataset": TINY_DATA,
     "train": [*TINY_DATA, "--epochs", "1", "--no-progress"],
-    "export": ["--prior-components", "2"],
-    "evaluate": ["--fresh-seed", "-1"],
+    "export": ["--prior-components", "2", "--suite-count", "8"],
+    "evaluate": ["--fresh-seed", "-1", "--suite-count", "8"],
     "average": ["--bn-curves", "128"],
     "augment": ["--count", "300"],
 }

@@ -390,11 +390,13 @@ def run_evaluation(
     log_path: Path | None = None,
     figures: bool = True,
     runtime: Any = None,
+    suite_count: int = 0,
 ) -> dict[str, Any]:
     """Evaluate on each named test set; write report.json (and figures) into out_dir.
 
     runtime: the exported model as the service runs it (service.runtime.CurveRuntime): adds the
-    generation report of its priors, the first test set held out and the second as the real reference.
+    generation report of its priors, the first test set held out and the second as the real reference,
+    and with suite_count > 0 the family suite (training/suite.py) of that many curves per set.
     """
     out = Path(out_dir)
     report: dict[str, Any] = {"test_sets": {}}
@@ -424,6 +426,12 @@ def run_evaluation(
             out / "interpolation_latent_vs_pointwise.png",
         )
         plot_latent_tsne(encode, first, out / "latent_tsne.png")
+    if runtime is not None and suite_count > 0:
+        from training.suite import plot_suite, run_suite, suite_sets
+
+        report["families"] = run_suite(runtime, first, count=suite_count)
+        if figures:
+            plot_suite(runtime, suite_sets(first, suite_count), out / "families.png")
     if figures and log_path is not None and log_path.exists():
         plot_training(log_path, out / "training.png")
     atomic_write_text(out / "report.json", json.dumps(report, indent=2) + "\n")

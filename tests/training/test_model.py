@@ -22,7 +22,7 @@ def test_shapes_forward_backward(variant, latent_dim):
 
 def test_reference_architecture_size():
     m = VAE(ModelConfig())
-    assert (m.encoder.feat_channels, m.encoder.feat_len) == (256, 16)  # Flatten 16×256, DESIGN.md
+    assert (m.encoder.feat_channels, m.encoder.feat_len) == (256, 16)  # Flatten 16×256, docs/ARCHITECTURE.md
     assert 1.8e6 < count_parameters(m) < 2.0e6
 
 
