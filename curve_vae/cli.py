@@ -269,7 +269,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         prior=prior,
         prior_info=prior_info,
     )
-    print(f"exported {a.checkpoint} → {a.out}/encoder.onnx, decoder.onnx, vae.pt, manifest.json")
+    print(f"exported {a.checkpoint} → {a.out}/: {', '.join(manifest['files'])}, manifest.json")
     if a.evaluate:
         fresh, _ = generate_curves(1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
         from service.runtime import CurveRuntime

@@ -61,7 +61,7 @@ Spacing = Literal["parameter", "arc_length"]
 PoseMode = Literal["auto", "as_is"]
 #: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
-POSE_CHORDS = 3
+POSE_CHORD_COUNT = 3
 _F32_MAX = float(np.finfo(np.float32).max)
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
 
@@ -341,7 +341,7 @@ class CurveRuntime:
                 inputs.append(pts)
                 try:
                     candidates: list[Frame | None] = (
-                        list(pose_frames(pts, chords=POSE_CHORDS))
+                        list(pose_frames(pts, chords=POSE_CHORD_COUNT))
                         if posing
                         else [fit_frame(pts) if frame == "auto" else None]
                     )
@@ -359,6 +359,7 @@ class CurveRuntime:
         with np.errstate(all="ignore"):
             mean, log_var = self.encode_model(batch)
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
+            _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
             decoded, ctrl = self.decode_model_splines(mean)
             err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
         owners = np.asarray(owner)

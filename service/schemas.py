@@ -56,8 +56,9 @@ PoseMode = Annotated[
         description=(
             '"auto" (default, with frame "auto"): each curve is tried in six poses — mirrored if it turns '
             "clockwise, its chord (first point to last) turned to -90°, -45° or -135°, each also reversed and "
-            "mirrored across the chord — and the pose whose reconstruction is closest to the input is kept, so a "
-            "curve, its reversal, mirror image and any rotation give the same curve back (6× the inference). "
+            "mirrored end for end (across the line normal to the chord) — and the pose whose reconstruction is "
+            "closest to the input is kept, so a curve, its reversal, mirror image and any rotation give the same "
+            "curve back (6× the inference). "
             'Results come back in the caller\'s pose. "as_is": the curve is encoded as it is oriented. With frame '
             '"model" curves are always taken as they are.'
         )

@@ -1,0 +1,70 @@
+"""The broad training mix and the evaluation suite: spacing, validity, pose, bookkeeping."""
+
+import numpy as np
+import pytest
+
+from geometry import fit_frame, self_intersects, signed_turning
+from geometry.frame import MODEL_CENTER, chord_heading
+from training import families as F
+from training.suite import format_suite, relative_rmse, run_suite, suite_sets
+
+
+@pytest.mark.parametrize("name", [*F.TRAIN_FAMILIES, *F.HELD_OUT])
+def test_every_family_draws_simple_finite_curves_in_the_models_pose_and_frame(name):
+    fam = {**F.TRAIN_FAMILIES, **F.HELD_OUT}[name]
+    curves = F.draw_family(fam, 64, np.random.default_rng(0), model_size=92.6)
+    assert curves.shape == (64, 161, 2) and curves.dtype == np.float32 and np.isfinite(curves).all()
+    assert not self_intersects(curves).any()
+    for c in curves.astype(np.float64):
+        f = fit_frame(c)
+        np.testing.assert_allclose(f.center, MODEL_CENTER, atol=1e-3)
+        assert f.size == pytest.approx(92.6, rel=1e-5)
+        assert signed_turning(c) >= -1e-4  # counter-clockwise, as the paper's curves turn (a straight line: 0)
+        assert -0.75 * np.pi - 1e-6 <= chord_heading(c) <= -0.25 * np.pi + 1e-6
+
+
+def test_spacings_put_points_where_they_say():
+    t = np.linspace(0, 1, F.DENSE)
+    dense = np.stack([t**3, np.zeros_like(t)], 1)[None].repeat(3, axis=0)  # x = u³: parameter ≠ arc length
+    rng = np.random.default_rng(1)
+    param, arc, warped = F.respace(dense, 41, ["parameter", "arc_length", "warped"], rng)
+    np.testing.assert_allclose(param[:, 0], np.linspace(0, 1, 41) ** 3, atol=1e-5)
+    np.testing.assert_allclose(np.diff(arc[:, 0]), 1 / 40, atol=1e-4)  # evenly by arc length
+    gaps = np.diff(warped[:, 0])
+    assert (gaps > 0).all() and warped[0, 0] == 0 and warped[-1, 0] == pytest.approx(1)
+    assert not np.allclose(warped[:, 0], param[:, 0], atol=1e-3)
+
+
+def test_warps_are_monotone_and_end_to_end():
+    w = F.warp(np.random.default_rng(2), 200, 161)
+    assert (np.diff(w, axis=1) > 0).all()
+    np.testing.assert_allclose(w[:, [0, -1]], [[0, 1]] * 200, atol=1e-12)
+
+
+def test_broad_mix_is_seeded_and_keeps_a_paper_share_as_the_paper_draws_it():
+    a, b = F.broad_mix(400, 3), F.broad_mix(400, 3)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, F.broad_mix(400, 4))
+    sizes = np.ptp(a, axis=1).max(axis=1)
+    posed = np.isclose(sizes, 92.6, rtol=1e-4)
+    assert 0.8 < posed.mean() < 0.9  # 85%: everything but half of the paper's 30% share is posed and framed
+
+
+def test_suite_bookkeeping_with_a_perfect_reconstructor():
+    class Echo:  # returns the input: every error is 0
+        def reconstruct(self, curves, **_):
+            return [np.asarray(c, np.float64) for c in curves], None
+
+    test = F.draw_family(F.paper, 12, np.random.default_rng(0), model_size=None)
+    report = run_suite(Echo(), test, count=6)
+    assert set(report) == set(suite_sets(test, 6))
+    assert {r["kind"] for r in report.values()} >= {"paper", "trained", "held out"}
+    for name, r in report.items():
+        assert r["n_curves"] == (6 if name != "airfoils (UIUC)" else r["n_curves"])
+        assert r["rel_rmse_mean"] == 0 and r["roughness_ratio"] == pytest.approx(1)
+    assert "paper, rotated" in format_suite(report)
+
+
+def test_relative_rmse_is_rmse_over_the_diagonal():
+    a = np.array([[0.0, 0.0], [3.0, 4.0]])
+    assert relative_rmse([a], [a + [0.5, 0.0]])[0] == pytest.approx(0.5 / 5)
