@@ -43,6 +43,13 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
         help="training curves: the paper's generator, or the broad mix of training/families.py (any spacing, "
         "other shapes, posed as the service poses curves); the test split is the paper's either way (default: paper)",
     )
+    g.add_argument(
+        "--curves",
+        default=None,
+        metavar="PATH",
+        help="your own curves instead: a file or a directory of .npy/.csv/.json/.dat files; 10%% of the curves are "
+        "held out for validation and 10%% for test, and --n-train posed copies of the rest are trained on",
+    )
 
 
 def _data_path(a: argparse.Namespace, config: Any) -> Path:
@@ -55,7 +62,10 @@ def _data_path(a: argparse.Namespace, config: Any) -> Path:
 def _data_config(a: argparse.Namespace):
     from training.data import DataConfig
 
-    return DataConfig(n_train=a.n_train, n_val=a.n_val, n_test=a.n_test, seed=a.data_seed, mix=a.mix)
+    mix = "files" if a.curves else a.mix
+    return DataConfig(
+        n_train=a.n_train, n_val=a.n_val, n_test=a.n_test, seed=a.data_seed, mix=mix, source=a.curves or ""
+    )
 
 
 # ------------------------------------------------------------------------------ dataset

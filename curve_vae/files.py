@@ -12,8 +12,8 @@ import numpy as np
 
 
 def read_curves(path: str) -> list[np.ndarray]:
-    """Curves from a .npy array (n, 2) or (N, n, 2), an airfoil .dat file, or JSON: [[x, y], …], [curve, …] or
-    {"curves": […]}.
+    """Curves from a .npy array (n, 2) or (N, n, 2), an airfoil .dat file, CSV (x,y rows; a blank line between
+    curves), or JSON: [[x, y], …], [curve, …] or {"curves": […]}.
 
     "-" reads JSON from standard input.
     """
@@ -22,6 +22,8 @@ def read_curves(path: str) -> list[np.ndarray]:
         data: Any = arr[None] if arr.ndim == 2 else arr
     elif path.endswith(".dat"):
         data = [parse_dat(Path(path).read_text(errors="replace"), path)]
+    elif path.endswith(".csv"):
+        data = parse_csv(Path(path).read_text(errors="replace"), path)
     else:
         text = sys.stdin.read() if path == "-" else Path(path).read_text()
         data = json.loads(text)
@@ -39,6 +41,51 @@ def read_curves(path: str) -> list[np.ndarray]:
             j = int(np.argwhere(~np.isfinite(c))[0][0])
             raise ValueError(f"{path}: curve {i} point {j} is not finite")
     return curves
+
+
+CURVE_SUFFIXES = (".npy", ".csv", ".json", ".dat")
+
+
+def read_curve_files(source: str | Path) -> list[np.ndarray]:
+    """Every curve of a file, or of every .npy/.csv/.json/.dat file under a directory (sorted by path)."""
+    src = Path(source)
+    if src.is_dir():
+        paths = sorted(p for p in src.rglob("*") if p.suffix in CURVE_SUFFIXES and p.is_file())
+        if not paths:
+            raise ValueError(f"{src}: no curve files ({', '.join(CURVE_SUFFIXES)}) in this directory")
+    elif src.is_file():
+        paths = [src]
+    else:
+        raise ValueError(f"{src}: no such file or directory")
+    return [c for p in paths for c in read_curves(str(p))]
+
+
+def parse_csv(text: str, name: str = "<csv>") -> list[np.ndarray]:
+    """Curves from CSV: a row `x,y` per point (a header row is skipped); a blank line starts the next curve.
+    ValueError names the file and line."""
+    curves: list[list[tuple[float, float]]] = [[]]
+    for number, line in enumerate(text.splitlines(), start=1):
+        parts = [p.strip() for p in line.split(",")]
+        if not any(parts):
+            if curves[-1]:
+                curves.append([])
+            continue
+        try:
+            values = [float(p) for p in parts]
+        except ValueError:
+            if number == 1:
+                continue  # a header such as x,y
+            raise ValueError(f"{name}:{number}: expected two numbers x,y, got {line.strip()!r}") from None
+        if len(values) != 2 or not np.isfinite(values).all():
+            raise ValueError(f"{name}:{number}: expected two finite numbers x,y, got {line.strip()!r}")
+        curves[-1].append((values[0], values[1]))
+    found = [np.array(c) for c in curves if c]
+    if not found:
+        raise ValueError(f"{name}: no coordinates found")
+    for c in found:
+        if len(c) < 4:
+            raise ValueError(f"{name}: a curve of {len(c)} points; a curve needs at least 4")
+    return found
 
 
 def parse_dat(text: str, name: str = "<dat>") -> np.ndarray:

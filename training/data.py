@@ -13,7 +13,7 @@ from geometry import random_control_points, sample_bspline, self_intersects
 from training.io import atomic_path
 
 FORMAT_VERSION = 1
-MIXES = ("paper", "broad")
+MIXES = ("paper", "broad", "files")
 
 
 @dataclass(frozen=True)
@@ -28,12 +28,16 @@ class DataConfig:
     center: tuple[float, float] = (64.0, 64.0)  # ... centred in the 128×128 plane
     # "paper": every split is the paper's curves. "broad": training and validation curves come from the broad
     # mix of training/families.py (any spacing, shapes beyond the paper's, in the service's pose and frame);
-    # the test split stays the paper's, the one eq. 4's MSE is reported on.
+    # the test split stays the paper's, the one eq. 4's MSE is reported on. "files": a user's own curves, read
+    # from `source` (training/families.own_curves): split by curve, the training curves posed n_train times.
     mix: str = "paper"
+    source: str = ""  # mix "files": a curve file, or a directory of .npy/.csv/.json/.dat files
 
     def __post_init__(self) -> None:
         if self.mix not in MIXES:
             raise ValueError(f"mix must be one of {', '.join(MIXES)}, got {self.mix!r}")
+        if (self.mix == "files") != bool(self.source):
+            raise ValueError('a data source (--curves PATH) goes with mix "files", and only with it')
 
 
 def generate_curves(
@@ -76,6 +80,11 @@ class CurveDataset:
 
     @classmethod
     def generate(cls, config: DataConfig) -> CurveDataset:
+        if config.mix == "files":
+            from training.families import own_curves
+
+            train, val, test = own_curves(config.source, config.n_train, config.seed, n_points=config.n_points)
+            return cls(config, train, val, test, np.zeros((len(test), 0, 2), np.float32))
         total = config.n_train + config.n_val + config.n_test
         curves, ctrl = generate_curves(
             total,
@@ -145,5 +154,5 @@ def load_or_generate(config: DataConfig, cache: str | Path | None, *, say: bool 
     if cache is not None:
         ds.save(cache)
         if say:
-            print(f"generated the data set ({config.n_train} / {config.n_val} / {config.n_test} curves) into {cache}")
+            print(f"generated the data set ({len(ds.train)} / {len(ds.val)} / {len(ds.test)} curves) into {cache}")
     return ds

@@ -220,6 +220,33 @@ def draw_family(
     return np.concatenate(out)[:count]
 
 
+def own_curves(
+    source: str, n_train: int, seed: int, *, n_points: int = 161, model_size: float = 92.6, held: float = 0.1
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A user's curves as a data set (train, val, test), each (k, n_points, 2) float32 in the model's pose and frame.
+
+    The curves of `source` (curve_vae.files.read_curve_files) are resampled to n_points by arc length and split
+    by curve — `held` of them for validation, as many for test (at least one each), seeded — so no test curve
+    is trained on. The training split is drawn n_train times, each draw in a fresh random pose (to_pose), so a
+    few hundred curves make a data set of any size.
+    """
+    from curve_vae.files import read_curve_files
+    from geometry import resample
+
+    curves = read_curve_files(source)
+    if len(curves) < 3:
+        raise ValueError(f"{source}: {len(curves)} curves; a data set needs at least 3 (train, validation, test)")
+    rng = np.random.default_rng(seed)
+    pts = np.stack([resample(np.asarray(c, np.float64), n_points) for c in curves])
+    order = rng.permutation(len(pts))
+    k = max(1, int(round(held * len(pts))))
+    test, val, train = pts[order[:k]], pts[order[k : 2 * k]], pts[order[2 * k :]]
+    if not len(train):
+        raise ValueError(f"{source}: {len(curves)} curves leave none for training after validation and test")
+    drawn = train[rng.integers(0, len(train), n_train)]
+    return tuple(to_pose(s, rng, model_size).astype(np.float32) for s in (drawn, val, test))  # type: ignore[return-value]
+
+
 def broad_mix(count: int, seed: int, *, n_points: int = 161, model_size: float = 92.6) -> np.ndarray:
     """`count` curves of the training mix (MIX shares, shuffled), seeded. The paper's share keeps its own
     pose, frame and parameter spacing half of the time, so the model stays as good on the paper's curves."""

@@ -1,9 +1,11 @@
 """The broad training mix and the evaluation suite: spacing, validity, pose, bookkeeping."""
 
+import json
+
 import numpy as np
 import pytest
 
-from geometry import fit_frame, self_intersects, signed_turning
+from geometry import fit_frame, self_intersects, signed_turning, turning_angles
 from geometry.frame import MODEL_CENTER, chord_heading
 from training import families as F
 from training.suite import format_suite, relative_rmse, run_suite, suite_sets
@@ -68,3 +70,33 @@ def test_suite_bookkeeping_with_a_perfect_reconstructor():
 def test_relative_rmse_is_rmse_over_the_diagonal():
     a = np.array([[0.0, 0.0], [3.0, 4.0]])
     assert relative_rmse([a], [a + [0.5, 0.0]])[0] == pytest.approx(0.5 / 5)
+
+
+def test_own_curves_split_by_curve_and_pose_every_training_draw(tmp_path):
+    t = np.linspace(0, 1, 30)
+    for i in range(10):  # ten files of one curve each, in three formats
+        c = np.stack([t, np.sin(3 * t) * 0.15 * (i + 1)], 1)  # ten different shapes
+        if i % 3 == 0:
+            np.save(tmp_path / f"c{i}.npy", c)
+        elif i % 3 == 1:
+            (tmp_path / f"c{i}.csv").write_text("x,y\n" + "\n".join(f"{x},{y}" for x, y in c))
+        else:
+            (tmp_path / f"c{i}.json").write_text(json.dumps(c.tolist()))
+    train, val, test = F.own_curves(str(tmp_path), 50, seed=0)
+    assert train.shape == (50, 161, 2) and val.shape == test.shape == (1, 161, 2)
+    for c in train.astype(np.float64):
+        assert fit_frame(c).size == pytest.approx(92.6, rel=1e-5)
+    # the held-out curves are none of the training curves, in whatever pose: turning angles do not change with
+    # rotation, mirror image, scale or direction
+    key = lambda c: np.round(np.sort(turning_angles(c)), 2).tobytes()  # noqa: E731
+    trained = {key(c) for c in train.astype(np.float64)}
+    assert len(trained) == 8  # the 8 training curves, each drawn in many poses
+    assert not {key(c) for c in np.concatenate([val, test]).astype(np.float64)} & trained
+
+
+def test_own_curves_name_the_bad_file_and_line(tmp_path):
+    (tmp_path / "a.csv").write_text("x,y\n0,0\n1,1\n2,oops\n3,3\n")
+    with pytest.raises(ValueError, match=r"a\.csv:4: expected two numbers"):
+        F.own_curves(str(tmp_path), 10, seed=0)
+    with pytest.raises(ValueError, match="no such file"):
+        F.own_curves(str(tmp_path / "missing"), 10, seed=0)
