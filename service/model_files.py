@@ -13,6 +13,7 @@ from typing import Any
 
 import onnxruntime as ort
 
+from geometry.frame import MODEL_CENTER
 from service.prior import PRIOR_FILE
 
 CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
@@ -50,6 +51,12 @@ def read_manifest(model_dir: str | Path) -> dict[str, Any]:
     if n_points < 4 or latent_dim < 1 or not (math.isfinite(model_size) and model_size > 0):
         raise ModelLoadError(
             f"{path}: implausible n_points={n_points}, latent_dim={latent_dim}, model_size={model_size}"
+        )
+    center = manifest["frame"].get("center", list(MODEL_CENTER))
+    if [float(v) for v in center] != list(MODEL_CENTER):  # frames map to this centre (geometry.frame)
+        raise ModelLoadError(
+            f"{path}: the model's plane is centred at {center}, but the service maps curves to {list(MODEL_CENTER)}; "
+            "export the model with the paper's plane (ModelConfig.center 64)"
         )
     names = [graph_file(manifest, graph) for graph in ("encoder", "decoder")]
     if manifest.get("prior"):

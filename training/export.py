@@ -8,7 +8,6 @@ manifest.json: names, dims, sha256 of each file, the frame convention, config an
 
 from __future__ import annotations
 
-import hashlib
 import json
 import logging
 import platform
@@ -25,6 +24,7 @@ import torch
 from torch import nn
 
 from geometry import clamped_uniform_knots
+from service.model_files import file_sha256
 from service.prior import PRIOR_FILE, LatentPrior
 from training.io import atomic_path, atomic_write_text
 from training.model import VAE, ModelConfig
@@ -68,11 +68,8 @@ def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
 
 
 def sha256(path: str | Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+    """The checksum the manifest records and the service checks (one definition: service.model_files)."""
+    return file_sha256(Path(path))
 
 
 @contextmanager

@@ -35,6 +35,15 @@ def test_tampered_graph_is_a_startup_error(model_dir, tmp_path):
         CurveRuntime.load(copy, providers="cpu")
 
 
+def test_a_model_plane_centred_elsewhere_is_a_startup_error_not_a_silent_shift(model_dir, tmp_path):
+    copy = _copy(model_dir, tmp_path)
+    manifest = json.loads((copy / "manifest.json").read_text())
+    manifest["frame"]["center"] = [0.0, 0.0]
+    (copy / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ModelLoadError, match=r"centred at \[0\.0, 0\.0\]"):
+        CurveRuntime.load(copy, providers="cpu")
+
+
 def test_missing_manifest_is_a_startup_error(tmp_path):
     with pytest.raises(ModelLoadError, match=r"manifest\.json is missing"):
         CurveRuntime.load(tmp_path, providers="cpu")
