@@ -16,7 +16,9 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 from service.errors import error_response
 
 #: Paths served without a key: probes must work for orchestrators, and the page must load to ask for the key.
-OPEN_PATHS = frozenset({"/health", "/ready", "/", "/docs", "/redoc", "/openapi.json"})
+OPEN_PATHS = frozenset(
+    {"/health", "/ready", "/v2/health/live", "/v2/health/ready", "/", "/docs", "/redoc", "/openapi.json"}
+)
 OPEN_PREFIXES = ("/static/", "/docs-assets/")
 
 
@@ -61,6 +63,6 @@ class ApiKeyMiddleware:
             else "the API key is not valid for this service"
         )
         response = error_response(
-            401, [("headers.authorization", msg)], detail=msg, headers={"WWW-Authenticate": "Bearer"}
+            401, [("headers.authorization", msg)], detail=msg, headers={"WWW-Authenticate": "Bearer"}, path=path
         )
         await response(scope, receive, send)

@@ -6,6 +6,7 @@ time) and the app factory; the rest lives by concern:
     routes/curves.py   encode, decode, reconstruct, interpolate, sample, augment (the model)
     routes/design.py   fit, revolve (geometry, no model)
     routes/ops.py      health, ready, model, metrics
+    routes/oip.py      the Open Inference Protocol (KServe v2) under /v2: raw tensors, as Triton serves them
     deps.py            settings and runtime from app.state, limits, the bounded run in a worker thread
     errors.py          the one error body and its handlers
     middleware.py      the body size limit;  access.py: API keys;  metrics.py: Prometheus
@@ -36,9 +37,11 @@ from service.access import ApiKeyMiddleware
 from service.errors import on_http_error, on_input_error, on_validation_error
 from service.metrics import Metrics, MetricsMiddleware
 from service.middleware import BodyLimitMiddleware
+from service.oip import DEFAULT_SIGNATURES, describe, signatures
 from service.openapi import state_bounds
 from service.routes.curves import curves_router
 from service.routes.design import design_router
+from service.routes.oip import oip_router
 from service.routes.ops import ops_router
 from service.runtime import (
     CurveRuntime,
@@ -118,6 +121,12 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
             {"name": "curves", "description": "Encode, decode, reconstruct, interpolate, sample and augment curves."},
             {"name": "design", "description": "B-spline fits and surfaces of revolution: geometry, no model needed."},
             {"name": "operations", "description": "Health, readiness, model metadata and metrics."},
+            {
+                "name": "open inference protocol",
+                "description": "The Open Inference Protocol (KServe v2), as NVIDIA Triton and KServe speak it: the "
+                "same client code calls this server or Triton serving `curve-vae triton`'s export. Raw model-plane "
+                'tensors (no frames, no resampling); errors are `{"error": "..."}`.',
+            },
         ],
     )
     app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
@@ -126,6 +135,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.include_router(curves_router)
     app.include_router(design_router)
     app.include_router(ops_router)
+    app.include_router(oip_router)
     mount_web(app)
     app.add_exception_handler(RequestValidationError, on_validation_error)
     app.add_exception_handler(InputError, on_input_error)
@@ -156,7 +166,11 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
         if app.openapi_schema is None or getattr(app.state, "openapi_for", None) != runtime_dim():
             app.openapi_schema = None
             app.state.openapi_for = runtime_dim()
-            app.openapi_schema = state_bounds(FastAPI.openapi(app), settings, runtime_dim())
+            schema = state_bounds(FastAPI.openapi(app), settings, runtime_dim())
+            rt = app.state.runtime
+            app.openapi_schema = describe(
+                schema, signatures(rt) if rt is not None else DEFAULT_SIGNATURES, settings.max_curves
+            )
         return app.openapi_schema
 
     def runtime_dim() -> int | None:
@@ -164,7 +178,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
         return rt.latent_dim if rt is not None else None
 
     app.openapi = openapi  # type: ignore[method-assign]
-    routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *app.routes)
+    routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *oip_router.routes, *app.routes)
     paths = [r.path for r in routes if hasattr(r, "path")]
     app.add_middleware(MetricsMiddleware, metrics=app.state.metrics, known_paths=paths)
     return app

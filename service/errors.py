@@ -1,4 +1,8 @@
-"""The API's one error format and the handlers that produce it: a line naming the first problem, and the list."""
+"""The API's one error format and the handlers that produce it: a line naming the first problem, and the list.
+
+Paths under /v2 (the Open Inference Protocol, service/routes/oip.py) answer in that protocol's format instead,
+`{"error": "..."}`, whichever layer refuses the request (API key, body limit, busy, timeout), because its clients
+(tritonclient, KServe's) read nothing else."""
 
 from __future__ import annotations
 
@@ -19,14 +23,32 @@ MAX_ERRORS_SHOWN = 20
 
 
 def error_response(
-    status: int, errors: Sequence[tuple[str, str]], *, detail: str | None = None, headers: dict[str, str] | None = None
+    status: int,
+    errors: Sequence[tuple[str, str]],
+    *,
+    detail: str | None = None,
+    headers: dict[str, str] | None = None,
+    path: str = "",
 ) -> JSONResponse:
-    """The one error body of the API: a line naming the first problem, and the list of all of them."""
+    """The one error body of the API: a line naming the first problem, and the list of all of them. Under /v2 (the
+    Open Inference Protocol, `path`) the protocol's `{"error": line}` instead, which its clients read."""
     items = [{"loc": loc, "msg": msg} for loc, msg in errors[:MAX_ERRORS_SHOWN]]
     if detail is None:
         loc, msg = errors[0]
         detail = f"{loc}: {msg}" if loc else msg
+    if speaks_oip(path):
+        return oip_error(status, detail, headers=headers)
     return JSONResponse({"detail": detail, "errors": items}, status_code=status, headers=headers)
+
+
+def speaks_oip(path: str) -> bool:
+    """Whether `path` is one of the Open Inference Protocol's (service/routes/oip.py), answered in its error format."""
+    return path == "/v2" or path.startswith("/v2/")
+
+
+def oip_error(status: int, msg: str, *, headers: dict[str, str] | None = None) -> JSONResponse:
+    """The Open Inference Protocol's error body: `{"error": "..."}`."""
+    return JSONResponse({"error": msg}, status_code=status, headers=headers)
 
 
 def _validation_message(err: dict[str, Any], request: Request) -> tuple[str, str]:
@@ -83,6 +105,9 @@ UNWRAPPED = 'expected a list of curves, got one curve\'s points: wrap it in a li
 async def on_validation_error(request: Request, exc: Exception) -> Response:
     assert isinstance(exc, RequestValidationError)
     errors = exc.errors()
+    if speaks_oip(request.url.path):  # the protocol answers a request it cannot read with 400
+        loc, msg = _validation_message(errors[0], request)
+        return oip_error(400, f"{loc}: {msg}")
     if _one_unwrapped_curve(getattr(exc, "body", None)) and any(
         list(e["loc"])[1:2] == ["curves"] and len(e["loc"]) == 4 for e in errors
     ):
@@ -101,4 +126,4 @@ async def on_http_error(request: Request, exc: Exception) -> Response:
         # FastAPI's answer to bodies json.loads rejects with something other than a syntax error
         # (an integer of over 4300 digits): the same 422 as any other unreadable JSON.
         return error_response(422, [("body", "invalid JSON (cannot parse the body)")])
-    return error_response(exc.status_code, [], detail=str(exc.detail), headers=exc.headers)
+    return error_response(exc.status_code, [], detail=str(exc.detail), headers=exc.headers, path=request.url.path)

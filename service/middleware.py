@@ -30,11 +30,11 @@ class BodyLimitMiddleware:
                 return  # the client went away: nobody to answer
             read += len(message.get("body", b""))
             more = message.get("more_body", False)
-        await self._too_large(size)(scope, receive, send)
+        await self._too_large(size, scope.get("path", ""))(scope, receive, send)
 
-    def _too_large(self, size: str) -> JSONResponse:
+    def _too_large(self, size: str, path: str) -> JSONResponse:
         return error_response(
-            413, [("body", f"{size} exceeds the limit of {self.limit} bytes (CURVE_VAE_MAX_BODY_BYTES)")]
+            413, [("body", f"{size} exceeds the limit of {self.limit} bytes (CURVE_VAE_MAX_BODY_BYTES)")], path=path
         )
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
