@@ -34,6 +34,7 @@ from fastapi.middleware.cors import CORSMiddleware
 from starlette.exceptions import HTTPException
 
 from service.access import ApiKeyMiddleware
+from service.cpus import available_cpus, threads_per_inference
 from service.errors import on_http_error, on_input_error, on_validation_error
 from service.metrics import Metrics, MetricsMiddleware
 from service.middleware import BodyLimitMiddleware
@@ -59,13 +60,21 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     settings: Settings = app.state.settings
     owned = app.state.runtime is None
     if owned:
+        threads = threads_per_inference(settings)
+        log.info(
+            "onnxruntime: %d threads per inference (%s; %d workers × %d inferences at once)",
+            threads,
+            "CURVE_VAE_INTRA_OP_THREADS" if settings.intra_op_threads else f"{available_cpus()} CPUs",
+            settings.workers,
+            settings.inference_concurrency,
+        )
         try:
             app.state.runtime = await anyio.to_thread.run_sync(
                 partial(
                     CurveRuntime.load,
                     settings.model_dir,
                     providers=settings.providers,
-                    intra_op_threads=settings.intra_op_threads,
+                    intra_op_threads=threads,
                     batch_size=settings.batch_size,
                 )
             )

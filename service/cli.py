@@ -33,7 +33,7 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--max-stream-curves", "max_stream_curves", int, "most curves in one streamed .npy (POST /augment format npy)"),
     ("--max-mesh-triangles", "max_mesh_triangles", int, "most triangles in one POST /revolve mesh"),
     ("--batch-size", "batch_size", int, "curves per ONNX run"),
-    ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0 lets it choose"),
+    ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0: the CPU quota shared out"),
     ("--inference-concurrency", "inference_concurrency", int, "inferences running at once"),
     ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
     ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),

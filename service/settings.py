@@ -31,7 +31,9 @@ class Settings(BaseSettings):
     log_level: Literal["critical", "error", "warning", "info", "debug", "trace"] = "info"
     model_dir: Path = DEFAULT_MODEL_DIR  # encoder.onnx, decoder.onnx and manifest.json
     providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
-    intra_op_threads: int = Field(0, ge=0)  # onnxruntime threads per inference; 0 lets it choose
+    # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among
+    # workers × inference_concurrency (service/cpus.py), so a container never runs more threads than its quota
+    intra_op_threads: int = Field(0, ge=0)
     inference_concurrency: int = Field(2, ge=1)  # inferences running at once; more only queue on a small CPU
     max_queue: int = Field(64, ge=0)  # requests waiting for an inference slot; beyond them: 503 with Retry-After
     request_timeout: float = Field(60.0, ge=0)  # seconds a request may take, queueing included (504); 0: no limit

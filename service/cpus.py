@@ -1,0 +1,55 @@
+"""How many CPUs this process may use, and the onnxruntime threads per inference that fill them without more.
+
+onnxruntime left to itself (intra_op_num_threads 0) starts one thread per core of the host, whatever CPU
+quota a container has, and its threads spin while they wait: in a pod limited to 2 CPUs on a 64-core node,
+two concurrent inferences would run 128 spinning threads on 2 CPUs' worth of time. So the service sizes
+them itself: the CPUs it may use (the cgroup's CPU quota, and the CPUs it may be scheduled on), divided
+among the worker processes and the inferences each runs at once. Torch-free; read at startup only.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+CGROUP = Path("/sys/fs/cgroup")
+
+
+def cgroup_cpus(root: Path = CGROUP) -> float | None:
+    """This cgroup's CPU quota in CPUs (cgroup v2 `cpu.max`, else v1 `cpu.cfs_quota_us` / `cpu.cfs_period_us`);
+    None where there is no quota."""
+    try:
+        quota, period = (root / "cpu.max").read_text().split()[:2]
+        return None if quota == "max" else int(quota) / int(period)
+    except (OSError, ValueError):
+        pass
+    try:
+        quota_us = int((root / "cpu" / "cpu.cfs_quota_us").read_text())
+        period_us = int((root / "cpu" / "cpu.cfs_period_us").read_text())
+    except (OSError, ValueError):
+        return None
+    return quota_us / period_us if quota_us > 0 and period_us > 0 else None
+
+
+def available_cpus(root: Path = CGROUP) -> int:
+    """Whole CPUs this process may use: those it may be scheduled on, capped by the cgroup quota (rounded down:
+    1.5 CPUs of quota run 1 thread flat out rather than 2 throttled), at least 1."""
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        cpus = os.cpu_count() or 1
+    quota = cgroup_cpus(root)
+    if quota is not None:
+        cpus = min(cpus, math.floor(quota))
+    return max(1, cpus)
+
+
+def threads_per_inference(settings: Any, cpus: int | None = None) -> int:
+    """`settings.intra_op_threads` where set; for 0, the CPUs shared out: workers × inference_concurrency
+    inferences run at once, each on this many threads (at least 1)."""
+    if settings.intra_op_threads:
+        return int(settings.intra_op_threads)
+    cpus = available_cpus() if cpus is None else cpus
+    return max(1, cpus // (settings.workers * settings.inference_concurrency))

@@ -1,0 +1,82 @@
+"""onnxruntime threads sized to the CPUs a container may use: the cgroup quota (v2 and v1), the affinity, and the
+workers × concurrent inferences sharing them."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from service import cpus
+from service.settings import Settings
+
+
+def cgroup(tmp_path, v2: str | None = None, v1: tuple[str, str] | None = None):
+    if v2 is not None:
+        (tmp_path / "cpu.max").write_text(v2 + "\n")
+    if v1 is not None:
+        (tmp_path / "cpu").mkdir()
+        (tmp_path / "cpu" / "cpu.cfs_quota_us").write_text(v1[0] + "\n")
+        (tmp_path / "cpu" / "cpu.cfs_period_us").write_text(v1[1] + "\n")
+    return tmp_path
+
+
+@pytest.mark.parametrize(
+    ("v2", "v1", "quota"),
+    [
+        ("200000 100000", None, 2.0),
+        ("150000 100000", None, 1.5),
+        ("max 100000", None, None),
+        (None, ("50000", "100000"), 0.5),
+        (None, ("-1", "100000"), None),
+        (None, None, None),  # no cgroup files at all (not Linux, or not mounted)
+        ("garbage", None, None),
+    ],
+)
+def test_the_cgroup_quota(tmp_path, v2, v1, quota):
+    assert cpus.cgroup_cpus(cgroup(tmp_path, v2, v1)) == quota
+
+
+def test_available_cpus_are_the_affinity_capped_by_the_quota_rounded_down(tmp_path, monkeypatch):
+    def root(name: str, v2: str | None = None):
+        (tmp_path / name).mkdir()
+        return cgroup(tmp_path / name, v2)
+
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(64)), raising=False)
+    assert cpus.available_cpus(root("none")) == 64
+    assert cpus.available_cpus(root("a", "250000 100000")) == 2
+    assert cpus.available_cpus(root("b", "50000 100000")) == 1  # half a CPU still runs one thread
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1, 2}, raising=False)
+    assert cpus.available_cpus(root("c", "800000 100000")) == 3  # pinned to 3 of the 8 the quota allows
+
+
+@pytest.mark.parametrize(
+    ("cpus_", "workers", "concurrency", "threads"),
+    [(2, 1, 2, 1), (8, 1, 2, 4), (8, 2, 2, 2), (16, 1, 1, 16), (2, 4, 2, 1), (7, 1, 2, 3)],
+)
+def test_threads_per_inference_share_the_cpus_out(cpus_, workers, concurrency, threads):
+    settings = Settings.model_construct(intra_op_threads=0, workers=workers, inference_concurrency=concurrency)
+    assert cpus.threads_per_inference(settings, cpus_) == threads
+    assert workers * concurrency * threads <= max(cpus_, workers * concurrency)  # never more threads than CPUs
+
+
+def test_an_explicit_thread_count_wins():
+    settings = Settings.model_construct(intra_op_threads=3, workers=4, inference_concurrency=2)
+    assert cpus.threads_per_inference(settings, 2) == 3
+
+
+def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypatch):
+    seen = {}
+    real = cpus.threads_per_inference
+
+    def spy(settings, n=None):
+        seen["threads"] = real(settings, 6)
+        return seen["threads"]
+
+    monkeypatch.setattr("service.app.threads_per_inference", spy)
+    client = make_client(share_runtime=False, providers="cpu", inference_concurrency=3)
+    assert client.get("/ready").status_code == 200
+    assert seen["threads"] == 2  # 6 CPUs for 1 worker × 3 inferences at once
+    runtime = client.app.state.runtime
+    for session in (runtime.encoder, runtime.decoder):
+        assert session.get_session_options().intra_op_num_threads == 2
