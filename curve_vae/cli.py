@@ -121,9 +121,10 @@ def _add_train_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--spline-ctrl",
         type=int,
-        default=0,
+        default=None,
         help="B-spline output head: project decoded points onto a clamped cubic B-spline with this many "
-        "control points, 7k+3 to keep the data's knots (0: raw points) (default: 0)",
+        "control points, 7k+3 to keep the data's knots (0: raw points) (default: the --init-from or resumed "
+        "checkpoint's head, else 0)",
     )
     d = TrainConfig()
     g = p.add_argument_group("training")
@@ -169,7 +170,15 @@ def cmd_train(a: argparse.Namespace) -> int:
     from training.evaluate import plot_training, run_evaluation, torch_codec
     from training.train import train
 
-    model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim, spline_ctrl=a.spline_ctrl)
+    spline_ctrl = a.spline_ctrl
+    if spline_ctrl is None:  # keep the head of the weights a run continues from: dropping it would go unnoticed
+        start = Path(a.run_dir) / "last.pt" if a.resume and (Path(a.run_dir) / "last.pt").exists() else a.init_from
+        spline_ctrl = 0
+        if start:
+            import torch
+
+            spline_ctrl = torch.load(start, map_location="cpu", weights_only=True)["model_config"].get("spline_ctrl", 0)
+    model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim, spline_ctrl=spline_ctrl)
     cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
     run_dir = Path(a.run_dir)
     state = train(

@@ -1,0 +1,38 @@
+"""A run continued from weights with a B-spline head keeps the head unless told otherwise."""
+
+import json
+
+import pytest
+import torch
+
+from curve_vae.cli import main
+from training.config import ModelConfig
+from training.model import VAE
+
+
+@pytest.mark.slow
+def test_init_from_keeps_the_checkpoints_spline_head(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    torch.manual_seed(0)
+    start = tmp_path / "start.pt"
+    torch.save(
+        {"model_config": ModelConfig(spline_ctrl=31).__dict__, "model": VAE(ModelConfig(spline_ctrl=31)).state_dict()},
+        start,
+    )
+    tiny = [
+        "--n-train",
+        "128",
+        "--n-val",
+        "32",
+        "--n-test",
+        "32",
+        "--epochs",
+        "1",
+        "--no-progress",
+        "--batch-size",
+        "64",
+    ]
+    assert main(["train", "--run-dir", "kept", "--init-from", str(start), *tiny]) == 0
+    assert json.loads((tmp_path / "kept" / "config.json").read_text())["model"]["spline_ctrl"] == 31
+    assert main(["train", "--run-dir", "dropped", "--init-from", str(start), "--spline-ctrl", "0", *tiny]) == 0
+    assert json.loads((tmp_path / "dropped" / "config.json").read_text())["model"]["spline_ctrl"] == 0
