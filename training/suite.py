@@ -85,6 +85,8 @@ def measure(runtime: Any, curves: list[np.ndarray], **options: Any) -> dict[str,
         "rel_rmse_max": float(rel.max()),
         "roughness_ratio": float(rough_out.mean() / max(rough_in.mean(), 1e-12)),
         "self_intersecting": float(np.mean([bool(self_intersects(o)) for o in out])),
+        # closed-looking inputs (airfoils whose trailing edge closes) touch themselves already
+        "self_intersecting_input": float(np.mean([bool(self_intersects(c)) for c in curves])),
     }
 
 
@@ -127,10 +129,12 @@ def plot_suite(runtime: Any, sets: dict[str, tuple[str, list[np.ndarray]]], path
 
 def format_suite(report: dict[str, Any]) -> str:
     """The suite as a text table."""
-    lines = [f"{'set':28s} {'kind':9s} {'rel RMSE':>9s} {'p95':>7s} {'max':>7s} {'rough×':>7s} {'crossing':>8s}"]
+    head = f"{'set':28s} {'kind':9s} {'rel RMSE':>9s} {'p95':>7s} {'max':>7s} {'rough×':>7s} {'crossing in/out':>16s}"
+    lines = [head]
     for name, r in report.items():
         lines.append(
             f"{name:28s} {r['kind']:9s} {100 * r['rel_rmse_mean']:8.2f}% {100 * r['rel_rmse_p95']:6.2f}% "
-            f"{100 * r['rel_rmse_max']:6.2f}% {r['roughness_ratio']:7.2f} {100 * r['self_intersecting']:7.1f}%"
+            f"{100 * r['rel_rmse_max']:6.2f}% {r['roughness_ratio']:7.2f} "
+            f"{100 * r.get('self_intersecting_input', 0):7.1f}%/{100 * r['self_intersecting']:5.1f}%"
         )
     return "\n".join(lines)
