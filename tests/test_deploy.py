@@ -1,8 +1,8 @@
 """The deployment files, checked without a Docker engine or a cluster (neither runs here): docker/Dockerfile,
 docker/Dockerfile.cuda, docker/compose.yaml and deploy/k8s/*.yaml against the app they deploy: pinned bases,
 multi-stage builds, a non-root user, health checks and probes on routes the app has, ports, the files an image
-copies, the entry point, and settings that are Settings fields. hadolint and kubernetes-validate (the `test`
-extra) lint them too where they are installed.
+copies, the entry point, and settings that are Settings fields; and the commands docs/DEPLOYMENT.md shows.
+hadolint and kubernetes-validate (the `test` extra) lint them too where they are installed.
 """
 
 from __future__ import annotations
@@ -392,3 +392,42 @@ def test_kubernetes_validate_accepts_the_manifests(tmp_path):
     out = subprocess.run([validate, "--strict", *files], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stdout + out.stderr
     assert out.stdout.count("passed") == len(files)
+
+
+# ------------------------------------------------------------------------------------------- docs/DEPLOYMENT.md
+
+
+def doc_commands() -> list[list[str]]:
+    """The curve-vae command lines of docs/DEPLOYMENT.md's bash blocks (`.venv/bin/curve-vae …`, `-m curve_vae.cli …`
+    under torchrun), continuation lines joined."""
+    text = (ROOT / "docs" / "DEPLOYMENT.md").read_text()
+    commands = []
+    for block in re.findall(r"```bash\n(.*?)```", text, flags=re.S):
+        for line in block.replace("\\\n", " ").splitlines():
+            argv = shlex.split(line, comments=True)
+            for i, word in enumerate(argv):
+                if word.endswith("bin/curve-vae") or (word == "curve-vae" and i == 0):
+                    commands.append(argv[i + 1 :])
+                elif word == "curve_vae.cli" and argv[i - 1] == "-m":
+                    commands.append(argv[i + 1 :])
+    return commands
+
+
+def test_the_deployment_guides_commands_and_settings_are_the_clis_and_the_services():
+    from curve_vae.cli import build_parser
+
+    commands = doc_commands()
+    assert {argv[0] for argv in commands} >= {"serve", "triton", "train"}
+    for argv in commands:
+        build_parser().parse_args(argv)  # argparse exits on an unknown command or option
+    named = set(re.findall(r"CURVE_VAE_([A-Z_]+)", (ROOT / "docs" / "DEPLOYMENT.md").read_text()))
+    assert {n.lower() for n in named} <= set(Settings.model_fields), named
+
+
+def test_the_guides_triton_command_writes_a_repository(tmp_path, capsys):
+    from curve_vae.cli import main
+
+    (argv,) = [a for a in doc_commands() if a[0] == "triton"]
+    out = tmp_path / argv[argv.index("--out") + 1]
+    assert main([*argv[:-1], str(out)]) == 0
+    assert {p.name for p in out.iterdir()} == {"curve_vae_encoder", "curve_vae_decoder"}

@@ -301,3 +301,18 @@ def test_api_keys_body_limit_and_unknown_paths_answer_in_the_protocols_format(ma
 def test_integral_numbers_are_integers_in_a_shape(client):
     """JSON Schema (and so the published schema) counts 2.0 as an integer: the service does too."""
     assert client.post("/v2/models/encoder/infer", json=_with("shape", [1.0, 161, 2])).status_code == 200
+
+
+def test_raw_tensors_are_what_the_rest_routes_send_in_the_model_plane(client, runtime):
+    """/encode with frame "model" at the model's point count, and /decode without frames, run the same graphs on the
+    same tensors as /v2 (what docs/DEPLOYMENT.md tells a Triton client)."""
+    curves = bspline_curves(2, seed=9)
+    raw = outputs_of(client.post("/v2/models/encoder/infer", json={"inputs": [tensor("curves", curves)]}).json())
+    rest = client.post("/encode", json={"curves": curves.tolist(), "frame": "model"}).json()
+    np.testing.assert_allclose(rest["mean"], raw["mean"], atol=1e-5)
+    np.testing.assert_allclose(rest["log_var"], raw["log_var"], atol=1e-5)
+    decoded = outputs_of(
+        client.post("/v2/models/decoder/infer", json={"inputs": [tensor("latent", raw["mean"])]}).json()
+    )
+    rest = client.post("/decode", json={"latents": raw["mean"].tolist()}).json()
+    np.testing.assert_allclose(rest["curves"], decoded["curves"], atol=1e-4)
