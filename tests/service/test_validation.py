@@ -86,7 +86,13 @@ CASES = [
         id="coincident-points",
     ),
     pytest.param("/encode", {"curves": []}, 422, "curves: List should have at least 1 item", id="no-curves"),
-    pytest.param("/encode", {"curves": C}, 422, "curves[0][0]: a point is [x, y]", id="curve-not-nested"),
+    pytest.param(
+        "/encode",
+        {"curves": C},
+        422,
+        "curves: expected a list of curves, got one curve's points",
+        id="curve-not-nested",
+    ),
     pytest.param(
         "/encode", {"curves": _with(0, 2, 1, "1.5")}, 422, "curves[0][2][1]: not a number", id="numeric-string"
     ),
