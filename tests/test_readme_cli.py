@@ -52,6 +52,16 @@ def _inputs(cwd: Path) -> None:
     (cwd / "seeds.json").write_text(json.dumps(seeds))
     (cwd / "curves.json").write_text(json.dumps({"curves": seeds[:2]}))
     (cwd / "profile.json").write_text(json.dumps([[0, 0], [3, 0], [4, 1], [3, 3], [2.5, 5], [3, 7], [0, 7]]))
+    mine = cwd / "my_curves"  # a family of one's own, in three formats
+    mine.mkdir()
+    for i, c in enumerate(seeds):
+        if i % 3 == 0:
+            np.save(mine / f"c{i}.npy", np.array(c))
+        elif i % 3 == 1:
+            (mine / f"c{i}.csv").write_text("x,y\n" + "\n".join(f"{x},{y}" for x, y in c))
+        else:
+            (mine / f"c{i}.json").write_text(json.dumps(c))
+    (cwd / "models").symlink_to(ROOT / "models")  # --init-from models/vae.pt, as in the repository
 
 
 @pytest.mark.slow

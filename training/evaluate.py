@@ -427,11 +427,12 @@ def run_evaluation(
         )
         plot_latent_tsne(encode, first, out / "latent_tsne.png")
     if runtime is not None and suite_count > 0:
-        from training.suite import plot_suite, run_suite, suite_sets
+        from training.suite import paper_test_split, plot_suite, run_suite, suite_sets
 
-        report["families"] = run_suite(runtime, first, count=suite_count)
+        paper = paper_test_split()  # whatever the model was trained on: the suite's paper sets are the paper's
+        report["families"] = run_suite(runtime, paper, count=suite_count)
         if figures:
-            plot_suite(runtime, suite_sets(first, suite_count), out / "families.png")
+            plot_suite(runtime, suite_sets(paper, suite_count), out / "families.png")
     if figures and log_path is not None and log_path.exists():
         plot_training(log_path, out / "training.png")
     atomic_write_text(out / "report.json", json.dumps(report, indent=2) + "\n")

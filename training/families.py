@@ -225,10 +225,11 @@ def own_curves(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A user's curves as a data set (train, val, test), each (k, n_points, 2) float32 in the model's pose and frame.
 
-    The curves of `source` (curve_vae.files.read_curve_files) are resampled to n_points by arc length and split
-    by curve — `held` of them for validation, as many for test (at least one each), seeded — so no test curve
-    is trained on. The training split is drawn n_train times, each draw in a fresh random pose (to_pose), so a
-    few hundred curves make a data set of any size.
+    The curves of `source` (curve_vae.files.read_curve_files) are split by curve — `held` of them for
+    validation, as many for test (at least one each), seeded — so no test curve is trained on. The training
+    split is drawn n_train times, each draw in a fresh random pose (to_pose) and at a spacing drawn from
+    SPACINGS ("parameter" keeps the file's own spacing, as the service takes posted points by default), so a
+    few hundred curves make a data set of any size. Validation and test curves keep their own spacing.
     """
     from curve_vae.files import read_curve_files
     from geometry import resample
@@ -237,13 +238,16 @@ def own_curves(
     if len(curves) < 3:
         raise ValueError(f"{source}: {len(curves)} curves; a data set needs at least 3 (train, validation, test)")
     rng = np.random.default_rng(seed)
-    pts = np.stack([resample(np.asarray(c, np.float64), n_points) for c in curves])
-    order = rng.permutation(len(pts))
-    k = max(1, int(round(held * len(pts))))
-    test, val, train = pts[order[:k]], pts[order[k : 2 * k]], pts[order[2 * k :]]
+    # each curve densely along its own points (its own spacing), and at n_points that way
+    dense = np.stack([resample(np.asarray(c, np.float64), DENSE, spacing="parameter") for c in curves])
+    own = dense[:, np.round(np.linspace(0, DENSE - 1, n_points)).astype(int)]
+    order = rng.permutation(len(dense))
+    k = max(1, int(round(held * len(dense))))
+    test, val, train = own[order[:k]], own[order[k : 2 * k]], order[2 * k :]
     if not len(train):
         raise ValueError(f"{source}: {len(curves)} curves leave none for training after validation and test")
-    drawn = train[rng.integers(0, len(train), n_train)]
+    picked = dense[train[rng.integers(0, len(train), n_train)]]
+    drawn = respace(picked, n_points, list(rng.choice(SPACINGS, n_train)), rng)
     return tuple(to_pose(s, rng, model_size).astype(np.float32) for s in (drawn, val, test))  # type: ignore[return-value]
 
 

@@ -25,6 +25,14 @@ from training.families import HELD_OUT, TRAIN_FAMILIES, draw_family
 AIRFOIL_WHEEL = Path("data/aerosandbox-4.2.10-py3-none-any.whl")
 
 
+def paper_test_split() -> np.ndarray:
+    """The paper's 1,000 test curves: the test split of the default data set (seed 0), generated (about 4 s)."""
+    from training.data import DataConfig, generate_curves
+
+    cfg = DataConfig()
+    return generate_curves(cfg.n_train + cfg.n_val + cfg.n_test, cfg.seed, n_points=cfg.n_points)[0][-cfg.n_test :]
+
+
 def random_moves(curves: list[np.ndarray], rng: np.random.Generator) -> list[np.ndarray]:
     """Each curve turned by a random angle, mirrored or reversed at random: a user's drawing in any pose."""
     out = []
