@@ -69,11 +69,11 @@ SpacingMode = Annotated[
     Literal["parameter", "arc_length"],
     Field(
         description=(
-            'How points are spaced along a curve. "parameter" (default): evenly in the curve\'s parameter, like the '
-            "paper's B-spline samples the model was trained on; curves of other lengths are interpolated along their "
-            'points, so 50, 161 or 500 samples of a curve give the same result. "arc_length": evenly by arc length, '
-            "for points spaced any which way (hand-drawn strokes); inputs are resampled by arc length and returned "
-            "curves are spaced so."
+            'How points are spaced along a curve. "parameter" (default): points are taken as given and interpolated '
+            "along their order — the paper's B-spline samples are spaced so, and the default model was also trained "
+            "on points spaced by arc length and unevenly; 50, 161 or 500 samples of a curve give the same result. "
+            '"arc_length": every curve is resampled evenly by arc length first, and returned curves are spaced so '
+            "(with the default model, better for spirals and sharp-cornered arcs, worse for airfoils)."
         )
     ),
 ]
