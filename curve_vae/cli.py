@@ -378,6 +378,8 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
             f"{name}: MSE {r['mse']:.4f} (paper eq. 4, {r['n_curves']} curves; median {r['mse_median']:.4f}); "
             f"roughness in {s_in:.3f}° out {s_out:.3f}°; self-intersecting outputs {r['self_intersecting_outputs']:.1%}"
         )
+        if "interpolation" not in r:
+            continue
         lat, pw = r["interpolation"]["latent"], r["interpolation"]["pointwise"]
         print(
             f"  interpolants ({r['interpolation']['pairs']} pairs): latent roughness {lat['roughness']:.3f}°, "

@@ -381,6 +381,9 @@ def plot_latent_tsne(encode: Encoder, curves: np.ndarray, path: Path, *, example
     _save(fig, path)
 
 
+MIN_FIGURE_CURVES = 32  # the interpolation figures take curves 0-13; t-SNE needs more points than its perplexity
+
+
 def run_evaluation(
     encode: Encoder,
     decode: Decoder,
@@ -403,9 +406,10 @@ def run_evaluation(
     for name, curves in test_sets.items():
         recon = batched(lambda x: decode(encode(x)), curves)
         report["test_sets"][name] = evaluate_set(curves, recon)
-        report["test_sets"][name]["interpolation"] = interpolation_report(encode, decode, curves)
+        if len(curves) >= 2:  # a data set of one's own may hold a single test curve: no pairs to interpolate
+            report["test_sets"][name]["interpolation"] = interpolation_report(encode, decode, curves)
         if figures:
-            plot_reconstructions(curves, recon, out / f"reconstructions_{name}.png")
+            plot_reconstructions(curves, recon, out / f"reconstructions_{name}.png", n=min(8, len(curves)))
             plot_tangents([curves[0], recon[0]], ["input", "reconstruction"], out / f"tangents_{name}.png")
     first = next(iter(test_sets.values()))
     if runtime is not None and len(test_sets) >= 2:
@@ -414,7 +418,7 @@ def run_evaluation(
         if figures:
             made = runtime.sample(16, seed=0)
             plot_samples(made.curves, first, out / "samples.png")
-    if figures:
+    if figures and len(first) >= MIN_FIGURE_CURVES:
         plot_pair_interpolation(
             encode, decode, [(first[0], first[1]), (first[2], first[3])], out / "interpolation_pair.png"
         )
