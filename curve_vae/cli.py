@@ -3,7 +3,7 @@
 Each subcommand imports what it needs when it runs, so `curve-vae serve` and the offline
 commands (sample, augment, fit, revolve) work in the base install (no torch).
 
-Length (~760 lines): one function per subcommand plus its argparse block, still one module;
+Length (~850 lines): one function per subcommand plus its argparse block, still one module;
 issue 20 moves each command beside the code it drives (a `curve_vae/commands/` package).
 """
 
@@ -75,7 +75,7 @@ def cmd_dataset(a: argparse.Namespace) -> int:
     import time
 
     from training.data import load_or_generate
-    from training.evaluate import _plt, _save
+    from training.figures import pyplot, save_figure
 
     if a.preview:
         refuse_overwrite(a.preview, a.force, "--preview")
@@ -88,7 +88,7 @@ def cmd_dataset(a: argparse.Namespace) -> int:
         f"in {dt:.1f} s; coordinates in [{ds.train.min():.1f}, {ds.train.max():.1f}]"
     )
     if a.preview:
-        plt = _plt()
+        plt = pyplot()
         fig, axes = plt.subplots(3, 6, figsize=(13, 6.5))
         for ax, c in zip(axes.flat, ds.train[:18]):
             ax.plot(*c.T, lw=1)
@@ -99,7 +99,7 @@ def cmd_dataset(a: argparse.Namespace) -> int:
             ax.set_xticks([])
             ax.set_yticks([])
         fig.suptitle("training curves (green: first point)")
-        _save(fig, Path(a.preview))
+        save_figure(fig, Path(a.preview))
         print(f"preview: {a.preview}")
     return 0
 
@@ -167,7 +167,8 @@ def cmd_train(a: argparse.Namespace) -> int:
     import os
 
     from training.config import ModelConfig, TrainConfig
-    from training.evaluate import plot_training, run_evaluation, torch_codec
+    from training.evaluate import run_evaluation, torch_codec
+    from training.figures import plot_training
     from training.train import train
 
     spline_ctrl = a.spline_ctrl
@@ -484,15 +485,13 @@ def cmd_augment(a: argparse.Namespace) -> int:
             chunks = runtime.augment_chunks(plan, start, stop, n_points=a.n_points, spacing=a.spacing, chunk=step)
             write_npy_chunks(a.output, shape, counted(chunks, progress))
         else:
-            parts = []
-            for i in range(start, stop, step):
+            parts = []  # chunk by chunk for the bar; a count of 0 still makes one (empty) chunk of the right shapes
+            for i in range(start, stop, step) or [start]:
                 parts.append(
                     runtime.augment_batch(plan, i, min(i + step, stop), n_points=a.n_points, spacing=a.spacing)
                 )
                 progress.update(len(parts[-1][0]))
-            out = np.concatenate([p[0] for p in parts]) if parts else np.zeros((0, runtime.n_points, 2))
-            sources = np.concatenate([p[1] for p in parts]) if parts else np.zeros((0, 2), np.int64)
-            weights = np.concatenate([p[2] for p in parts]) if parts else np.zeros((0, 2))
+            out, sources, weights = (np.concatenate([p[k] for p in parts]) for k in range(3))
             frames = [f for p in parts for f in p[3]]
             shape = out.shape
             body = augment_body(out, sources, weights, frames, seed=seed, offset=a.offset, metrics=a.metrics)

@@ -23,6 +23,7 @@ from geometry.frame import (
     blend_frames,
     fit_frame,
     pose_frames,
+    posed_frame,
     resample,
     signed_turning,
 )
@@ -51,6 +52,7 @@ __all__ = [
     "fit_frame",
     "mse_per_curve",
     "pose_frames",
+    "posed_frame",
     "random_control_points",
     "resample",
     "revolve",

@@ -152,14 +152,17 @@ def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> l
             c, s = np.cos(turn), np.sin(turn)
             a = (np.eye(2) - 2 * np.outer(n, n)) @ np.array([[c, -s], [s, c]]) @ np.diag([-1.0, 1.0])
             poses.append((float(np.arctan2(a[1, 0], a[0, 0])), not mirror, True))
-    out = []
-    for turn, mir, rev in poses:
-        linear = Frame((0.0, 0.0), 1.0, rotation=turn, mirror=mir)._linear()
-        q = pts @ linear  # the bounding box is taken in the model's orientation
-        lo, hi = q.min(axis=0), q.max(axis=0)
-        center = ((lo + hi) / 2) @ linear.T
-        out.append(Frame((float(center[0]), float(center[1])), float((hi - lo).max()), turn, mir, rev))
-    return out
+    return [posed_frame(pts, turn, mirror=mir, reverse=rev) for turn, mir, rev in poses]
+
+
+def posed_frame(points: np.ndarray, rotation: float, *, mirror: bool = False, reverse: bool = False) -> Frame:
+    """The frame of a curve in a pose: its bounding box taken in the posed orientation, so the posed curve fills
+    the model's box as `fit_frame` makes an unposed one fill it."""
+    linear = Frame((0.0, 0.0), 1.0, rotation=rotation, mirror=mirror)._linear()
+    q = np.asarray(points, np.float64) @ linear
+    lo, hi = q.min(axis=0), q.max(axis=0)
+    center = ((lo + hi) / 2) @ linear.T
+    return Frame((float(center[0]), float(center[1])), float((hi - lo).max()), rotation, mirror, reverse)
 
 
 def arc_fractions(points: np.ndarray) -> np.ndarray:

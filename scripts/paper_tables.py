@@ -74,7 +74,8 @@ def _init_label(path: str) -> str:
 def laplacian_figure(runs: list[tuple[float, Path]], data: str, out: Path, *, curve: int = 0) -> None:
     """Tangents of one test curve: the input, then each run's reconstruction (paper Fig. 3)."""
     from training.data import DataConfig, load_or_generate
-    from training.evaluate import plot_tangents, torch_codec
+    from training.evaluate import torch_codec
+    from training.figures import plot_tangents
 
     test = load_or_generate(DataConfig(), data).test[curve : curve + 1]
     curves, labels = [test[0]], ["input B-spline"]

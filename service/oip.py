@@ -11,6 +11,9 @@ The tensors are the graphs' raw ones, in the model's plane: encoder `curves` (B,
 and, with a B-spline head, `control_points` (B, n_ctrl, 2). None of the REST geometry happens
 here (no frames, no resampling, no pose): it is what a Triton server running the export of
 `curve-vae triton` computes, so a client can switch between the two by changing the URL.
+
+Length (~400 lines): the protocol's request checks are most of it, one rule per error the protocol's
+clients expect; they share the signatures, so they stay together.
 """
 
 from __future__ import annotations

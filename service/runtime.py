@@ -17,7 +17,8 @@ the same model input. "arc_length" resamples evenly by arc length instead, for p
 spaced arbitrarily (hand-drawn strokes). Nothing here imports torch. Reading and checking model
 files is `service.model_files`; the learned latent distribution is `service.prior`.
 
-Length (~800 lines): one class whose methods share the sessions and the frame/length adaptation;
+Length (~870 lines): one class whose methods share the sessions, the frame/length adaptation and the
+choice of pose (which needs both graphs);
 issue 20 moves that adaptation into `geometry/` and the mixing weights and augment plans out,
 which is where this module should shrink next.
 """
@@ -334,7 +335,7 @@ class CurveRuntime:
         each, and the pose whose reconstruction is closest to the input is kept, with its latent.
         """
         posing = frame == "auto" and pose == "auto"
-        rows, owner, frames, fractions, inputs = [], [], [], [], []
+        rows, frames, fractions, inputs = [], [], [], []
         with np.errstate(all="ignore"):
             for i, c in enumerate(curves):
                 pts = np.asarray(c, dtype=np.float64)
@@ -350,7 +351,6 @@ class CurveRuntime:
                 for f in candidates:
                     m, fraction = self._to_model_points(pts, f, spacing, i)
                     rows.append(m)
-                    owner.append(i)
                     frames.append(f)
                     fractions.append(fraction)
         batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, self.n_points, 2), np.float32)
@@ -362,8 +362,8 @@ class CurveRuntime:
             _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
             decoded, ctrl = self.decode_model_splines(mean)
             err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
-        owners = np.asarray(owner)
-        best = [int(np.flatnonzero(owners == i)[np.argmin(err[owners == i])]) for i in range(len(inputs))]
+        k = len(batch) // max(len(inputs), 1)  # every curve has the same number of candidates, in a row
+        best = list(np.arange(len(inputs)) * k + err.reshape(len(inputs), k).argmin(axis=1))
         return Prepared(
             batch[best],
             [frames[b] for b in best],

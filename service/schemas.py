@@ -6,7 +6,7 @@ settings or the loaded model (curves per request, points per curve, latent size,
 row length) are checked in `service.deps`, with the same error format, and stated in the
 published schema by `service.openapi.state_bounds`.
 
-Length (~490 lines): every request and response body in one place, as the OpenAPI page groups
+Length (~520 lines): every request and response body in one place, as the OpenAPI page groups
 them; the field docs are most of it.
 """
 

@@ -18,7 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from geometry import random_control_points, sample_bspline, self_intersects
-from geometry.frame import MODEL_CENTER, chord_heading, fit_frame, signed_turning
+from geometry.frame import chord_heading, posed_frame, signed_turning
 
 DENSE = 641  # points per curve before respacing: 4× the model's, so every spacing interpolates finely
 SPACINGS = ("parameter", "arc_length", "warped")
@@ -185,13 +185,9 @@ def to_pose(curves: np.ndarray, rng: np.random.Generator, model_size: float) -> 
     in the model plane with its larger side `model_size` — exactly as the service maps a posted curve."""
     out = np.empty_like(curves, dtype=np.float64)
     for i, c in enumerate(np.asarray(curves, np.float64)):
-        if signed_turning(c) < 0:
-            c = c * [-1.0, 1.0]
-        turn = rng.uniform(-0.75 * np.pi, -0.25 * np.pi) - chord_heading(c)
-        rot = np.array([[np.cos(turn), np.sin(turn)], [-np.sin(turn), np.cos(turn)]])
-        c = c @ rot
-        f = fit_frame(c)
-        out[i] = (c - np.asarray(f.center)) * (model_size / f.size) + np.asarray(MODEL_CENTER)
+        mirror = signed_turning(c) < 0
+        turn = rng.uniform(-0.75 * np.pi, -0.25 * np.pi) - chord_heading(c * [-1.0, 1.0] if mirror else c)
+        out[i] = posed_frame(c, turn, mirror=mirror).to_model(c, model_size)
     return out
 
 

@@ -106,35 +106,6 @@ def run_suite(runtime: Any, test_curves: np.ndarray, *, count: int = 200, **opti
     }
 
 
-def plot_suite(runtime: Any, sets: dict[str, tuple[str, list[np.ndarray]]], path: Path, *, n: int = 5) -> None:
-    """A row per set: its first n curves (grey) and their reconstructions (colour), each in its own frame."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from training.io import atomic_path
-
-    fig, axes = plt.subplots(len(sets), n, figsize=(1.7 * n, 1.7 * len(sets)), squeeze=False)
-    for row, (name, (kind, curves)) in zip(axes, sets.items()):
-        out, _ = runtime.reconstruct(curves[:n])
-        rel = relative_rmse(curves[:n], out)
-        for ax, c, o, r in zip(row, curves, out, rel):
-            ax.plot(c[:, 0], c[:, 1], color="0.65", lw=2.4)
-            ax.plot(o[:, 0], o[:, 1], color="tab:red", lw=0.9)
-            ax.plot(*c[0], "o", color="0.3", ms=2.5)
-            ax.set_title(f"{100 * r:.2f}%", fontsize=7, pad=1)
-            ax.set_aspect("equal")
-            ax.axis("off")
-        row[0].text(-0.08, 0.5, f"{name}\n({kind})", transform=row[0].transAxes, ha="right", va="center", fontsize=7)
-    fig.suptitle("grey: input (dot: first point) · red: reconstruction · relative RMSE", fontsize=8)
-    fig.tight_layout(rect=(0.12, 0, 1, 0.98))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-
-
 def format_suite(report: dict[str, Any]) -> str:
     """The suite as a text table."""
     head = f"{'set':28s} {'kind':9s} {'rel RMSE':>9s} {'p95':>7s} {'max':>7s} {'rough×':>7s} {'crossing in/out':>16s}"

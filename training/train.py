@@ -3,7 +3,7 @@
 Knows nothing about curves beyond "a (N, n_points, 2) float array": the model owns the
 architecture, `losses` owns the objective. Run under `torchrun --nproc-per-node K` for
 data-parallel training (gloo on CPU, nccl on GPU); a single process needs no launcher.
-Length (~410 lines): checkpoint saving and loading still live here; issue 20 gives them
+Length (~430 lines): checkpoint saving and loading still live here; issue 20 gives them
 `training/checkpoint.py`.
 """
 

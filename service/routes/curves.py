@@ -1,7 +1,7 @@
 """The model's routes: encode, decode, reconstruct, interpolate, sample, augment. Each validates, calls the
 runtime in a worker thread (deps.run_inference) and shapes the JSON.
 
-Length (~410 lines): six routes, each ~20 lines of work and ~40 of OpenAPI examples beside the
+Length (~420 lines): six routes, each ~20 lines of work and ~40 of OpenAPI examples beside the
 route they document; one router per resource, as FastAPI's bigger-applications layout has it."""
 
 from __future__ import annotations

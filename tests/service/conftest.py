@@ -169,6 +169,19 @@ def server_factory() -> Iterator[Callable[..., LiveServer]]:
         server.stop()
 
 
+@pytest.fixture(scope="module")
+def shipped_server() -> Iterator[LiveServer]:
+    """`curve-vae serve` on the shipped model, for tests of what users see (the page, the README's answers)."""
+    if not (SHIPPED / "manifest.json").is_file():
+        pytest.skip("no shipped model: models/manifest.json is absent")
+    server = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
+    try:
+        server.wait_ready()
+        yield server
+    finally:
+        server.stop()
+
+
 @pytest.fixture(scope="session")
 def live_server(model_dir: Path) -> Iterator[LiveServer]:
     server = LiveServer("--model-dir", str(model_dir), "--providers", "cpu", "--max-body-bytes", "200000")

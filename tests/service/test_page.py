@@ -42,14 +42,9 @@ ARGS = [
 
 
 @pytest.fixture(scope="module")
-def server() -> Iterator[LiveServer]:
+def server(shipped_server: LiveServer) -> LiveServer:
     """The shipped model, so that the page draws real reconstructions and interpolants."""
-    s = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
-    try:
-        s.wait_ready()
-        yield s
-    finally:
-        s.stop()
+    return shipped_server
 
 
 @pytest.fixture(scope="module")

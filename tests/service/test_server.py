@@ -247,20 +247,6 @@ def _first(answer, key: str):
     return None
 
 
-@pytest.fixture(scope="module")
-def shipped_server():
-    from tests.service.conftest import SHIPPED, LiveServer
-
-    if not (SHIPPED / "manifest.json").is_file():
-        pytest.skip("no shipped model")
-    server = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
-    try:
-        server.wait_ready()
-        yield server
-    finally:
-        server.stop()
-
-
 SHOWN = [b for b in _curl_blocks() if _shown_scalars(b) and "-o " not in b and "%{http_code}" not in b]
 
 

@@ -61,8 +61,8 @@ def test_suite_bookkeeping_with_a_perfect_reconstructor():
     report = run_suite(Echo(), test, count=6)
     assert set(report) == set(suite_sets(test, 6))
     assert {r["kind"] for r in report.values()} >= {"paper", "trained", "held out"}
-    for name, r in report.items():
-        assert r["n_curves"] == (6 if name != "airfoils (UIUC)" else r["n_curves"])
+    for r in report.values():
+        assert r["n_curves"] == 6
         assert r["rel_rmse_mean"] == 0 and r["roughness_ratio"] == pytest.approx(1)
     assert "paper, rotated" in format_suite(report)
 
