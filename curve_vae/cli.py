@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from dataclasses import fields
 from pathlib import Path
@@ -50,6 +51,12 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
         help="your own curves instead: a file or a directory of .npy/.csv/.json/.dat files; 10%% of the curves are "
         "held out for validation and 10%% for test, and --n-train posed copies of the rest are trained on",
     )
+    g.add_argument(
+        "--workers",
+        type=int,
+        default=len(os.sched_getaffinity(0)),
+        help="processes drawing the broad mix: the same curves however many (default: the CPUs available, %(default)s)",
+    )
 
 
 def _data_path(a: argparse.Namespace, config: Any) -> Path:
@@ -81,7 +88,7 @@ def cmd_dataset(a: argparse.Namespace) -> int:
         refuse_overwrite(a.preview, a.force, "--preview")
     t = time.perf_counter()
     path = _data_path(a, _data_config(a))
-    ds = load_or_generate(_data_config(a), path)
+    ds = load_or_generate(_data_config(a), path, workers=a.workers)
     dt = time.perf_counter() - t
     print(
         f"{path}: train {ds.train.shape}, val {ds.val.shape}, test {ds.test.shape} "
@@ -188,6 +195,7 @@ def cmd_train(a: argparse.Namespace) -> int:
         _data_config(a),
         cfg,
         data_cache=_data_path(a, _data_config(a)),
+        data_workers=a.workers,
         resume=a.resume,
         progress=shown(a.no_progress),
         stop_after=a.stop_after,

@@ -32,10 +32,18 @@ class DataConfig:
     # from `source` (training/families.own_curves): split by curve, the training curves posed n_train times.
     mix: str = "paper"
     source: str = ""  # mix "files": a curve file, or a directory of .npy/.csv/.json/.dat files
+    # mix "broad": the version of its definition (training.families.MIX_VERSION), set by default; 0 otherwise
+    mix_version: int = 0
 
     def __post_init__(self) -> None:
         if self.mix not in MIXES:
             raise ValueError(f"mix must be one of {', '.join(MIXES)}, got {self.mix!r}")
+        if self.mix == "broad" and not self.mix_version:
+            from training.families import MIX_VERSION
+
+            object.__setattr__(self, "mix_version", MIX_VERSION)
+        elif self.mix != "broad" and self.mix_version:
+            raise ValueError('mix_version belongs to mix "broad" only')
         if (self.mix == "files") != bool(self.source):
             raise ValueError('a data source (--curves PATH) goes with mix "files", and only with it')
 
@@ -79,12 +87,32 @@ class CurveDataset:
     test_ctrl: np.ndarray  # control points of the test curves, for B-spline comparisons
 
     @classmethod
-    def generate(cls, config: DataConfig) -> CurveDataset:
+    def generate(cls, config: DataConfig, *, workers: int = 1) -> CurveDataset:
+        """The data set of `config`; the broad mix is drawn by `workers` processes (the same data however many)."""
         if config.mix == "files":
             from training.families import own_curves
 
             train, val, test = own_curves(config.source, config.n_train, config.seed, n_points=config.n_points)
             return cls(config, train, val, test, np.zeros((len(test), 0, 2), np.float32))
+        a, b = config.n_train, config.n_train + config.n_val
+        if config.mix == "broad":
+            from training.families import MIX_VERSION, broad_mix
+
+            if config.mix_version != MIX_VERSION:
+                raise ValueError(f"the broad mix of version {config.mix_version} is no longer made (now {MIX_VERSION})")
+            # the test split is the paper data set's own (DataConfig() sizes, this seed): eq. 4's MSE is measured
+            # on the paper's test curves whatever the training mix and its size
+            paper_total = DataConfig().n_train + config.n_val + config.n_test
+            curves, ctrl = generate_curves(
+                paper_total,
+                config.seed,
+                n_ctrl=config.n_ctrl,
+                n_points=config.n_points,
+                radius=config.radius,
+                center=config.center,
+            )
+            mixed = broad_mix(b, config.seed + 1, n_points=config.n_points, workers=workers)
+            return cls(config, mixed[:a], mixed[a:b], curves[-config.n_test :], ctrl[-config.n_test :])
         total = config.n_train + config.n_val + config.n_test
         curves, ctrl = generate_curves(
             total,
@@ -94,12 +122,6 @@ class CurveDataset:
             radius=config.radius,
             center=config.center,
         )
-        a, b = config.n_train, config.n_train + config.n_val
-        if config.mix == "broad":
-            from training.families import broad_mix
-
-            mixed = broad_mix(b, config.seed + 1, n_points=config.n_points)
-            return cls(config, mixed[:a], mixed[a:b], curves[b:], ctrl[b:])
         return cls(config, curves[:a], curves[a:b], curves[b:], ctrl[b:])
 
     def save(self, path: str | Path) -> None:
@@ -119,6 +141,7 @@ class CurveDataset:
                 )
             cfg = meta["config"]
             cfg["center"] = tuple(cfg["center"])
+            cfg.setdefault("mix_version", 1 if cfg.get("mix") == "broad" else 0)  # written before versions
             return cls(DataConfig(**cfg), z["train"], z["val"], z["test"], z["test_ctrl"])
 
 
@@ -129,7 +152,9 @@ def default_cache(config: DataConfig) -> Path:
     return Path("data") / f"curves-{digest}.npz"
 
 
-def load_or_generate(config: DataConfig, cache: str | Path | None, *, say: bool = True) -> CurveDataset:
+def load_or_generate(
+    config: DataConfig, cache: str | Path | None, *, say: bool = True, workers: int = 1
+) -> CurveDataset:
     """The data set for `config`: from `cache` when it holds exactly that configuration, generated and written there
     when the file does not exist yet (saying where), generated without a file for cache None.
 
@@ -150,7 +175,7 @@ def load_or_generate(config: DataConfig, cache: str | Path | None, *, say: bool 
                 "--data path, or omit --data for the default cache of each configuration"
             )
         return ds
-    ds = CurveDataset.generate(config)
+    ds = CurveDataset.generate(config, workers=workers)
     if cache is not None:
         ds.save(cache)
         if say:

@@ -136,7 +136,7 @@ def train_one_epoch(
     DDP process at the same step: rank 0's clock decides).
     """
     model.train()
-    sums: dict[str, float] = {}
+    sums: dict[str, torch.Tensor] = {}  # summed on the device: no host sync per step
     n_batches = 0
     per_step = cfg.batch_size // max(1, dist.get_world_size() if dist.is_initialized() else 1)
     for i in range(0, len(order) - per_step + 1, per_step):  # drop the ragged last batch
@@ -155,12 +155,12 @@ def train_one_epoch(
             sched.step()
         n_batches += 1
         for k, v in terms.items():
-            sums[k] = sums.get(k, 0.0) + float(v.detach())
+            sums[k] = sums[k] + v.detach() if k in sums else v.detach().float()
         if bar is not None:  # a time-budgeted run's bar counts seconds of the budget; an epoch's, curves
             bar.update(min(clock.elapsed(), clock.budget) - bar.n if clock is not None and clock.budget > 0 else len(x))
             if n_batches % 10 == 0:
-                bar.set_postfix({k: f"{sums[k] / n_batches:.4g}" for k in ("loss", "mse", "kl", "lap")})
-    return {**{k: v / max(1, n_batches) for k, v in sums.items()}, "steps": n_batches}
+                bar.set_postfix({k: f"{float(sums[k]) / n_batches:.4g}" for k in ("loss", "mse", "kl", "lap")})
+    return {**{k: float(v) / max(1, n_batches) for k, v in sums.items()}, "steps": n_batches}
 
 
 def _agree(flag: bool) -> bool:
@@ -234,6 +234,7 @@ def train(
     cfg: TrainConfig,
     *,
     data_cache: str | Path | None = None,
+    data_workers: int = 1,
     resume: bool = False,
     progress: bool = True,
     stop_after: int = 0,
@@ -258,11 +259,13 @@ def train(
     world = dist.get_world_size() if distributed else 1
     if cfg.threads > 0:
         torch.set_num_threads(cfg.threads)
+    if device.type == "cuda":
+        torch.backends.cudnn.benchmark = True  # every batch has the same shape: pick the fastest kernels once
 
     try:
         torch.manual_seed(cfg.seed)
         random.seed(cfg.seed)
-        ds = load_or_generate(data_cfg, data_cache) if rank == 0 else None
+        ds = load_or_generate(data_cfg, data_cache, workers=data_workers) if rank == 0 else None
         if distributed:  # rank 0 generates or loads (and writes the cache) first
             dist.barrier()
             if rank != 0:

@@ -75,3 +75,28 @@ def test_cache_round_trip_and_mismatch(tmp_path, small):
     assert CurveDataset.load(tmp_path / "new.npz").config == other and fresh.train.shape == (100, 161, 2)
     assert default_cache(other) != default_cache(SMALL) and default_cache(SMALL) == default_cache(SMALL)
     assert not list(tmp_path.glob("*.tmp")), "no temporary files left behind"
+
+
+def test_broad_mix_is_versioned_and_its_test_split_is_the_papers(tmp_path):
+    from training.families import MIX_VERSION
+
+    cfg = DataConfig(n_train=300, n_val=20, n_test=10, mix="broad")
+    assert cfg.mix_version == MIX_VERSION and DataConfig().mix_version == 0
+    ds = load_or_generate(cfg, tmp_path / "b.npz", say=False, workers=2)
+    paper = generate_curves(DataConfig().n_train + 20 + 10, 0)[0][-10:]
+    np.testing.assert_array_equal(ds.test, paper)  # the paper data set's test curves, whatever the mix's size
+    assert ds.train.shape == (300, 161, 2) and ds.val.shape == (20, 161, 2)
+    # a cache written before the mix had versions holds version 1: read as such, refused for the present one
+    import json
+
+    with np.load(tmp_path / "b.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    meta = json.loads(str(arrays["meta"]))
+    del meta["config"]["mix_version"]
+    arrays["meta"] = np.array(json.dumps(meta))
+    np.savez(tmp_path / "old.npz", **arrays)
+    assert CurveDataset.load(tmp_path / "old.npz").config.mix_version == 1
+    with pytest.raises(ValueError, match="mix_version 1 .file. vs 2 .asked."):
+        load_or_generate(cfg, tmp_path / "old.npz")
+    with pytest.raises(ValueError, match="mix_version"):
+        DataConfig(mix_version=2)

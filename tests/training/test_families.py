@@ -49,7 +49,14 @@ def test_broad_mix_is_seeded_and_keeps_a_paper_share_as_the_paper_draws_it():
     assert not np.array_equal(a, F.broad_mix(400, 4))
     sizes = np.ptp(a, axis=1).max(axis=1)
     posed = np.isclose(sizes, 92.6, rtol=1e-4)
-    assert 0.8 < posed.mean() < 0.9  # 85%: everything but half of the paper's 30% share is posed and framed
+    assert 0.8 < posed.mean() < 0.9  # 85%: everything but a third of the paper's 45% share is posed and framed
+
+
+def test_broad_mix_is_the_same_however_many_processes_draw_it():
+    n = F.CHUNK + 300  # two chunks
+    one = F.broad_mix(n, 5, workers=1)
+    np.testing.assert_array_equal(one, F.broad_mix(n, 5, workers=2))
+    assert one.shape == (n, 161, 2) and np.isfinite(one).all()
 
 
 def test_suite_bookkeeping_with_a_perfect_reconstructor():
