@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import AsyncIterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
 from functools import partial
 from typing import Any
@@ -34,7 +35,7 @@ from fastapi.middleware.cors import CORSMiddleware
 from starlette.exceptions import HTTPException
 
 from service.access import ApiKeyMiddleware
-from service.cpus import available_cpus, threads_per_inference
+from service.cpus import available_cpus, inference_slots, session_config
 from service.errors import on_http_error, on_input_error, on_validation_error
 from service.metrics import Metrics, MetricsMiddleware
 from service.middleware import BodyLimitMiddleware
@@ -59,14 +60,17 @@ log = logging.getLogger("service")
 async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     settings: Settings = app.state.settings
     owned = app.state.runtime is None
+    slots = app.state.slots
     if owned:
-        threads = threads_per_inference(settings)
+        config = session_config(settings)
         log.info(
-            "onnxruntime: %d threads per inference (%s; %d workers × %d inferences at once)",
-            threads,
-            "CURVE_VAE_INTRA_OP_THREADS" if settings.intra_op_threads else f"{available_cpus()} CPUs",
-            settings.workers,
-            settings.inference_concurrency,
+            "onnxruntime: %d session pairs of %d threads (%s), %d inferences at once (%s), spinning %s",
+            config.sessions,
+            config.intra_op_threads,
+            "CURVE_VAE_INTRA_OP_THREADS" if settings.intra_op_threads else f"{available_cpus()} CPUs shared out",
+            slots,
+            "CURVE_VAE_INFERENCE_CONCURRENCY" if settings.inference_concurrency else f"{settings.workers} workers",
+            "on" if config.spinning else "off",
         )
         try:
             app.state.runtime = await anyio.to_thread.run_sync(
@@ -74,15 +78,14 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
                     CurveRuntime.load,
                     settings.model_dir,
                     providers=settings.providers,
-                    intra_op_threads=threads,
                     batch_size=settings.batch_size,
+                    sessions=config,
                 )
             )
         except ModelLoadError as e:
             log.error("cannot serve the model: %s", e)
             raise
     runtime: CurveRuntime = app.state.runtime
-    app.state.limiter = anyio.CapacityLimiter(settings.inference_concurrency)
     app.state.ready = True
     app.state.metrics.ready.set(1)
     log.info(
@@ -97,8 +100,16 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     finally:
         app.state.ready = False
         app.state.metrics.ready.set(0)
+        app.state.executor.shutdown(wait=False, cancel_futures=True)
+        app.state.executor = inference_executor(slots)  # for a lifespan that starts again (tests)
         if owned:
             app.state.runtime = None
+
+
+def inference_executor(slots: int) -> ThreadPoolExecutor:
+    """The inference threads: the app's own pool, one thread per slot (not anyio's default pool of 40, shared with
+    every sync call of the app, which let more inferences run at once than the CPUs hold)."""
+    return ThreadPoolExecutor(max_workers=slots, thread_name_prefix="inference")
 
 
 DESCRIPTION = """\
@@ -141,6 +152,8 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
     app.state.metrics = Metrics()
     app.state.pending = 0  # requests in deps.run_inference: running or waiting for an inference slot
+    app.state.slots = inference_slots(settings)
+    app.state.executor = inference_executor(app.state.slots)
     app.include_router(curves_router)
     app.include_router(design_router)
     app.include_router(ops_router)

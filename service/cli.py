@@ -34,7 +34,11 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--max-mesh-triangles", "max_mesh_triangles", int, "most triangles in one POST /revolve mesh"),
     ("--batch-size", "batch_size", int, "curves per ONNX run"),
     ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0: the CPU quota shared out"),
-    ("--inference-concurrency", "inference_concurrency", int, "inferences running at once"),
+    ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),
+    ("--spinning", "spinning", str, "true: onnxruntime threads spin-wait between runs"),
+    ("--inference-concurrency", "inference_concurrency", int, "inferences running at once; 0: one per CPU of a worker"),
+    ("--sessions", "sessions", int, "onnxruntime session pairs per worker; 0: one per inference running at once"),
+    ("--access-log", "access_log", str, "true: log a line per request (uvicorn's access log)"),
     ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
     ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
 ]
@@ -51,13 +55,14 @@ def configure_parser(parser: argparse.ArgumentParser) -> None:
         field = fields[name]
         default = field.default_factory() if field.default_factory is not None else field.default  # type: ignore[call-arg]
         default_text = ",".join(default) if isinstance(default, list) else default
+        default_text = "none" if default_text in ("", None) else default_text
         parser.add_argument(
             flag,
             dest=name,
             type=kind,
             default=None,
             choices=_CHOICES.get(name),
-            help=f"{text} (default: {default_text or 'none'}; env CURVE_VAE_{name.upper()})",
+            help=f"{text} (default: {default_text}; env CURVE_VAE_{name.upper()})",
         )
 
 
@@ -125,7 +130,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"curve-vae serve: error: {e}", file=sys.stderr)
         return 2
     common = dict(
-        host=settings.host, port=settings.port, log_level=settings.log_level, log_config=_log_config(settings.log_level)
+        host=settings.host,
+        port=settings.port,
+        log_level=settings.log_level,
+        log_config=_log_config(settings.log_level),
+        access_log=settings.access_log,
     )
     try:
         if settings.workers == 1:

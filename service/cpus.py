@@ -14,6 +14,8 @@ import os
 from pathlib import Path
 from typing import Any
 
+from service.sessions import SessionConfig
+
 CGROUP = Path("/sys/fs/cgroup")
 
 
@@ -46,10 +48,31 @@ def available_cpus(root: Path = CGROUP) -> int:
     return max(1, cpus)
 
 
+def inference_slots(settings: Any, cpus: int | None = None) -> int:
+    """Inferences one worker runs at once: `settings.inference_concurrency` where set; for 0, the CPUs shared
+    out among the workers (at least 1), so that 1-thread sessions fill the machine."""
+    if settings.inference_concurrency:
+        return int(settings.inference_concurrency)
+    cpus = available_cpus() if cpus is None else cpus
+    return max(1, cpus // settings.workers)
+
+
 def threads_per_inference(settings: Any, cpus: int | None = None) -> int:
-    """`settings.intra_op_threads` where set; for 0, the CPUs shared out: workers × inference_concurrency
+    """`settings.intra_op_threads` where set; for 0, the CPUs shared out: workers × inference slots
     inferences run at once, each on this many threads (at least 1)."""
     if settings.intra_op_threads:
         return int(settings.intra_op_threads)
     cpus = available_cpus() if cpus is None else cpus
-    return max(1, cpus // (settings.workers * settings.inference_concurrency))
+    return max(1, cpus // (settings.workers * inference_slots(settings, cpus)))
+
+
+def session_config(settings: Any, cpus: int | None = None) -> SessionConfig:
+    """The onnxruntime sessions of one worker: threads and spinning from the settings, one pair per inference
+    slot unless `settings.sessions` says otherwise."""
+    cpus = available_cpus() if cpus is None else cpus
+    return SessionConfig(
+        intra_op_threads=threads_per_inference(settings, cpus),
+        inter_op_threads=settings.inter_op_threads,
+        spinning=settings.spinning,
+        sessions=settings.sessions or inference_slots(settings, cpus),
+    )

@@ -3,10 +3,11 @@ the bounded, timed run of the work in a worker thread."""
 
 from __future__ import annotations
 
+import asyncio
 import math
 import time
 from collections.abc import Callable
-from typing import Annotated
+from typing import Annotated, Any, TypeVar
 
 import anyio
 import numpy as np
@@ -25,6 +26,8 @@ from service.runtime import (
 )
 from service.settings import Settings
 
+T = TypeVar("T")
+
 DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
 WEIGHT_SUM_TOLERANCE = 1e-6
 
@@ -39,8 +42,18 @@ def runtime_of(request: Request) -> CurveRuntime:
     return request.app.state.runtime
 
 
-SettingsDep = Annotated[Settings, Depends(settings_of)]
-RuntimeDep = Annotated[CurveRuntime, Depends(runtime_of)]
+async def _settings(request: Request) -> Settings:
+    return settings_of(request)
+
+
+async def _runtime(request: Request) -> CurveRuntime:
+    return runtime_of(request)
+
+
+# Async dependencies: FastAPI runs a plain `def` dependency on a worker thread, two thread hops per request for
+# what is an attribute read (measured: a fifth of a single-curve request's server CPU).
+SettingsDep = Annotated[Settings, Depends(_settings)]
+RuntimeDep = Annotated[CurveRuntime, Depends(_runtime)]
 
 
 def check_curves(curves: list[list[tuple[float, float]]], settings: Settings) -> list[np.ndarray]:
@@ -95,25 +108,32 @@ def splines_wanted(output: str, runtime: CurveRuntime) -> list[Spline] | None:
     return []
 
 
-def limiter_of(request: Request) -> anyio.CapacityLimiter | None:
-    return getattr(request.app.state, "limiter", None)  # set by the lifespan; None: anyio's default
+def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
+    """What GET /model reports under `execution`: the sessions' applied options and the inference threads."""
+    return {**runtime.pool.applied(), "inference_threads": request.app.state.slots}
+
+
+async def in_executor(request: Request, fn: Callable[..., T], *args: Any) -> T:
+    """`fn(*args)` on one of the app's inference threads (at most one inference per slot at once, first come
+    first served). Cancelling the caller leaves a running call to finish on its own; a queued one never starts."""
+    return await asyncio.wrap_future(request.app.state.executor.submit(fn, *args))
 
 
 async def run_inference(request: Request, route: str, batch: int, work: Callable[[], Response]) -> Response:
-    """Run `work` (inference and JSON rendering) in a worker thread, never on the event loop; timed, and at
-    most `inference_concurrency` at once.
+    """Run `work` (inference and JSON rendering) on an inference thread, never on the event loop; timed, and at
+    most one per inference slot (CURVE_VAE_INFERENCE_CONCURRENCY) at once.
 
-    Bounded both ways: with `inference_concurrency + max_queue` requests already in here, a new one is
-    answered 503 with Retry-After at once instead of joining an ever longer queue; one that takes longer
-    than `request_timeout` seconds (queueing included) is answered 504 (its thread finishes on its own).
+    Bounded both ways: with `slots + max_queue` requests already in here, a new one is answered 503 with
+    Retry-After at once instead of joining an ever longer queue; one that takes longer than `request_timeout`
+    seconds (queueing included) is answered 504 (its thread finishes on its own).
     """
     settings: Settings = request.app.state.settings
     state = request.app.state
-    if state.pending >= settings.inference_concurrency + settings.max_queue:
+    if state.pending >= state.slots + settings.max_queue:
         raise HTTPException(
             503,
-            f"busy: {state.pending} requests are running or queued (CURVE_VAE_INFERENCE_CONCURRENCY "
-            f"{settings.inference_concurrency} + CURVE_VAE_MAX_QUEUE {settings.max_queue}); retry in a moment",
+            f"busy: {state.pending} requests are running or queued ({state.slots} inference slots, "
+            f"CURVE_VAE_INFERENCE_CONCURRENCY, + CURVE_VAE_MAX_QUEUE {settings.max_queue}); retry in a moment",
             headers={"Retry-After": "1"},
         )
     metrics: Metrics = state.metrics
@@ -122,7 +142,7 @@ async def run_inference(request: Request, route: str, batch: int, work: Callable
     start = time.perf_counter()
     try:
         with anyio.fail_after(settings.request_timeout or None):
-            return await anyio.to_thread.run_sync(work, limiter=limiter_of(request), abandon_on_cancel=True)
+            return await in_executor(request, work)
     except TimeoutError:
         raise HTTPException(
             504, f"the request took longer than {settings.request_timeout:g} s (CURVE_VAE_REQUEST_TIMEOUT); send less"

@@ -52,8 +52,9 @@ from geometry import (
     self_intersects,
     smoothness,
 )
-from service.model_files import CUDA, ModelLoadError, graph_file, read_manifest, resolve_providers
+from service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
 from service.prior import PRIOR_FILE, LatentPrior
+from service.sessions import SessionConfig, SessionPool, open_pair
 
 log = logging.getLogger(__name__)
 
@@ -181,8 +182,10 @@ class CurveRuntime:
         batch_size: int = 64,
         requested_providers: str = "cpu",
         prior: LatentPrior | None = None,
+        pool: SessionPool | None = None,
     ) -> None:
-        self.encoder, self.decoder, self.manifest = encoder, decoder, manifest
+        self.pool = pool or SessionPool([(encoder, decoder)])  # the pair of each inference thread
+        self.manifest = manifest
         self.prior = prior
         self.batch_size = batch_size
         self.requested_providers = requested_providers
@@ -209,27 +212,20 @@ class CurveRuntime:
         intra_op_threads: int = 0,
         batch_size: int = 64,
         warm_up: bool = True,
+        sessions: SessionConfig | None = None,
     ) -> CurveRuntime:
-        """Open a model directory; raises ModelLoadError with what to fix when it cannot serve."""
+        """Open a model directory; raises ModelLoadError with what to fix when it cannot serve.
+
+        `sessions` sets threads, spinning and the number of session pairs (service.sessions); without it, one pair
+        of `intra_op_threads` threads."""
         root = Path(model_dir)
         manifest = read_manifest(root)
         provider_list = resolve_providers(providers)
-        opts = ort.SessionOptions()
-        opts.intra_op_num_threads = intra_op_threads
-        opts.log_severity_level = 3  # errors only: provider fallbacks are reported by /model instead
-        sessions = []
-        for graph in ("encoder", "decoder"):
-            path = root / graph_file(manifest, graph)
-            try:
-                sessions.append(ort.InferenceSession(str(path), sess_options=opts, providers=provider_list))
-            except Exception as e:  # onnxruntime raises its own exception types
-                raise ModelLoadError(f"{path}: onnxruntime cannot open it on {provider_list}: {e}") from e
-            if providers == "cuda" and CUDA not in sessions[-1].get_providers():
-                raise ModelLoadError(
-                    f"providers=cuda, but the CUDA provider failed to load for {path.name} (session runs on "
-                    f"{sessions[-1].get_providers()}): check that the CUDA 12 and cuDNN 9 libraries of "
-                    "onnxruntime-gpu are installed and a GPU is visible, or run with --providers cpu or auto"
-                )
+        config = sessions or SessionConfig(intra_op_threads=intra_op_threads)
+        paths = (root / graph_file(manifest, "encoder"), root / graph_file(manifest, "decoder"))
+        pool = SessionPool(
+            [open_pair(paths, provider_list, config, require_cuda=providers == "cuda") for _ in range(config.sessions)]
+        )
         prior = None
         if manifest.get("prior"):
             path = root / str(manifest["prior"].get("file", PRIOR_FILE))
@@ -237,7 +233,9 @@ class CurveRuntime:
                 prior = LatentPrior.load(path)
             except (OSError, ValueError, KeyError) as e:
                 raise ModelLoadError(f"{path}: not a usable latent prior ({e})") from e
-        runtime = cls(*sessions, manifest, batch_size=batch_size, requested_providers=providers, prior=prior)
+        runtime = cls(
+            *pool.pairs[0], manifest, batch_size=batch_size, requested_providers=providers, prior=prior, pool=pool
+        )
         if warm_up:
             runtime.warm_up()
         return runtime
@@ -265,6 +263,16 @@ class CurveRuntime:
             raise ModelLoadError("graphs do not match the manifest: " + "; ".join(problems))
 
     @property
+    def encoder(self) -> ort.InferenceSession:
+        """The calling thread's encoder session."""
+        return self.pool.pair()[0]
+
+    @property
+    def decoder(self) -> ort.InferenceSession:
+        """The calling thread's decoder session."""
+        return self.pool.pair()[1]
+
+    @property
     def has_splines(self) -> bool:
         """Whether the decoder ends in a B-spline head (curves can be returned as splines)."""
         return self.knots is not None
@@ -287,15 +295,18 @@ class CurveRuntime:
             raise ModelLoadError(f"warm-up gave shapes {mean.shape}, {out.shape}")
         if not (np.isfinite(mean).all() and np.isfinite(log_var).all() and np.isfinite(out).all()):
             raise ModelLoadError("warm-up inference gave non-finite numbers: the weights are broken")
+        for encoder, decoder in self.pool.pairs:  # every pair's first run allocates; not a request's
+            decoder.run(None, {self._dec_in: encoder.run(["mean"], {self._enc_in: circle})[0]})
 
     # ----------------------------------------------------------------------- raw graphs
 
     def encode_model(self, curves: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(B, n_points, 2) in the model plane -> mean, log_var (B, latent_dim); split into runs of batch_size."""
         x = np.ascontiguousarray(curves, dtype=np.float32)
+        encoder = self.encoder
         means, log_vars = [], []
         for i in range(0, len(x), self.batch_size):
-            mean, log_var = self.encoder.run(["mean", "log_var"], {self._enc_in: x[i : i + self.batch_size]})
+            mean, log_var = encoder.run(["mean", "log_var"], {self._enc_in: x[i : i + self.batch_size]})
             means.append(mean)
             log_vars.append(log_var)
         if not means:
@@ -309,9 +320,10 @@ class CurveRuntime:
     def decode_model_splines(self, latents: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         """(B, latent_dim) -> curves (B, n_points, 2) and, with a B-spline head, control points (B, n_ctrl, 2)."""
         z = np.ascontiguousarray(latents, dtype=np.float32)
+        decoder = self.decoder
         curves, ctrls = [], []
         for i in range(0, len(z), self.batch_size):
-            out = self.decoder.run(None, {self._dec_in: z[i : i + self.batch_size]})
+            out = decoder.run(None, {self._dec_in: z[i : i + self.batch_size]})
             curves.append(out[0])
             ctrls.append(out[1] if self.has_splines else None)
         if not curves:

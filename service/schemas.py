@@ -519,3 +519,7 @@ class ModelInfo(BaseModel):
     onnxruntime: str
     metrics: dict[str, Any] | None = Field(None, description="Evaluation results recorded at export, when present.")
     limits: dict[str, int] = Field(description="Request limits of this server.")
+    execution: dict[str, Any] = Field(
+        description="How this worker runs inference, read back from the live onnxruntime sessions: session pairs, "
+        "intra- and inter-op threads, spinning; and the inference threads (slots) and micro-batching in use."
+    )

@@ -34,7 +34,12 @@ class Settings(BaseSettings):
     # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among
     # workers × inference_concurrency (service/cpus.py), so a container never runs more threads than its quota
     intra_op_threads: int = Field(0, ge=0)
-    inference_concurrency: int = Field(2, ge=1)  # inferences running at once; more only queue on a small CPU
+    inter_op_threads: int = Field(1, ge=0)  # onnxruntime's inter-op pool; the graphs run sequentially; 0: its default
+    spinning: bool = False  # onnxruntime threads spin-wait between runs: CPU stolen from the other inferences
+    # inferences running at once = threads of the inference executor; 0: one per CPU of this worker (cpus ÷ workers)
+    inference_concurrency: int = Field(0, ge=0)
+    sessions: int = Field(0, ge=0)  # encoder/decoder session pairs per worker; 0: one per inference running at once
+    access_log: bool = False  # uvicorn's line per request: ~15% of a single-curve request's CPU, so off by default
     max_queue: int = Field(64, ge=0)  # requests waiting for an inference slot; beyond them: 503 with Retry-After
     request_timeout: float = Field(60.0, ge=0)  # seconds a request may take, queueing included (504); 0: no limit
     batch_size: int = Field(64, ge=1)  # curves per ONNX run: large requests are split to bound memory

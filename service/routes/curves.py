@@ -10,10 +10,9 @@ import time
 from collections.abc import AsyncIterator, Callable
 from typing import Annotated, Any
 
-import anyio
 import numpy as np
 from fastapi import APIRouter, Body, Request
-from fastapi.responses import JSONResponse, Response, StreamingResponse
+from fastapi.responses import Response, StreamingResponse
 
 from service import schemas as s
 from service.api_docs import C1, C2, C3, POST_ERRORS, curl_sample, example
@@ -23,13 +22,18 @@ from service.deps import (
     check_curves,
     check_n_points,
     check_weights,
-    limiter_of,
+    in_executor,
     run_inference,
+    runtime_of,
+    settings_of,
     splines_wanted,
 )
+from service.fastjson import JSON, FastJSONRoute
 from service.metrics import Metrics
 from service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
 from service.npy import chunk_bytes, npy_header, npy_size
+from service.npy_bodies import OPENAPI_BODY as NPY_BODY
+from service.npy_bodies import npy_route
 from service.payloads import augment_body, frames_json, sample_body, with_metrics, with_output
 from service.runtime import (
     AugmentPlan,
@@ -38,7 +42,8 @@ from service.runtime import (
     fresh_seed,
 )
 
-curves_router = APIRouter(tags=["curves"])
+ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'
+curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 
 
 @curves_router.post(
@@ -46,7 +51,8 @@ curves_router = APIRouter(tags=["curves"])
     response_model=s.EncodeResponse,
     responses=POST_ERRORS,
     summary="Latent mean and log-variance of each curve",
-    openapi_extra=curl_sample("/encode", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'),
+    openapi_extra=NPY_BODY
+    | curl_sample("/encode", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'),
 )
 async def encode(
     request: Request,
@@ -65,12 +71,21 @@ async def encode(
         ),
     ],
 ) -> Response:
-    """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance)."""
-    curves = check_curves(req.curves, settings)
+    """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance).
+    The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
+    return await _encode(request, req, check_curves(req.curves, settings))
+
+
+@npy_route("/encode", s.EncodeRequest)
+async def _encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray]) -> Response:
+    runtime = runtime_of(request)
 
     def work() -> Response:
         mean, log_var, frames = runtime.encode(curves, frame=req.frame, spacing=req.spacing, pose=req.pose)
-        return JSONResponse({"mean": mean.tolist(), "log_var": log_var.tolist(), "frames": frames_json(frames)})
+        # float64 as the JSON always carried: orjson would write float32 at float32's shorter precision
+        return JSON(
+            {"mean": mean.astype(np.float64), "log_var": log_var.astype(np.float64), "frames": frames_json(frames)}
+        )
 
     return await run_inference(request, "/encode", len(curves), work)
 
@@ -119,9 +134,7 @@ async def decode(
     def work() -> Response:
         latents = np.array(req.latents, np.float64)
         curves = runtime.decode(latents, n_points=req.n_points, spacing=req.spacing, frames=frames, splines=splines)
-        return JSONResponse(
-            with_output(with_metrics({"curves": curves.tolist()}, curves, req.metrics), splines, req.output)
-        )
+        return JSON(with_output(with_metrics({"curves": curves.tolist()}, curves, req.metrics), splines, req.output))
 
     return await run_inference(request, "/decode", len(req.latents), work)
 
@@ -131,7 +144,8 @@ async def decode(
     response_model=s.ReconstructResponse,
     responses=POST_ERRORS,
     summary="Pass curves through the VAE",
-    openapi_extra=curl_sample("/reconstruct", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'),
+    openapi_extra=NPY_BODY
+    | curl_sample("/reconstruct", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'),
 )
 async def reconstruct(
     request: Request,
@@ -150,18 +164,23 @@ async def reconstruct(
         ),
     ],
 ) -> Response:
-    """Encode each curve's latent mean and decode it: the reconstruction in the caller's frame, and its MSE there."""
-    curves = check_curves(req.curves, settings)
-    check_n_points(req.n_points, settings)
+    """Encode each curve's latent mean and decode it: the reconstruction in the caller's frame, and its MSE there.
+    The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
+    return await _reconstruct(request, req, check_curves(req.curves, settings))
 
+
+@npy_route("/reconstruct", s.ReconstructRequest)
+async def _reconstruct(request: Request, req: s.ReconstructRequest, curves: list[np.ndarray]) -> Response:
+    runtime, settings = runtime_of(request), settings_of(request)
+    check_n_points(req.n_points, settings)
     splines = splines_wanted(req.output, runtime)
 
     def work() -> Response:
         out, mse = runtime.reconstruct(
             curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines, pose=req.pose
         )
-        body = with_metrics({"curves": [c.tolist() for c in out], "mse": mse.tolist()}, out, req.metrics)
-        return JSONResponse(with_output(body, splines, req.output))
+        body = with_metrics({"curves": [np.ascontiguousarray(c) for c in out], "mse": mse}, out, req.metrics)
+        return JSON(with_output(body, splines, req.output))
 
     return await run_inference(request, "/reconstruct", len(curves), work)
 
@@ -171,7 +190,8 @@ async def reconstruct(
     response_model=s.InterpolateResponse,
     responses=POST_ERRORS,
     summary="Curves between curves, by mixing latent means",
-    openapi_extra=curl_sample(
+    openapi_extra=NPY_BODY
+    | curl_sample(
         "/interpolate",
         '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]], '
         '[[0,0],[1.5,0.5],[3,2],[4,4],[5,6.5],[6.5,8],[8,8.5]]], "steps": 5}',
@@ -203,19 +223,24 @@ async def interpolate(
     ],
 ) -> Response:
     """Decode affine combinations of the curves' latent means; with frame "auto" each result is mapped
-    into the same blend of the inputs' frames."""
-    curves = check_curves(req.curves, settings)
+    into the same blend of the inputs' frames. The curves may also be posted as a .npy body
+    (`Content-Type: application/x-npy`), the other fields in the query."""
+    return await _interpolate(request, req, check_curves(req.curves, settings))
+
+
+@npy_route("/interpolate", s.InterpolateRequest)
+async def _interpolate(request: Request, req: s.InterpolateRequest, curves: list[np.ndarray]) -> Response:
+    runtime, settings = runtime_of(request), settings_of(request)
     check_n_points(req.n_points, settings)
     weights = check_weights(req, settings)
-
     splines = splines_wanted(req.output, runtime)
 
     def work() -> Response:
         out, frames = runtime.interpolate(
             curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines, pose=req.pose
         )
-        body = {"weights": weights.tolist(), "curves": out.tolist(), "frames": frames_json(frames)}
-        return JSONResponse(with_output(with_metrics(body, out, req.metrics), splines, req.output))
+        body = {"weights": weights, "curves": np.ascontiguousarray(out), "frames": frames_json(frames)}
+        return JSON(with_output(with_metrics(body, out, req.metrics), splines, req.output))
 
     return await run_inference(request, "/interpolate", len(weights), work)
 
@@ -272,7 +297,7 @@ async def sample(
             frame=frame,
             splines=splines,
         )
-        return JSONResponse(with_output(sample_body(made, seed, metrics=req.metrics), splines, req.output))
+        return JSON(with_output(sample_body(made, seed, metrics=req.metrics), splines, req.output))
 
     return await run_inference(request, "/sample", req.count, work)
 
@@ -367,7 +392,7 @@ async def augment(
             plan(), start, stop, n_points=req.n_points, spacing=req.spacing, splines=splines
         )
         body = augment_body(out, sources, weights, frames, seed=seed, offset=req.offset, metrics=req.metrics)
-        return JSONResponse(with_output(body, splines, req.output))
+        return JSON(with_output(body, splines, req.output))
 
     return await run_inference(request, "/augment", req.count, work)
 
@@ -386,7 +411,7 @@ async def _stream_augment(
         nonlocal busy
         begin = time.perf_counter()
         try:
-            return await anyio.to_thread.run_sync(fn, *args, limiter=limiter_of(request))
+            return await in_executor(request, fn, *args)
         finally:
             busy += time.perf_counter() - begin
 

@@ -6,7 +6,7 @@ from typing import Annotated
 
 import numpy as np
 from fastapi import APIRouter, Body, Request
-from fastapi.responses import JSONResponse, Response
+from fastapi.responses import Response
 
 from geometry import revolve
 from service import schemas as s
@@ -17,12 +17,13 @@ from service.deps import (
     check_n_points,
     run_inference,
 )
+from service.fastjson import JSON, FastJSONRoute
 from service.payloads import fit_body
 from service.runtime import (
     InputError,
 )
 
-design_router = APIRouter(tags=["design"])
+design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 
 
 @design_router.post(
@@ -56,9 +57,7 @@ async def fit(
     check_n_points(req.n_points, settings)
 
     def work() -> Response:
-        return JSONResponse(
-            fit_body(curves, req.n_ctrl, param=req.param, n_points=req.n_points, tolerance=req.tolerance)
-        )
+        return JSON(fit_body(curves, req.n_ctrl, param=req.param, n_points=req.n_points, tolerance=req.tolerance))
 
     return await run_inference(request, "/fit", len(curves), work)
 

@@ -6,8 +6,8 @@ the graphs' own, in the model's plane: no frames, no resampling, no pose (see se
 docs/DEPLOYMENT.md for how the REST routes' geometry wraps them). Errors are the protocol's
 `{"error": "..."}`: 400 for a request that does not fit the model's tensors, 404 for a model this
 server does not have, 401/413/503/504 as on every other route (service/errors.py speaks the
-protocol's format for every path under /v2). Inference runs like every other model route: in a
-worker thread, bounded by the same limiter and queue (deps.run_inference).
+protocol's format for every path under /v2). Inference runs like every other model route: on an
+inference thread, bounded by the same slots and queue (deps.run_inference).
 """
 
 from __future__ import annotations
@@ -17,13 +17,14 @@ from collections.abc import Awaitable, Callable
 from typing import Any
 
 from fastapi import APIRouter, Request
-from fastapi.responses import JSONResponse, Response
+from fastapi.responses import Response
 from pydantic import BaseModel, Field
 
 from service import oip
 from service.api_docs import ERROR_EXAMPLES, curl_sample
 from service.deps import run_inference, runtime_of
 from service.errors import oip_error
+from service.fastjson import JSON
 from service.oip import OipError
 
 TAG = "open inference protocol"
@@ -189,8 +190,9 @@ def _model_routes(model: str) -> None:
             version = str(runtime.manifest.get("version", ""))
 
             def work() -> Response:
-                result = oip.infer(session, req, batch_size=runtime.batch_size)
-                return JSONResponse(oip.response(model, version, req, result))
+                own = runtime.encoder if model == "encoder" else runtime.decoder  # this inference thread's session
+                result = oip.infer(own, req, batch_size=runtime.batch_size)
+                return JSON(oip.response(model, version, req, result))
 
             return await run_inference(request, f"/v2/models/{model}/infer", req.batch, work)
         except OipError as e:
@@ -204,7 +206,7 @@ def _model_routes(model: str) -> None:
     model_infer.__doc__ = (
         f"Run the {model} graph ({graph}) on tensors in the protocol's JSON format; each output comes back "
         f"flattened row-major with its shape. {RAW_TENSORS} Batches of up to CURVE_VAE_MAX_CURVES rows, run like "
-        "every other model route (same worker threads, limiter and queue). Triton's binary data extension is not "
+        "every other model route (same inference threads, slots and queue). Triton's binary data extension is not "
         "served: JSON tensors only."
     )
     oip_router.add_api_route(

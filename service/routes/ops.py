@@ -14,6 +14,7 @@ from service.api_docs import curl_sample, error_docs
 from service.deps import (
     RuntimeDep,
     SettingsDep,
+    execution_of,
     runtime_of,
 )
 
@@ -46,7 +47,7 @@ async def ready(request: Request) -> dict[str, str]:
     summary="The model being served",
     openapi_extra=curl_sample("/model"),
 )
-async def model_info(runtime: RuntimeDep, settings: SettingsDep) -> dict[str, Any]:
+async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDep) -> dict[str, Any]:
     """Name, version, dimensions and checksums from the manifest, and the providers the sessions actually use."""
     m = runtime.manifest
     return {
@@ -77,6 +78,7 @@ async def model_info(runtime: RuntimeDep, settings: SettingsDep) -> dict[str, An
             "max_stream_curves": settings.max_stream_curves,
             "max_mesh_triangles": settings.max_mesh_triangles,
         },
+        "execution": execution_of(request, runtime),
     }
 
 

@@ -65,18 +65,67 @@ def test_an_explicit_thread_count_wins():
     assert cpus.threads_per_inference(settings, 2) == 3
 
 
+@pytest.mark.parametrize(
+    ("cpus_", "workers", "concurrency", "slots"), [(2, 1, 0, 2), (8, 2, 0, 4), (3, 4, 0, 1), (2, 1, 5, 5)]
+)
+def test_inference_slots_default_to_one_per_cpu_of_a_worker(cpus_, workers, concurrency, slots):
+    settings = Settings.model_construct(workers=workers, inference_concurrency=concurrency)
+    assert cpus.inference_slots(settings, cpus_) == slots
+
+
 def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypatch):
-    seen = {}
-    real = cpus.threads_per_inference
-
-    def spy(settings, n=None):
-        seen["threads"] = real(settings, 6)
-        return seen["threads"]
-
-    monkeypatch.setattr("service.app.threads_per_inference", spy)
+    monkeypatch.setattr("service.cpus.available_cpus", lambda root=None: 6)
     client = make_client(share_runtime=False, providers="cpu", inference_concurrency=3)
     assert client.get("/ready").status_code == 200
-    assert seen["threads"] == 2  # 6 CPUs for 1 worker × 3 inferences at once
     runtime = client.app.state.runtime
-    for session in (runtime.encoder, runtime.decoder):
-        assert session.get_session_options().intra_op_num_threads == 2
+    assert len(runtime.pool.pairs) == 3  # one session pair per inference at once
+    for pair in runtime.pool.pairs:
+        for session in pair:  # read back from onnxruntime, not from our settings
+            opts = session.get_session_options()
+            assert opts.intra_op_num_threads == 2  # 6 CPUs for 1 worker × 3 inferences at once
+            assert opts.inter_op_num_threads == 1
+            assert opts.get_session_config_entry("session.intra_op.allow_spinning") == "0"
+    assert client.app.state.executor._max_workers == 3
+    execution = client.get("/model").json()["execution"]
+    assert execution == {
+        "sessions": 3,
+        "intra_op_threads": 2,
+        "inter_op_threads": 1,
+        "spinning": False,
+        "inference_threads": 3,
+    }
+
+
+def test_every_runtime_setting_can_be_overridden(make_client):
+    client = make_client(
+        share_runtime=False, providers="cpu", intra_op_threads=3, inter_op_threads=2, spinning=True, sessions=1
+    )
+    execution = client.get("/model").json()["execution"]
+    assert execution["sessions"] == 1 and execution["intra_op_threads"] == 3
+    assert execution["inter_op_threads"] == 2 and execution["spinning"] is True
+    opts = client.app.state.runtime.encoder.get_session_options()
+    assert opts.get_session_config_entry("session.intra_op.allow_spinning") == "1"
+
+
+def test_each_inference_thread_keeps_its_own_session_pair(make_client, curves):
+    """Concurrent requests run on distinct pairs: the executor's threads are spread over the pool."""
+    import concurrent.futures as cf
+    import threading
+
+    client = make_client(share_runtime=False, providers="cpu", inference_concurrency=2, intra_op_threads=1)
+    pool = client.app.state.runtime.pool
+    used: dict[str, int] = {}
+    real = pool.pair
+
+    def spy():
+        pair = real()
+        used[threading.current_thread().name] = id(pair[0])
+        return pair
+
+    pool.pair = spy
+    body = {"curves": curves(2, 40).tolist(), "pose": "as_is"}
+    with cf.ThreadPoolExecutor(4) as callers:
+        answers = list(callers.map(lambda _: client.post("/reconstruct", json=body).status_code, range(8)))
+    assert answers == [200] * 8
+    inference = {name: pair for name, pair in used.items() if name.startswith("inference")}
+    assert 1 <= len(inference) <= 2 and len(set(inference.values())) == len(inference)

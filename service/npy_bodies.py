@@ -1,0 +1,133 @@
+""".npy request bodies (Content-Type: application/x-npy) on the curve routes: the curves as one binary array.
+
+`POST /reconstruct?pose=as_is` with a .npy body of shape (B, n, 2) (or (n, 2), one curve), float32 or float64,
+is the JSON request `{"curves": <the array>, "pose": "as_is"}`: the other fields come from the query string,
+each a JSON value (`n_points=100`, `metrics=true`, `weights=[[0.5,0.5]]`) or else a string (`frame=model`).
+The curves skip JSON parsing and per-number validation: numpy checks them at once, and each refusal is a 422
+naming what is wrong (the header, the dtype, the shape, or the curve and point that is not finite).
+The answer is the same JSON as for a JSON request.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import orjson
+from fastapi import Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import Response
+from pydantic import BaseModel, ValidationError
+
+from service.runtime import InputError
+from service.settings import Settings
+
+MEDIA_TYPE = "application/x-npy"
+MAGIC = b"\x93NUMPY"
+_PLACEHOLDER = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]]  # stands for each posted curve in the schema check
+
+#: requestBody content for a route's OpenAPI operation (merged into openapi_extra)
+OPENAPI_BODY = {
+    "requestBody": {
+        "content": {
+            MEDIA_TYPE: {
+                "schema": {
+                    "type": "string",
+                    "format": "binary",
+                    "description": "The curves as a .npy file: float32 or float64 of shape (curves, points, 2) or "
+                    "(points, 2); the other fields as query parameters, each a JSON value or a string.",
+                }
+            }
+        }
+    }
+}
+
+Handler = Callable[[Request, Any, list[np.ndarray]], Awaitable[Response]]
+
+
+@dataclass(frozen=True)
+class NpyRoute:
+    model: type[BaseModel]  # the JSON request body the query fields are checked against
+    handler: Handler  # (request, validated request model, curves) -> the response
+
+
+ROUTES: dict[str, NpyRoute] = {}
+
+
+def npy_route(path: str, model: type[BaseModel]) -> Callable[[Handler], Handler]:
+    """Register `handler` for .npy bodies posted to `path` (service.fastjson.FastJSONRoute dispatches to it)."""
+
+    def register(handler: Handler) -> Handler:
+        ROUTES[path] = NpyRoute(model, handler)
+        return handler
+
+    return register
+
+
+def is_npy(request: Request) -> bool:
+    return request.headers.get("content-type", "").split(";")[0].strip().lower() == MEDIA_TYPE
+
+
+async def dispatch(request: Request, route: NpyRoute) -> Response:
+    """Read and check the curves, check the query fields against the route's schema, run the handler."""
+    settings: Settings = request.app.state.settings
+    curves = read_curves(await request.body(), settings)
+    fields: dict[str, Any] = {k: _query_value(v) for k, v in request.query_params.items()}
+    try:
+        req = route.model.model_validate({**fields, "curves": [_PLACEHOLDER] * len(curves)})
+    except ValidationError as e:
+        errors = [{**err, "loc": ("query", *err["loc"])} for err in e.errors() if err["loc"][:1] != ("curves",)]
+        raise RequestValidationError(errors or e.errors()) from None
+    return await route.handler(request, req, curves)
+
+
+def _query_value(text: str) -> Any:
+    try:
+        return orjson.loads(text)
+    except orjson.JSONDecodeError:
+        return text
+
+
+def read_curves(body: bytes, settings: Settings) -> list[np.ndarray]:
+    """The curves of a .npy body, float64, each (n, 2); InputError naming what is wrong."""
+    if not body.startswith(MAGIC):
+        raise InputError(("body",), f"not a .npy file (Content-Type {MEDIA_TYPE}): it must start with \\x93NUMPY")
+    buf = io.BytesIO(body)
+    try:
+        version = np.lib.format.read_magic(buf)
+        read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+        shape, fortran, dtype = read(buf)
+    except (ValueError, SyntaxError) as e:
+        raise InputError(("body",), f"a .npy header numpy cannot read: {e}") from None
+    if dtype.kind != "f" or dtype.itemsize not in (4, 8):
+        raise InputError(("body",), f"dtype {dtype.str}: send float32 or float64 (<f4 or <f8)")
+    if len(shape) == 2:
+        shape = (1, *shape)
+    if len(shape) != 3 or shape[2] != 2:
+        raise InputError(("body",), f"shape {shape}: expected (curves, points, 2) or (points, 2)")
+    count, points = shape[0], shape[1]
+    if count < 1:
+        raise InputError(("curves",), "no curves: the array's first axis is 0")
+    if count > settings.max_curves:
+        raise InputError(("curves",), f"at most {settings.max_curves} curves per request, got {count}")
+    if points < 4:
+        raise InputError(("curves",), f"at least 4 points per curve, got {points}")
+    if points > settings.max_points:
+        raise InputError(("curves",), f"at most {settings.max_points} points per curve, got {points}")
+    data = body[buf.tell() :]
+    expected = count * points * 2 * dtype.itemsize
+    if len(data) != expected:
+        raise InputError(("body",), f"{len(data)} bytes of data, the header's shape {shape} needs {expected}")
+    a = np.frombuffer(data, dtype=dtype).reshape(shape, order="F" if fortran else "C").astype(np.float64)
+    finite = np.isfinite(a)
+    if not finite.all():
+        i, j, k = np.argwhere(~finite)[0]
+        raise InputError(("curves", int(i), int(j), int(k)), "not a finite number")
+    coincide = (a == a[:, :1]).all(axis=(1, 2))
+    if coincide.any():
+        i = int(np.argmax(coincide))
+        raise InputError(("curves", i), f"all {points} points coincide: a curve needs at least 2 distinct points")
+    return list(a)
