@@ -1,0 +1,150 @@
+"""The in-process ceiling a server on this machine can approach, and onnxruntime against torch eager.
+
+A "curve" here is one encoder run and one decoder run of the shipped graphs (what `/reconstruct` with pose
+"as_is" costs the model), timed without HTTP, JSON or geometry:
+
+    default     one session with onnxruntime's default options, batch 128, run from one thread
+    per_core    one 1-thread session per core, each run from its own thread in parallel, batch 128
+    eager       torch eager on the same weights (vae.pt), the same thread count, batch 1 and 128
+
+The ceiling is the best of `default` and `per_core` (issue 16). Every measurement runs for `seconds` and
+counts whole batches.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import onnxruntime as ort
+
+from geometry import random_control_points, sample_bspline
+
+
+def curves(count: int, seed: int = 0) -> np.ndarray:
+    """(count, 161, 2) float32 curves of the paper's kind in the model plane."""
+    return sample_bspline(random_control_points(np.random.default_rng(seed), count), 161).astype(np.float32)
+
+
+def sessions(model_dir: Path, threads: int | None) -> tuple[ort.InferenceSession, ort.InferenceSession]:
+    """Encoder and decoder sessions; threads None: onnxruntime's defaults (spinning included)."""
+    opts = ort.SessionOptions()
+    if threads is not None:
+        opts.intra_op_num_threads = threads
+        opts.inter_op_num_threads = 1
+        opts.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    opts.log_severity_level = 3
+    cpu = ["CPUExecutionProvider"]
+    return (
+        ort.InferenceSession(str(model_dir / "encoder.onnx"), opts, providers=cpu),
+        ort.InferenceSession(str(model_dir / "decoder.onnx"), opts, providers=cpu),
+    )
+
+
+def _roundtrip(enc: ort.InferenceSession, dec: ort.InferenceSession, x: np.ndarray) -> None:
+    mean = enc.run(["mean"], {"curves": x})[0]
+    dec.run(None, {"latent": mean})
+
+
+def _count(fn: Any, batch: int, seconds: float, stop_at: float | None = None) -> tuple[int, float]:
+    """Curves done by calling fn() repeatedly for `seconds` (after one warm-up call), and the time taken."""
+    fn()
+    start = time.perf_counter()
+    end = stop_at if stop_at is not None else start + seconds
+    done = 0
+    while time.perf_counter() < end:
+        fn()
+        done += batch
+    return done, time.perf_counter() - start
+
+
+def onnx_default(model_dir: Path, *, batch: int = 128, seconds: float = 5.0) -> float:
+    """Curves/s: one session with default options, one thread calling it."""
+    enc, dec = sessions(model_dir, None)
+    x = curves(batch)
+    done, took = _count(lambda: _roundtrip(enc, dec, x), batch, seconds)
+    return done / took
+
+
+def onnx_per_core(model_dir: Path, *, cores: int, batch: int = 128, seconds: float = 5.0) -> float:
+    """Curves/s: `cores` 1-thread sessions, each run by its own thread, all at once."""
+    pairs = [sessions(model_dir, 1) for _ in range(cores)]
+    x = curves(batch)
+    for enc, dec in pairs:
+        _roundtrip(enc, dec, x)
+    results: list[tuple[int, float]] = []
+    stop_at = time.perf_counter() + seconds
+
+    def loop(pair: tuple[ort.InferenceSession, ort.InferenceSession]) -> None:
+        results.append(_count(lambda: _roundtrip(*pair, x), batch, seconds, stop_at))
+
+    threads = [threading.Thread(target=loop, args=(pair,)) for pair in pairs]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    return sum(d for d, _ in results) / max(t for _, t in results)
+
+
+def onnx_threads(model_dir: Path, *, threads: int, batch: int, seconds: float = 5.0) -> float:
+    """Curves/s: one session of `threads` intra-op threads (spinning off), one caller."""
+    enc, dec = sessions(model_dir, threads)
+    x = curves(batch)
+    done, took = _count(lambda: _roundtrip(enc, dec, x), batch, seconds)
+    return done / took
+
+
+def torch_eager(model_dir: Path, *, threads: int, batch: int, seconds: float = 5.0) -> float | None:
+    """Curves/s of torch eager (no_grad, eval) on vae.pt with `threads` threads; None without torch or vae.pt."""
+    try:
+        import torch
+
+        from training.model import VAE, ModelConfig
+    except ImportError:
+        return None
+    weights = model_dir / "vae.pt"
+    if not weights.is_file():
+        return None
+    before = torch.get_num_threads()
+    torch.set_num_threads(threads)
+    try:
+        ckpt = torch.load(weights, map_location="cpu", weights_only=True)
+        model = VAE(ModelConfig(**ckpt["model_config"]))
+        model.load_state_dict(ckpt["model"])
+        model.eval()
+        x = torch.from_numpy(curves(batch))
+
+        def roundtrip() -> None:
+            with torch.inference_mode():
+                model.decoder(model.encoder(x)[0])
+
+        done, took = _count(roundtrip, batch, seconds)
+        return done / took
+    finally:
+        torch.set_num_threads(before)
+
+
+def measure(model_dir: Path, *, seconds: float = 5.0, cores: int | None = None, eager: bool = True) -> dict[str, Any]:
+    """All in-process figures of the report; the ceiling is the best of default and per-core; `eager` adds C."""
+    cores = cores or len(os.sched_getaffinity(0))
+    out: dict[str, Any] = {"cores": cores}
+    out["default_b128"] = onnx_default(model_dir, seconds=seconds)
+    out["per_core_b128"] = onnx_per_core(model_dir, cores=cores, seconds=seconds)
+    out["ceiling"] = max(out["default_b128"], out["per_core_b128"])
+    for batch in (1, 128) if eager else ():
+        ort_rate = onnx_threads(model_dir, threads=1, batch=batch, seconds=seconds)
+        eager = torch_eager(model_dir, threads=1, batch=batch, seconds=seconds)
+        out[f"onnx_1t_b{batch}"] = ort_rate
+        out[f"torch_1t_b{batch}"] = eager
+        out[f"C_b{batch}"] = ort_rate / eager if eager else None
+    return out
+
+
+if __name__ == "__main__":
+    import json
+
+    print(json.dumps(measure(Path(__file__).resolve().parent.parent / "models", seconds=3.0), indent=1))

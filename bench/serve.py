@@ -1,0 +1,335 @@
+"""Serving benchmark: the real server under wrk, as ratios to the in-process onnxruntime ceiling (issue 16).
+
+    apt-get install -y wrk                       # once: the load generator (Debian package)
+    .venv/bin/python -m bench.serve              # ~4 minutes on 2 cores; --seconds 10 per load run
+    .venv/bin/python -m bench.serve --seconds 1 --runs B   # the test suite's smoke run
+
+It starts `python -m service.cli` (uvicorn, the service's defaults unless a run says otherwise) on a loopback port
+for each configuration, drives it with wrk (POST bodies from a small Lua script, tests/bench run through
+`bench/post.lua`), and reads the server's CPU time from /proc (all its processes), so the server's cost per
+request shows apart from wrk's. Single-curve requests use pose "as_is" (one encoder and one decoder run per
+curve: the ceiling's unit of work); the default pose "auto" tries six poses, 6x the inference. The report is a
+Markdown section (printed, and written with --markdown FILE) and JSON (--json FILE).
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import os
+import platform
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bench import ceiling
+
+ROOT = Path(__file__).resolve().parent.parent
+LUA = Path(__file__).resolve().parent / "post.lua"
+RUNS = ("A", "B", "B_npy", "latency", "interpolate", "augment", "spinning", "access_log", "workers", "one_session", "C")
+
+
+# --------------------------------------------------------------------------- the server
+
+
+class Server:
+    """`python -m service.cli` on a free loopback port, with extra flags and environment."""
+
+    def __init__(self, model_dir: Path, *flags: str, env: dict[str, str] | None = None) -> None:
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            self.port = s.getsockname()[1]
+        self.url = f"http://127.0.0.1:{self.port}"
+        cmd = [sys.executable, "-m", "service.cli", "--port", str(self.port), "--model-dir", str(model_dir)]
+        cmd += ["--providers", "cpu", "--log-level", "warning", *flags]
+        self.proc = subprocess.Popen(cmd, cwd=ROOT, env={**os.environ, **(env or {})})
+        deadline = time.monotonic() + 90
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"server exited with {self.proc.returncode}: {' '.join(cmd)}")
+            try:
+                with urllib.request.urlopen(f"{self.url}/ready", timeout=1) as r:
+                    if r.status == 200:
+                        return
+            except OSError:
+                time.sleep(0.2)
+        self.stop()
+        raise TimeoutError(f"{self.url} not ready after 90 s")
+
+    def pids(self) -> list[int]:
+        """The server process and all its descendants (uvicorn's workers)."""
+        out, todo = [], [self.proc.pid]
+        while todo:
+            pid = todo.pop()
+            out.append(pid)
+            try:
+                todo += [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+            except OSError:
+                pass
+        return out
+
+    def cpu_seconds(self) -> dict[int, float]:
+        """User + system CPU seconds of each server process so far."""
+        tick = os.sysconf("SC_CLK_TCK")
+        out = {}
+        for pid in self.pids():
+            try:
+                fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            out[pid] = (int(fields[11]) + int(fields[12])) / tick  # utime, stime
+        return out
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+# --------------------------------------------------------------------------- load
+
+
+def wrk(server: Server, path: str, body: bytes, content_type: str, *, connections: int, seconds: float) -> dict:
+    """Drive `path` with wrk for `seconds`; requests/s, latency percentiles (ms), errors, server CPU per request."""
+    with tempfile.NamedTemporaryFile(suffix=".body", delete=False) as f:
+        f.write(body)
+    env = {**os.environ, "BENCH_BODY": f.name, "BENCH_CONTENT_TYPE": content_type}
+    threads = min(connections, 2)
+    cmd = ["wrk", f"-t{threads}", f"-c{connections}", f"-d{max(1, round(seconds))}s", "--timeout", "30s"]
+    cmd += ["-s", str(LUA), f"{server.url}{path}"]
+    before, wrk_before = server.cpu_seconds(), _children_cpu()
+    try:
+        out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True, timeout=seconds + 60).stdout
+    finally:
+        os.unlink(f.name)
+    after, wrk_cpu = server.cpu_seconds(), _children_cpu() - wrk_before
+    result = json.loads(out.strip().splitlines()[-1])  # the line post.lua's done() prints
+    requests = max(result["requests"], 1)
+    result["rps"] = result["requests"] / (result["duration_us"] / 1e6)
+    result["p50_ms"], result["p99_ms"] = result.pop("p50_us") / 1e3, result.pop("p99_us") / 1e3
+    cpu = {pid: after[pid] - before.get(pid, 0.0) for pid in after}
+    result["server_cpu_ms_per_request"] = sum(cpu.values()) / requests * 1e3
+    result["wrk_cpu_ms_per_request"] = wrk_cpu / requests * 1e3
+    result["cpu_s_by_process"] = {str(pid): round(s, 2) for pid, s in cpu.items()}
+    if result["errors"] or result["non_2xx"]:
+        print(f"  ! {path}: {result['errors']} socket errors, {result['non_2xx']} non-2xx answers", file=sys.stderr)
+    return result
+
+
+def _children_cpu() -> float:
+    """CPU seconds of this process's finished children (wrk's, once it has exited)."""
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def json_body(curves: np.ndarray, **fields: Any) -> bytes:
+    return json.dumps({"curves": curves.tolist(), **fields}).encode()
+
+
+def npy_body(a: np.ndarray) -> bytes:
+    buf = io.BytesIO()
+    np.save(buf, a.astype(np.float32))
+    return buf.getvalue()
+
+
+def post(url: str, body: bytes) -> bytes:
+    req = urllib.request.Request(url, data=body, headers={"Content-Type": "application/json"})
+    with urllib.request.urlopen(req, timeout=600) as r:
+        return r.read()
+
+
+def augment(server: Server, seeds: np.ndarray, count: int) -> dict[str, float]:
+    """Seconds for `count` curves from /augment: JSON paged by offset (max_curves a page), and one .npy stream."""
+    page = 256
+    start = time.perf_counter()
+    got = 0
+    for offset in range(0, count, page):
+        n = min(page, count - offset)
+        body = json_body(seeds, count=n, offset=offset, seed=1, pose="as_is")
+        got += len(json.loads(post(f"{server.url}/augment", body))["curves"])
+    json_s = time.perf_counter() - start
+    start = time.perf_counter()
+    data = post(f"{server.url}/augment", json_body(seeds, count=count, seed=1, pose="as_is", format="npy"))
+    npy_s = time.perf_counter() - start
+    assert got == count and np.load(io.BytesIO(data)).shape[0] == count
+    return {"count": count, "json_s": json_s, "npy_s": npy_s, "json_cps": count / json_s, "npy_cps": count / npy_s}
+
+
+# --------------------------------------------------------------------------- the report
+
+
+def machine() -> dict[str, Any]:
+    import onnxruntime
+    import uvicorn
+
+    cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
+    return {
+        "cpu": cpu,
+        "cores": len(os.sched_getaffinity(0)),
+        "python": platform.python_version(),
+        "onnxruntime": onnxruntime.__version__,
+        "uvicorn": uvicorn.__version__,
+        "load_before": os.getloadavg(),
+    }
+
+
+def run(a: argparse.Namespace) -> dict[str, Any]:
+    if shutil.which("wrk") is None:
+        sys.exit("bench.serve: wrk is not installed: apt-get install -y wrk")
+    model_dir, secs = Path(a.model_dir), a.seconds
+    runs = set(a.runs)
+    report: dict[str, Any] = {"machine": machine(), "seconds": secs, "command": " ".join(sys.argv)}
+    print("in-process ceiling ...", file=sys.stderr)
+    inproc = ceiling.measure(model_dir, seconds=min(secs, 5.0), eager="C" in runs)
+    report["inprocess"] = inproc
+    top = inproc["ceiling"]
+    one = ceiling.curves(1, seed=1)
+    many = ceiling.curves(128, seed=2)
+    single = json_body(one, pose="as_is")
+
+    def load(name: str, server: Server, path: str, body: bytes, ctype: str = "application/json", c: int = 16):
+        print(f"{name} ...", file=sys.stderr)
+        report[name] = wrk(server, path, body, ctype, connections=c, seconds=secs)
+        return report[name]
+
+    server = Server(model_dir)
+    try:
+        if "A" in runs:
+            r = load("A", server, "/reconstruct", json_body(many, pose="as_is"), c=2)
+            r["curves_per_s"] = r["rps"] * 128
+            r["ratio"] = r["curves_per_s"] / top
+        if "B" in runs:
+            r = load("B", server, "/reconstruct", single)
+            r["ratio"] = r["rps"] / top
+        if "B_npy" in runs:
+            r = load("B_npy", server, "/reconstruct?pose=as_is", npy_body(one), "application/x-npy")
+            r["ratio"] = r["rps"] / top
+        if "latency" in runs:
+            load("latency_1", server, "/reconstruct", single, c=1)
+            load("latency_1_pose_auto", server, "/reconstruct", json_body(one), c=1)
+        if "interpolate" in runs:
+            pair = ceiling.curves(2, seed=3)
+            load("interpolate", server, "/interpolate", json_body(pair, steps=5, pose="as_is"))
+            load("interpolate_pose_auto", server, "/interpolate", json_body(pair, steps=5))
+        if "augment" in runs:
+            print("augment ...", file=sys.stderr)
+            report["augment"] = augment(server, ceiling.curves(8, seed=4), a.augment_count)
+    finally:
+        server.stop()
+    variants = {
+        "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
+        "access_log": (["--access-log", "true"], "B with the access log on"),
+        "workers": (["--workers", "2", "--inference-concurrency", "1"], "B over 2 worker processes"),
+        "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
+    }
+    for name, (flags, _) in variants.items():
+        if name in runs:
+            server = Server(model_dir, *flags)
+            try:
+                r = load(name, server, "/reconstruct", single)
+                r["ratio"] = r["rps"] / top
+            finally:
+                server.stop()
+    report["machine"]["load_after"] = os.getloadavg()
+    return report
+
+
+def _f(x: float | None, digits: int = 2) -> str:
+    return "–" if x is None else f"{x:.{digits}f}"
+
+
+def markdown(r: dict[str, Any]) -> str:
+    m, ip = r["machine"], r["inprocess"]
+    lines = [
+        f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, onnxruntime {m['onnxruntime']}, "
+        f"uvicorn {m['uvicorn']}. Load average before {m['load_before'][0]:.2f}, after {m['load_after'][0]:.2f}. "
+        f"Command: `{r['command']}` ({r['seconds']:g} s per load run).",
+        "",
+        f"In-process ceiling: {ip['ceiling']:.0f} curves/s (one default session at batch 128: "
+        f"{ip['default_b128']:.0f}; one 1-thread session per core in parallel: {ip['per_core_b128']:.0f}).",
+        "",
+        "| run | requests/s | curves/s | ÷ ceiling | p50 ms | p99 ms | server CPU ms/request | wrk CPU ms/request "
+        "| non-2xx |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    names = {
+        "A": "A: /reconstruct, 128 curves JSON, 2 connections",
+        "B": "B: /reconstruct, 1 curve JSON, 16 connections",
+        "B_npy": "B with .npy bodies",
+        "latency_1": "/reconstruct, 1 curve, 1 connection",
+        "latency_1_pose_auto": '/reconstruct, 1 curve, pose "auto" (6 poses), 1 connection',
+        "interpolate": "/interpolate, pair, 5 steps, 16 connections",
+        "interpolate_pose_auto": '/interpolate, pair, 5 steps, pose "auto", 16 connections',
+        "spinning": "B, spinning on (`--spinning true`)",
+        "access_log": "B, access log on (`--access-log true`)",
+        "workers": "B, `--workers 2 --inference-concurrency 1`",
+        "one_session": "B, one session pair for both threads (`--sessions 1`)",
+    }
+    for key, label in names.items():
+        if key not in r:
+            continue
+        x = r[key]
+        single = ("B", "B_npy", "spinning", "access_log", "workers", "one_session")
+        cps = x.get("curves_per_s", x["rps"] if key in single else None)
+        lines.append(
+            f"| {label} | {x['rps']:.0f} | {_f(cps, 0)} | {_f(x.get('ratio'))} | {x['p50_ms']:.1f} | "
+            f"{x['p99_ms']:.1f} | {x['server_cpu_ms_per_request']:.2f} | {x['wrk_cpu_ms_per_request']:.2f} | "
+            f"{x['non_2xx'] + x['errors']} |"
+        )
+    if "workers" in r:
+        spread = ", ".join(f"{s:.1f}" for s in sorted(r["workers"]["cpu_s_by_process"].values(), reverse=True))
+        lines += ["", f"`--workers 2`: CPU seconds per server process during the run (supervisor included): {spread}."]
+    if "augment" in r:
+        g = r["augment"]
+        lines += [
+            "",
+            f"/augment, {g['count']:,} curves (8 seeds, pose as_is): JSON in pages of 256 "
+            f"{g['json_s']:.2f} s ({g['json_cps']:.0f} curves/s); one .npy stream {g['npy_s']:.2f} s "
+            f"({g['npy_cps']:.0f} curves/s).",
+        ]
+    if ip.get("C_b1") is not None:
+        lines += [
+            "",
+            "C, onnxruntime ÷ torch eager, encoder + decoder, 1 thread each: "
+            f"batch 1 {ip['onnx_1t_b1']:.0f} vs {ip['torch_1t_b1']:.0f} curves/s = **{ip['C_b1']:.2f}×**; "
+            f"batch 128 {ip['onnx_1t_b128']:.0f} vs {ip['torch_1t_b128']:.0f} = **{ip['C_b128']:.2f}×**.",
+        ]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--model-dir", default=str(ROOT / "models"), help="model to serve (default: the shipped one)")
+    p.add_argument("--seconds", type=float, default=10.0, help="length of each wrk run (default: 10)")
+    p.add_argument("--runs", nargs="+", choices=RUNS, default=list(RUNS), help="which runs (default: all)")
+    p.add_argument("--augment-count", type=int, default=10_000, help="curves asked of /augment (default: 10000)")
+    p.add_argument("--json", help="write the full results as JSON to this file")
+    p.add_argument("--markdown", help="write the Markdown report to this file")
+    a = p.parse_args(argv)
+    report = run(a)
+    text = markdown(report)
+    print(text)
+    if a.json:
+        Path(a.json).write_text(json.dumps(report, indent=1) + "\n")
+    if a.markdown:
+        Path(a.markdown).write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

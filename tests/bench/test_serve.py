@@ -1,0 +1,33 @@
+"""The serving benchmark's smoke run: one second of wrk against the real server, so bench/serve.py does not rot.
+
+The numbers mean nothing here (the test suite shares the CPU); the run must complete with every answer a 200.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.skipif(
+    shutil.which("wrk") is None, reason="wrk is not installed (.ci/run installs it: apt-get install wrk)"
+)
+@pytest.mark.skipif(not (ROOT / "models" / "manifest.json").is_file(), reason="no shipped model")
+def test_the_benchmark_runs_for_a_second(tmp_path):
+    out = tmp_path / "bench.json"
+    cmd = [sys.executable, "-m", "bench.serve", "--seconds", "1", "--runs", "B", "B_npy", "--json", str(out)]
+    done = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=180)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(out.read_text())
+    assert report["inprocess"]["ceiling"] > 0
+    for run in ("B", "B_npy"):
+        assert report[run]["requests"] > 0 and report[run]["non_2xx"] == 0 and report[run]["errors"] == 0
+        assert report[run]["server_cpu_ms_per_request"] > 0
+    assert "| B: /reconstruct, 1 curve JSON, 16 connections |" in done.stdout
