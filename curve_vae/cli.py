@@ -246,7 +246,14 @@ def cmd_export(a: argparse.Namespace) -> int:
         )
     ckpt = load_checkpoint(a.checkpoint)
     data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
-    ds = load_or_generate(data_cfg, _data_path(a, data_cfg))
+    if data_cfg.mix == "broad":  # posed at one size, tested on the paper's curves: no training split to draw
+        from training.data import paper_test_curves
+        from training.families import MODEL_SIZE
+
+        train, test, model_size = None, paper_test_curves(data_cfg)[0], MODEL_SIZE
+    else:
+        ds = load_or_generate(data_cfg, _data_path(a, data_cfg))
+        train, test, model_size = ds.train, ds.test, model_size_of(ds.train)
     model = model_from_checkpoint(a.checkpoint)
     if a.spline_ctrl is not None and a.spline_ctrl != model.cfg.spline_ctrl:
         from dataclasses import replace
@@ -276,8 +283,8 @@ def cmd_export(a: argparse.Namespace) -> int:
 
         # /sample draws the paper's curves: with the broad mix, the prior is fitted to the paper's training curves
         fit_on = (
-            ds.train[:FIT_CURVES]
-            if data_cfg.mix == "paper"
+            train[:FIT_CURVES]
+            if train is not None and data_cfg.mix == "paper"
             else generate_curves(min(FIT_CURVES, data_cfg.n_train), data_cfg.seed, n_points=data_cfg.n_points)[0]
         )
         with torch.no_grad():
@@ -292,7 +299,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         a.out,
         name=a.name,
         version=a.version,
-        model_size=model_size_of(ds.train),
+        model_size=model_size,
         extra={"training": training},
         prior=prior,
         prior_info=prior_info,
@@ -306,7 +313,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         report = run_evaluation(
             enc,
             dec,
-            {"test": ds.test, f"fresh_seed_{a.fresh_seed}": fresh},
+            {"test": test, f"fresh_seed_{a.fresh_seed}": fresh},
             Path(a.out) / "report",
             figures=False,
             runtime=CurveRuntime.load(a.out, providers="cpu"),

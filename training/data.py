@@ -76,6 +76,21 @@ def generate_curves(
     return np.concatenate(curves)[:count], np.concatenate(ctrls)[:count]
 
 
+def paper_test_curves(config: DataConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The broad mix's test split and its control points: the paper data set's own test curves (DataConfig()'s
+    sizes, this seed), so eq. 4's MSE is measured on the paper's test curves whatever the mix and its size."""
+    paper_total = DataConfig().n_train + config.n_val + config.n_test
+    curves, ctrl = generate_curves(
+        paper_total,
+        config.seed,
+        n_ctrl=config.n_ctrl,
+        n_points=config.n_points,
+        radius=config.radius,
+        center=config.center,
+    )
+    return curves[-config.n_test :], ctrl[-config.n_test :]
+
+
 @dataclass(frozen=True)
 class CurveDataset:
     """The three splits as (n, n_points, 2) float32 arrays in the 128×128 plane."""
@@ -100,19 +115,9 @@ class CurveDataset:
 
             if config.mix_version != MIX_VERSION:
                 raise ValueError(f"the broad mix of version {config.mix_version} is no longer made (now {MIX_VERSION})")
-            # the test split is the paper data set's own (DataConfig() sizes, this seed): eq. 4's MSE is measured
-            # on the paper's test curves whatever the training mix and its size
-            paper_total = DataConfig().n_train + config.n_val + config.n_test
-            curves, ctrl = generate_curves(
-                paper_total,
-                config.seed,
-                n_ctrl=config.n_ctrl,
-                n_points=config.n_points,
-                radius=config.radius,
-                center=config.center,
-            )
+            curves, ctrl = paper_test_curves(config)
             mixed = broad_mix(b, config.seed + 1, n_points=config.n_points, workers=workers)
-            return cls(config, mixed[:a], mixed[a:b], curves[-config.n_test :], ctrl[-config.n_test :])
+            return cls(config, mixed[:a], mixed[a:b], curves, ctrl)
         total = config.n_train + config.n_val + config.n_test
         curves, ctrl = generate_curves(
             total,

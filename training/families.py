@@ -20,6 +20,7 @@ import numpy as np
 from geometry import random_control_points, sample_bspline, self_intersects
 from geometry.frame import chord_heading, posed_frame, signed_turning
 
+MODEL_SIZE = 92.6  # the larger bounding-box side of a posed curve in the model plane: the paper's curves' median
 DENSE = 641  # points per curve before respacing: 4× the model's, so every spacing interpolates finely
 SPACINGS = ("parameter", "arc_length", "warped")
 
@@ -208,7 +209,7 @@ def draw_family(
     rng: np.random.Generator,
     *,
     n_points: int = 161,
-    model_size: float | None = 92.6,
+    model_size: float | None = MODEL_SIZE,
     spacings: tuple[str, ...] = SPACINGS,
     chunk: int = 1024,
 ) -> np.ndarray:
@@ -228,7 +229,7 @@ def draw_family(
 
 
 def own_curves(
-    source: str, n_train: int, seed: int, *, n_points: int = 161, model_size: float = 92.6, held: float = 0.1
+    source: str, n_train: int, seed: int, *, n_points: int = 161, model_size: float = MODEL_SIZE, held: float = 0.1
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A user's curves as a data set (train, val, test), each (k, n_points, 2) float32 in the model's pose and frame.
 
@@ -277,7 +278,9 @@ def _mix_chunk(args: tuple[int, int, int, int, float]) -> np.ndarray:
     return np.concatenate(parts)
 
 
-def broad_mix(count: int, seed: int, *, n_points: int = 161, model_size: float = 92.6, workers: int = 1) -> np.ndarray:
+def broad_mix(
+    count: int, seed: int, *, n_points: int = 161, model_size: float = MODEL_SIZE, workers: int = 1
+) -> np.ndarray:
     """`count` curves of the training mix (MIX shares, shuffled), seeded. The paper's share keeps its own
     pose, frame and parameter spacing a third of the time (PAPER_RAW), so the model stays as good on the
     paper's curves. Drawn in CHUNK-curve chunks by `workers` processes; the result does not depend on
