@@ -35,7 +35,20 @@ from bench import ceiling
 
 ROOT = Path(__file__).resolve().parent.parent
 LUA = Path(__file__).resolve().parent / "post.lua"
-RUNS = ("A", "B", "B_npy", "latency", "interpolate", "augment", "spinning", "access_log", "workers", "one_session", "C")
+RUNS = (
+    "A",
+    "B",
+    "B_npy",
+    "latency",
+    "interpolate",
+    "augment",
+    "spinning",
+    "access_log",
+    "workers",
+    "one_session",
+    "micro_batch",
+    "C",
+)
 
 
 # --------------------------------------------------------------------------- the server
@@ -236,6 +249,7 @@ def run(a: argparse.Namespace) -> dict[str, Any]:
         "access_log": (["--access-log", "true"], "B with the access log on"),
         "workers": (["--workers", "2", "--inference-concurrency", "1"], "B over 2 worker processes"),
         "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
+        "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),
     }
     for name, (flags, _) in variants.items():
         if name in runs:
@@ -279,12 +293,13 @@ def markdown(r: dict[str, Any]) -> str:
         "access_log": "B, access log on (`--access-log true`)",
         "workers": "B, `--workers 2 --inference-concurrency 1`",
         "one_session": "B, one session pair for both threads (`--sessions 1`)",
+        "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
     }
     for key, label in names.items():
         if key not in r:
             continue
         x = r[key]
-        single = ("B", "B_npy", "spinning", "access_log", "workers", "one_session")
+        single = ("B", "B_npy", "spinning", "access_log", "workers", "one_session", "micro_batch")
         cps = x.get("curves_per_s", x["rps"] if key in single else None)
         lines.append(
             f"| {label} | {x['rps']:.0f} | {_f(cps, 0)} | {_f(x.get('ratio'))} | {x['p50_ms']:.1f} | "

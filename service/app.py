@@ -35,6 +35,8 @@ from fastapi.middleware.cors import CORSMiddleware
 from starlette.exceptions import HTTPException
 
 from service.access import ApiKeyMiddleware
+from service.batching import GraphBatcher
+from service.batching import attach as attach_batcher
 from service.cpus import available_cpus, inference_slots, session_config
 from service.errors import on_http_error, on_input_error, on_validation_error
 from service.metrics import Metrics, MetricsMiddleware
@@ -86,6 +88,20 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
             log.error("cannot serve the model: %s", e)
             raise
     runtime: CurveRuntime = app.state.runtime
+    batcher = None
+    if settings.micro_batch:
+        batcher = GraphBatcher(
+            runtime.pool,
+            {"encoder": runtime.encoder.get_inputs()[0].name, "decoder": runtime.decoder.get_inputs()[0].name},
+            max_rows=settings.micro_batch_rows,
+            max_wait=settings.micro_batch_wait_ms / 1e3,
+            runners=app.state.slots,
+            registry=app.state.metrics.registry,
+        )
+        app.state.executor.shutdown(wait=False)
+        # Threads enough for a full batch of single-curve requests to wait together; runs are bounded by the slots.
+        app.state.executor = inference_executor(app.state.slots + settings.micro_batch_rows, batcher)
+    app.state.batcher = batcher
     app.state.ready = True
     app.state.metrics.ready.set(1)
     log.info(
@@ -102,14 +118,19 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
         app.state.metrics.ready.set(0)
         app.state.executor.shutdown(wait=False, cancel_futures=True)
         app.state.executor = inference_executor(slots)  # for a lifespan that starts again (tests)
+        if batcher is not None:
+            batcher.close()
         if owned:
             app.state.runtime = None
 
 
-def inference_executor(slots: int) -> ThreadPoolExecutor:
+def inference_executor(threads: int, batcher: GraphBatcher | None = None) -> ThreadPoolExecutor:
     """The inference threads: the app's own pool, one thread per slot (not anyio's default pool of 40, shared with
-    every sync call of the app, which let more inferences run at once than the CPUs hold)."""
-    return ThreadPoolExecutor(max_workers=slots, thread_name_prefix="inference")
+    every sync call of the app, which let more inferences run at once than the CPUs hold); with micro-batching,
+    threads whose graph runs go through the batcher."""
+    return ThreadPoolExecutor(
+        max_workers=threads, thread_name_prefix="inference", initializer=attach_batcher, initargs=(batcher,)
+    )
 
 
 DESCRIPTION = """\

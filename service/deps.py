@@ -110,7 +110,13 @@ def splines_wanted(output: str, runtime: CurveRuntime) -> list[Spline] | None:
 
 def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
     """What GET /model reports under `execution`: the sessions' applied options and the inference threads."""
-    return {**runtime.pool.applied(), "inference_threads": request.app.state.slots}
+    settings: Settings = request.app.state.settings
+    batching = (
+        {"rows": settings.micro_batch_rows, "wait_ms": settings.micro_batch_wait_ms}
+        if getattr(request.app.state, "batcher", None) is not None
+        else None
+    )
+    return {**runtime.pool.applied(), "inference_threads": request.app.state.slots, "micro_batch": batching}
 
 
 async def in_executor(request: Request, fn: Callable[..., T], *args: Any) -> T:

@@ -52,6 +52,7 @@ from geometry import (
     self_intersects,
     smoothness,
 )
+from service import batching
 from service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
 from service.prior import PRIOR_FILE, LatentPrior
 from service.sessions import SessionConfig, SessionPool, open_pair
@@ -306,12 +307,21 @@ class CurveRuntime:
         encoder = self.encoder
         means, log_vars = [], []
         for i in range(0, len(x), self.batch_size):
-            mean, log_var = encoder.run(["mean", "log_var"], {self._enc_in: x[i : i + self.batch_size]})
+            mean, log_var = self._run_graph(encoder, "encoder", x[i : i + self.batch_size], ["mean", "log_var"])
             means.append(mean)
             log_vars.append(log_var)
         if not means:
             return np.zeros((0, self.latent_dim), np.float32), np.zeros((0, self.latent_dim), np.float32)
         return np.concatenate(means), np.concatenate(log_vars)
+
+    def _run_graph(
+        self, session: ort.InferenceSession, graph: str, x: np.ndarray, outputs: list[str] | None
+    ) -> list[np.ndarray]:
+        """One run of a graph: gathered with other requests' by the thread's micro-batcher, if it has one."""
+        batcher = batching.current()
+        if batcher is not None:
+            return batcher.run(graph, x, outputs)
+        return session.run(outputs, {self._enc_in if graph == "encoder" else self._dec_in: x})
 
     def decode_model(self, latents: np.ndarray) -> np.ndarray:
         """(B, latent_dim) -> (B, n_points, 2) in the model plane."""
@@ -323,7 +333,7 @@ class CurveRuntime:
         decoder = self.decoder
         curves, ctrls = [], []
         for i in range(0, len(z), self.batch_size):
-            out = decoder.run(None, {self._dec_in: z[i : i + self.batch_size]})
+            out = self._run_graph(decoder, "decoder", z[i : i + self.batch_size], None)
             curves.append(out[0])
             ctrls.append(out[1] if self.has_splines else None)
         if not curves:

@@ -93,6 +93,7 @@ def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypa
         "inter_op_threads": 1,
         "spinning": False,
         "inference_threads": 3,
+        "micro_batch": None,
     }
 
 
