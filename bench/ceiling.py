@@ -128,6 +128,44 @@ def torch_eager(model_dir: Path, *, threads: int, batch: int, seconds: float = 5
         torch.set_num_threads(before)
 
 
+def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
+    """Milliseconds per request of what the server does besides HTTP, in-process on one 1-thread session:
+    the raw encoder + decoder run, `CurveRuntime.reconstruct` (pose "as_is": frames, resampling, B-spline
+    back), and for 128 curves also parsing and validating the JSON body and rendering the answer."""
+    import orjson
+
+    from service.deps import check_curves
+    from service.fastjson import JSON
+    from service.runtime import CurveRuntime
+    from service.schemas import ReconstructRequest
+    from service.sessions import SessionConfig
+    from service.settings import Settings
+
+    runtime = CurveRuntime.load(model_dir, providers="cpu", sessions=SessionConfig(intra_op_threads=1))
+    settings = Settings()
+    out: dict[str, float] = {}
+
+    def ms(fn: Any) -> float:
+        done, took = _count(fn, 1, seconds)
+        return took / max(done, 1) * 1e3
+
+    for batch in (1, 128):
+        x = curves(batch, seed=batch)
+        as_lists = [c.astype(np.float64) for c in x]
+        out[f"onnx_b{batch}_ms"] = ms(lambda x=x: runtime.decode_model_splines(runtime.encode_model(x)[0]))
+        out[f"reconstruct_b{batch}_ms"] = ms(lambda c=as_lists: runtime.reconstruct(c, pose="as_is"))
+        body = orjson.dumps({"curves": x.astype(np.float64), "pose": "as_is"}, option=orjson.OPT_SERIALIZE_NUMPY)
+
+        def parse(body: bytes = body) -> None:
+            req = ReconstructRequest.model_validate(orjson.loads(body))
+            check_curves(req.curves, settings)
+
+        out[f"parse_validate_b{batch}_ms"] = ms(parse)
+        rec, mse = runtime.reconstruct(as_lists, pose="as_is")
+        out[f"render_b{batch}_ms"] = ms(lambda rec=rec, mse=mse: JSON({"curves": rec, "mse": mse}))
+    return out
+
+
 def measure(model_dir: Path, *, seconds: float = 5.0, cores: int | None = None, eager: bool = True) -> dict[str, Any]:
     """All in-process figures of the report; the ceiling is the best of default and per-core; `eager` adds C."""
     cores = cores or len(os.sched_getaffinity(0))
@@ -135,6 +173,7 @@ def measure(model_dir: Path, *, seconds: float = 5.0, cores: int | None = None, 
     out["default_b128"] = onnx_default(model_dir, seconds=seconds)
     out["per_core_b128"] = onnx_per_core(model_dir, cores=cores, seconds=seconds)
     out["ceiling"] = max(out["default_b128"], out["per_core_b128"])
+    out["breakdown"] = breakdown(model_dir, seconds=min(seconds, 3.0))
     for batch in (1, 128) if eager else ():
         ort_rate = onnx_threads(model_dir, threads=1, batch=batch, seconds=seconds)
         eager = torch_eager(model_dir, threads=1, batch=batch, seconds=seconds)

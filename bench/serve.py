@@ -317,6 +317,24 @@ def markdown(r: dict[str, Any]) -> str:
             f"{g['json_s']:.2f} s ({g['json_cps']:.0f} curves/s); one .npy stream {g['npy_s']:.2f} s "
             f"({g['npy_cps']:.0f} curves/s).",
         ]
+    b = ip.get("breakdown")
+    if b:
+        lines += [
+            "",
+            "In-process, one 1-thread session, ms per request: "
+            f"encoder + decoder {b['onnx_b1_ms']:.2f} (1 curve) / {b['onnx_b128_ms']:.0f} (128 curves); "
+            f"`CurveRuntime.reconstruct` pose as_is {b['reconstruct_b1_ms']:.2f} / {b['reconstruct_b128_ms']:.0f}; "
+            f"JSON parse + validation {b['parse_validate_b1_ms']:.2f} / {b['parse_validate_b128_ms']:.1f}; "
+            f"rendering the answer {b['render_b1_ms']:.2f} / {b['render_b128_ms']:.1f}.",
+        ]
+        if "B" in r:
+            rest = r["B"]["server_cpu_ms_per_request"] - b["reconstruct_b1_ms"] - b["parse_validate_b1_ms"]
+            lines.append(
+                f"Of B's {r['B']['server_cpu_ms_per_request']:.2f} ms of server CPU per request, "
+                f"{b['reconstruct_b1_ms']:.2f} are the runtime's work in isolation and "
+                f"{b['parse_validate_b1_ms']:.2f} JSON; the other {rest:.2f} ms are HTTP, the framework, the thread "
+                "hand-offs and inference slowed by sharing the cores (caches) with the event loop and wrk."
+            )
     if ip.get("C_b1") is not None:
         lines += [
             "",
