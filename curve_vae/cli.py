@@ -183,9 +183,9 @@ def cmd_train(a: argparse.Namespace) -> int:
         start = Path(a.run_dir) / "last.pt" if a.resume and (Path(a.run_dir) / "last.pt").exists() else a.init_from
         spline_ctrl = 0
         if start:
-            import torch
+            from training.checkpoint import load_weights
 
-            spline_ctrl = torch.load(start, map_location="cpu", weights_only=True)["model_config"].get("spline_ctrl", 0)
+            spline_ctrl = load_weights(start)[0].spline_ctrl
     model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim, spline_ctrl=spline_ctrl)
     cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
     run_dir = Path(a.run_dir)
@@ -228,11 +228,11 @@ def cmd_train(a: argparse.Namespace) -> int:
 
 
 def cmd_export(a: argparse.Namespace) -> int:
+    from training.checkpoint import load_checkpoint, model_from_checkpoint
     from training.data import DataConfig, generate_curves, load_or_generate
     from training.evaluate import onnx_codec, run_evaluation
     from training.export import export, model_size_of
     from training.io import atomic_write_text
-    from training.train import load_checkpoint, model_from_checkpoint
 
     held = [
         f
@@ -339,8 +339,8 @@ def cmd_average(a: argparse.Namespace) -> int:
     import torch
 
     from training.average import average_checkpoints
+    from training.checkpoint import atomic_save, load_checkpoint
     from training.data import DataConfig, load_or_generate
-    from training.train import atomic_save, load_checkpoint
 
     if a.threads > 0:
         torch.set_num_threads(a.threads)
@@ -370,7 +370,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
         enc, dec, meta = torch_codec(a.checkpoint)
         import torch
 
-        data_cfg_d = torch.load(a.checkpoint, map_location="cpu", weights_only=True).get("data_config")
+        data_cfg_d = torch.load(a.checkpoint, map_location="cpu", weights_only=True).get("data_config")  # vae.pt: none
     else:
         from service.runtime import CurveRuntime
 

@@ -33,11 +33,11 @@ import torch
 from geometry import smoothness, spline_head
 from service.runtime import CurveRuntime
 from training.airfoils import load_airfoils
+from training.checkpoint import model_from_checkpoint
 from training.data import DataConfig, default_cache, generate_curves, load_or_generate
 from training.evaluate import evaluate_set, interpolation_report, onnx_codec
 from training.export import export
 from training.model import VAE, ModelConfig
-from training.train import model_from_checkpoint
 
 
 def load_weights(path: str, spline_ctrl: int) -> VAE:

@@ -17,9 +17,10 @@ import numpy as np
 import torch
 from torch import nn
 
+from training.checkpoint import CHECKPOINT_VERSION, load_checkpoint
 from training.config import ModelConfig
 from training.model import VAE
-from training.train import CHECKPOINT_VERSION, load_checkpoint, validation_mse
+from training.train import validation_mse
 
 __all__ = ["average_state_dicts", "recompute_batchnorm", "average_checkpoints"]
 

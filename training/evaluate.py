@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -45,12 +46,9 @@ def torch_codec(checkpoint: str | Path) -> tuple[Encoder, Decoder, dict[str, Any
     """Encoder/decoder callables over a torch checkpoint (last.pt, best.pt or vae.pt)."""
     import torch
 
-    from training.model import VAE, ModelConfig
+    from training.checkpoint import model_from_checkpoint
 
-    ckpt = torch.load(checkpoint, map_location="cpu", weights_only=True)
-    model = VAE(ModelConfig(**ckpt["model_config"]))
-    model.load_state_dict(ckpt["model"])
-    model.eval()
+    model = model_from_checkpoint(checkpoint)
 
     @torch.no_grad()
     def encode(curves: np.ndarray) -> np.ndarray:
@@ -60,7 +58,7 @@ def torch_codec(checkpoint: str | Path) -> tuple[Encoder, Decoder, dict[str, Any
     def decode(z: np.ndarray) -> np.ndarray:
         return model.decoder(torch.as_tensor(z, dtype=torch.float32)).numpy()
 
-    return encode, decode, {"model_config": ckpt["model_config"]}
+    return encode, decode, {"model_config": asdict(model.cfg)}
 
 
 def batched(fn: Callable[[np.ndarray], np.ndarray], x: np.ndarray, batch: int = 500) -> np.ndarray:

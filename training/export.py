@@ -26,6 +26,7 @@ from torch import nn
 from geometry import clamped_uniform_knots
 from service.model_files import file_sha256
 from service.prior import PRIOR_FILE, LatentPrior
+from training.checkpoint import save_weights
 from training.io import atomic_path, atomic_write_text
 from training.model import VAE, ModelConfig
 
@@ -149,8 +150,7 @@ def export(
         prior.save(out / PRIOR_FILE)
         files.append(PRIOR_FILE)
     if weights:
-        with atomic_path(out / "vae.pt") as tmp:
-            torch.save({"model_config": asdict(cfg), "model": model.state_dict()}, tmp)
+        save_weights(model, out / "vae.pt")
         files.append("vae.pt")
     manifest = {
         "manifest_version": MANIFEST_VERSION,

@@ -3,8 +3,7 @@
 Knows nothing about curves beyond "a (N, n_points, 2) float array": the model owns the
 architecture, `losses` owns the objective. Run under `torchrun --nproc-per-node K` for
 data-parallel training (gloo on CPU, nccl on GPU); a single process needs no launcher.
-Length (~430 lines): checkpoint saving and loading still live here; issue 20 gives them
-`training/checkpoint.py`.
+Checkpoint files are training/checkpoint.py's.
 """
 
 from __future__ import annotations
@@ -26,15 +25,13 @@ from torch import nn
 from tqdm import tqdm
 
 from geometry import mse_per_curve
+from training.checkpoint import CHECKPOINT_VERSION, atomic_save, load_checkpoint, load_weights, without_resume_state
 from training.config import SCHEDULES, ModelConfig, TrainConfig
 from training.data import DataConfig, load_or_generate
-from training.io import atomic_path
 from training.losses import vae_loss
 from training.model import VAE
 
-__all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch", "load_checkpoint", "model_from_checkpoint"]
-
-CHECKPOINT_VERSION = 1
+__all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch"]
 
 
 @dataclass
@@ -46,27 +43,6 @@ class RunState:
     best_epoch: int = -1
     trained_seconds: float = 0.0  # time spent in training steps, across resumes
     history: list[dict[str, float]] = field(default_factory=list)
-
-
-def atomic_save(obj: Any, path: Path) -> None:
-    """torch.save through a temporary file, renamed over `path` once complete."""
-    with atomic_path(path) as tmp:
-        torch.save(obj, tmp)
-
-
-def load_checkpoint(path: str | Path) -> dict[str, Any]:
-    ckpt = torch.load(path, map_location="cpu", weights_only=True)
-    if ckpt.get("version") != CHECKPOINT_VERSION:
-        raise ValueError(f"{path}: checkpoint version {ckpt.get('version')}, expected {CHECKPOINT_VERSION}")
-    return ckpt
-
-
-def model_from_checkpoint(path: str | Path) -> VAE:
-    """Rebuild the model from a checkpoint alone (its stored config), in eval mode."""
-    ckpt = load_checkpoint(path)
-    model = VAE(ModelConfig(**ckpt["model_config"]))
-    model.load_state_dict(ckpt["model"])
-    return model.eval()
 
 
 def pick_device(name: str) -> torch.device:
@@ -216,9 +192,7 @@ def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch
 
 def _keep_snapshot(run_dir: Path, ckpt: dict[str, Any], epoch: int, keep: int) -> None:
     """Save this epoch's weights (no optimiser state) and drop snapshots older than the latest `keep`."""
-    atomic_save(
-        {k: v for k, v in ckpt.items() if k not in ("optimizer", "scheduler", "rng")}, run_dir / f"epoch-{epoch:04d}.pt"
-    )
+    atomic_save(without_resume_state(ckpt), run_dir / f"epoch-{epoch:04d}.pt")
     for old in sorted(run_dir.glob("epoch-[0-9][0-9][0-9][0-9].pt"))[:-keep]:
         old.unlink()
 
@@ -312,10 +286,10 @@ def train(
             if resume and rank == 0:
                 print(f"no checkpoint at {last}: starting a new run", flush=True)
             if init_from:
-                init = torch.load(init_from, map_location="cpu", weights_only=True)
-                if not ModelConfig(**init["model_config"]).same_weights(model_cfg):
-                    raise ValueError(f"{init_from} holds a {init['model_config']} model, not {asdict(model_cfg)}")
-                model.load_state_dict(init["model"])
+                init_cfg, weights = load_weights(init_from)
+                if not init_cfg.same_weights(model_cfg):
+                    raise ValueError(f"{init_from} holds a {asdict(init_cfg)} model, not {asdict(model_cfg)}")
+                model.load_state_dict(weights)
                 if rank == 0:
                     print(f"initialised from {init_from}", flush=True)
 

@@ -12,8 +12,8 @@ import pytest
 import torch
 
 from curve_vae.cli import main
+from training.checkpoint import load_checkpoint, model_from_checkpoint
 from training.export import sha256
-from training.train import load_checkpoint, model_from_checkpoint
 
 pytestmark = pytest.mark.slow
 

@@ -11,7 +11,7 @@ import time
 
 import pytest
 
-from training.train import load_checkpoint
+from training.checkpoint import load_checkpoint
 
 pytestmark = pytest.mark.slow
 
