@@ -1,0 +1,276 @@
+"""`curve-vae export`, `evaluate` and `triton`: a checkpoint into the service's model files (training/export.py), their
+measurement (training/evaluate.py, training/suite.py), and a Triton model repository of them (service/triton.py)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from curve_vae.commands.options import (
+    DATA_HELP,
+    DEFAULT_MODELS,
+    FRESH_TEST_SEED,
+    add_suite_option,
+    data_path,
+)
+
+
+def cmd_export(a: argparse.Namespace) -> int:
+    from training.checkpoint import load_checkpoint, model_from_checkpoint
+    from training.data import DataConfig, generate_curves, load_or_generate
+    from training.evaluate import onnx_codec, run_evaluation
+    from training.export import export, model_size_of
+    from training.io import atomic_write_text
+
+    held = [
+        f
+        for f in ("manifest.json", "encoder.onnx", "decoder.onnx", "vae.pt", "prior.npz")
+        if (Path(a.out) / f).exists()
+    ]
+    if held and not a.force:
+        raise ValueError(
+            f"{a.out} already holds a model ({', '.join(held)}) and is left as it is: pass --force to replace it, "
+            "or export to a new --out directory"
+        )
+    ckpt = load_checkpoint(a.checkpoint)
+    data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
+    if data_cfg.mix == "broad":  # posed at one size, tested on the paper's curves: no training split to draw
+        from training.data import paper_test_curves
+        from training.families import MODEL_SIZE
+
+        train, test, model_size = None, paper_test_curves(data_cfg)[0], MODEL_SIZE
+    else:
+        ds = load_or_generate(data_cfg, data_path(a, data_cfg))
+        train, test, model_size = ds.train, ds.test, model_size_of(ds.train)
+    model = model_from_checkpoint(a.checkpoint)
+    if a.spline_ctrl is not None and a.spline_ctrl != model.cfg.spline_ctrl:
+        from dataclasses import replace
+
+        from training.model import VAE
+
+        head = VAE(replace(model.cfg, spline_ctrl=a.spline_ctrl))  # the head has no weights: same state dict
+        head.load_state_dict(model.state_dict())
+        model = head.eval()
+    training: dict[str, Any] = {
+        "data": ckpt["data_config"],
+        "train": ckpt["train_config"],
+        "epochs_run": ckpt["state"]["epoch"],
+        "best_epoch": ckpt["state"]["best_epoch"],
+        "best_val_mse": ckpt["state"]["best_val"],
+    }
+    if "averaged" in ckpt:  # made by curve-vae average: which checkpoints, and what it measured
+        training["averaged"] = ckpt["averaged"]
+    if a.training_info:
+        training.update(json.loads(Path(a.training_info).read_text()))
+    prior, prior_info = None, None
+    if a.prior:
+        import numpy as np
+        import torch
+
+        from training.prior import FIT_CURVES, fit_prior
+
+        # /sample draws the paper's curves: with the broad mix, the prior is fitted to the paper's training curves
+        fit_on = (
+            train[:FIT_CURVES]
+            if train is not None and data_cfg.mix == "paper"
+            else generate_curves(min(FIT_CURVES, data_cfg.n_train), data_cfg.seed, n_points=data_cfg.n_points)[0]
+        )
+        with torch.no_grad():
+            means = np.concatenate(
+                [model.encoder(torch.from_numpy(fit_on[i : i + 500]))[0].numpy() for i in range(0, len(fit_on), 500)]
+            )
+        prior = fit_prior(means, components=a.prior_components)
+        prior_info = {"fitted_on": f"latent means of the first {len(fit_on)} training curves of the paper's data set"}
+        print(f"fitted a {a.prior_components}-component latent prior to {len(fit_on)} training curves")
+    manifest = export(
+        model,
+        a.out,
+        name=a.name,
+        version=a.version,
+        model_size=model_size,
+        extra={"training": training},
+        prior=prior,
+        prior_info=prior_info,
+    )
+    print(f"exported {a.checkpoint} → {a.out}/: {', '.join(manifest['files'])}, manifest.json")
+    if a.evaluate:
+        fresh, _ = generate_curves(1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
+        from service.runtime import CurveRuntime
+
+        enc, dec, _ = onnx_codec(a.out)
+        report = run_evaluation(
+            enc,
+            dec,
+            {"test": test, f"fresh_seed_{a.fresh_seed}": fresh},
+            Path(a.out) / "report",
+            figures=False,
+            runtime=CurveRuntime.load(a.out, providers="cpu"),
+            suite_count=a.suite_count,
+        )
+        manifest["metrics"] = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
+        atomic_write_text(Path(a.out) / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+        (Path(a.out) / "report" / "report.json").unlink()
+        (Path(a.out) / "report").rmdir()
+        for name, r in report["test_sets"].items():
+            print(f"{name}: MSE {r['mse']:.4f} (median {r['mse_median']:.4f}) over {r['n_curves']} curves")
+        if "families" in report:
+            from training.suite import format_suite
+
+            print(format_suite(report["families"]))
+    return 0
+
+
+def cmd_evaluate(a: argparse.Namespace) -> int:
+    from training.data import DataConfig, generate_curves, load_or_generate
+    from training.evaluate import onnx_codec, run_evaluation, torch_codec
+
+    runtime = None
+    if a.checkpoint:
+        enc, dec, meta = torch_codec(a.checkpoint)
+        import torch
+
+        data_cfg_d = torch.load(a.checkpoint, map_location="cpu", weights_only=True).get("data_config")  # vae.pt: none
+    else:
+        from service.runtime import CurveRuntime
+
+        enc, dec, meta = onnx_codec(a.model_dir)
+        runtime = CurveRuntime.load(a.model_dir, providers="cpu")
+        data_cfg_d = meta.get("training", {}).get("data")
+    data_cfg = DataConfig(**{**data_cfg_d, "center": tuple(data_cfg_d["center"])}) if data_cfg_d else DataConfig()
+    ds = load_or_generate(data_cfg, data_path(a, data_cfg))
+    sets = {"test": ds.test}
+    if a.fresh_seed >= 0:
+        sets[f"fresh_seed_{a.fresh_seed}"] = generate_curves(
+            1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points
+        )[0]
+    log = Path(a.checkpoint).parent / "log.jsonl" if a.checkpoint else None
+    report = run_evaluation(
+        enc, dec, sets, a.out, log_path=log, figures=not a.no_figures, runtime=runtime, suite_count=a.suite_count
+    )
+    for name, r in report["test_sets"].items():
+        s_in, s_out = r["smoothness_input"]["roughness"], r["smoothness_output"]["roughness"]
+        print(
+            f"{name}: MSE {r['mse']:.4f} (paper eq. 4, {r['n_curves']} curves; median {r['mse_median']:.4f}); "
+            f"roughness in {s_in:.3f}° out {s_out:.3f}°; self-intersecting outputs {r['self_intersecting_outputs']:.1%}"
+        )
+        if "interpolation" not in r:
+            continue
+        lat, pw = r["interpolation"]["latent"], r["interpolation"]["pointwise"]
+        print(
+            f"  interpolants ({r['interpolation']['pairs']} pairs): latent roughness {lat['roughness']:.3f}°, "
+            f"self-intersecting {lat['self_intersecting']:.1%}; point-wise blends {pw['roughness']:.3f}°, "
+            f"{pw['self_intersecting']:.1%}"
+        )
+    for prior, g in report.get("generation", {}).items():
+        if isinstance(g, dict):
+            raw, kept = g["every_draw"], g["valid"]
+            print(
+                f"samples, {prior} prior: {raw['self_intersecting']:.1%} self-intersecting before rejection "
+                f"({kept['rejected_share']:.1%} of draws rejected); size {kept['size_vs_data']:.2f}× the data's, "
+                f"roughness {kept['roughness']:.3f}°, coverage {kept['coverage_vs_real']:.2f}×, "
+                f"precision {kept['precision_vs_real']:.2f}× of real curves'"
+            )
+    if "families" in report:
+        from training.suite import format_suite
+
+        print("curve families (relative RMSE: RMSE ÷ bounding-box diagonal, through the service's runtime):")
+        print(format_suite(report["families"]))
+    print(f"report: {Path(a.out) / 'report.json'}")
+    return 0
+
+
+def cmd_triton(a: argparse.Namespace) -> int:
+    from curve_vae.triton import smoke_test, write_repository
+    from service.settings import DEFAULT_MODEL_DIR
+
+    folders = write_repository(
+        a.model_dir or DEFAULT_MODEL_DIR,
+        a.out,
+        prefix=a.prefix,
+        max_batch_size=a.max_batch_size,
+        max_queue_delay_us=a.max_queue_delay_us,
+        force=a.force,
+    )
+    for folder in folders:
+        shapes = ", ".join(f"{k} {list(v)}" for k, v in smoke_test(folder).items())
+        print(f"{folder}: config.pbtxt, 1/model.onnx (a batch of 3 runs: {shapes})")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser("export", help="export a checkpoint to ONNX + manifest (the service's model)")
+    s.add_argument("--checkpoint", required=True, help="a training checkpoint (best.pt / last.pt)")
+    s.add_argument("--out", default=DEFAULT_MODELS, help=f"output directory (default: {DEFAULT_MODELS})")
+    s.add_argument("--name", default="curve-vae-inception", help="model name in the manifest")
+    s.add_argument("--version", default="0.1.0", help="model version in the manifest")
+    s.add_argument(
+        "--data", default=None, help=f"data set cache of the checkpoint's data config (default: {DATA_HELP})"
+    )
+    s.add_argument(
+        "--fresh-seed",
+        type=int,
+        default=FRESH_TEST_SEED,
+        help=f"seed of the second test set (default: {FRESH_TEST_SEED})",
+    )
+    s.add_argument(
+        "--training-info",
+        default="",
+        help="JSON file merged into the manifest's training section (wall time, hardware)",
+    )
+    s.add_argument(
+        "--prior",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="fit the learned latent distribution /sample draws from and ship it as prior.npz (default: on)",
+    )
+    s.add_argument("--prior-components", type=int, default=8, help="Gaussian mixture components (default: 8)")
+    s.add_argument(
+        "--spline-ctrl",
+        type=int,
+        default=None,
+        help="export with this B-spline output head (control points, 0: none) in place of the checkpoint's; "
+        "the head has no weights, so any checkpoint takes any head (default: the checkpoint's)",
+    )
+    s.add_argument(
+        "--evaluate",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="measure the exported graphs on both test sets and store the metrics in the manifest (default: on)",
+    )
+    add_suite_option(s)
+    s.set_defaults(func=cmd_export)
+
+    s = sub.add_parser("evaluate", help="reconstruction MSE, smoothness and figures on the test sets")
+    src = s.add_mutually_exclusive_group()
+    src.add_argument(
+        "--model-dir",
+        default=DEFAULT_MODELS,
+        help=f"exported model to evaluate with onnxruntime (default: {DEFAULT_MODELS})",
+    )
+    src.add_argument("--checkpoint", default="", help="evaluate a torch checkpoint instead")
+    s.add_argument("--data", default=None, help=f"data set cache (default: {DATA_HELP})")
+    s.add_argument(
+        "--fresh-seed",
+        type=int,
+        default=FRESH_TEST_SEED,
+        help=f"also test on 1000 curves of this seed, -1 to skip (default: {FRESH_TEST_SEED})",
+    )
+    s.add_argument(
+        "--out", default="runs/evaluation", help="report.json and figures go here (default: runs/evaluation)"
+    )
+    s.add_argument("--no-figures", action="store_true", help="write only report.json")
+    add_suite_option(s)
+    s.set_defaults(func=cmd_evaluate)
+
+    s = sub.add_parser("triton", help="write an NVIDIA Triton model repository of an exported model's graphs")
+    s.add_argument("--model-dir", default="", help="exported model directory (default: the shipped model, models/)")
+    s.add_argument("--out", required=True, help="the repository directory (model folders are created in it)")
+    s.add_argument("--prefix", default="curve_vae", help="model name prefix: PREFIX_encoder, PREFIX_decoder")
+    s.add_argument("--max-batch-size", type=int, default=256, help="Triton's max_batch_size (default: 256)")
+    s.add_argument(
+        "--max-queue-delay-us", type=int, default=2000, help="dynamic batching queue delay (default: 2000 µs)"
+    )
+    s.add_argument("--force", action="store_true", help="replace model folders that exist")
+    s.set_defaults(func=cmd_triton)

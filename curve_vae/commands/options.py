@@ -1,0 +1,114 @@
+"""Options and helpers shared by several `curve-vae` commands: the data set's, the model directory's, the suite's."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+from typing import Any
+
+DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
+DEFAULT_MODELS = "models"
+FRESH_TEST_SEED = 7919  # the second test set: a seed no training or model selection uses
+
+
+def add_data_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("data set (paper §3.1)")
+    g.add_argument(
+        "--data",
+        default=None,
+        help="data set cache file: read when it holds this configuration, written when it does not exist, never "
+        f"overwritten (default: {DATA_HELP})",
+    )
+    g.add_argument("--n-train", type=int, default=70_000, help="training curves (default: 70000)")
+    g.add_argument("--n-val", type=int, default=2_000, help="validation curves (default: 2000)")
+    g.add_argument("--n-test", type=int, default=1_000, help="test curves (default: 1000)")
+    g.add_argument("--data-seed", type=int, default=0, help="seed of the data set (default: 0)")
+    g.add_argument(
+        "--mix",
+        choices=("paper", "broad"),
+        default="paper",
+        help="training curves: the paper's generator, or the broad mix of training/families.py (any spacing, "
+        "other shapes, posed as the service poses curves); the test split is the paper's either way (default: paper)",
+    )
+    g.add_argument(
+        "--curves",
+        default=None,
+        metavar="PATH",
+        help="your own curves instead: a file or a directory of .npy/.csv/.json/.dat files; 10%% of the curves are "
+        "held out for validation and 10%% for test, and --n-train posed copies of the rest are trained on",
+    )
+    g.add_argument(
+        "--workers",
+        type=int,
+        default=len(os.sched_getaffinity(0)),
+        help="processes drawing the broad mix: the same curves however many (default: the CPUs available, %(default)s)",
+    )
+
+
+def data_path(a: argparse.Namespace, config: Any) -> Path:
+    """--data, or the default cache file of this data configuration."""
+    from training.data import default_cache
+
+    return Path(a.data) if a.data else default_cache(config)
+
+
+def data_config(a: argparse.Namespace):
+    from training.data import DataConfig
+
+    mix = "files" if a.curves else a.mix
+    return DataConfig(
+        n_train=a.n_train, n_val=a.n_val, n_test=a.n_test, seed=a.data_seed, mix=mix, source=a.curves or ""
+    )
+
+
+def add_suite_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--suite-count",
+        type=int,
+        default=200,
+        help="curves per set of the family suite (training/suite.py: the paper's curves moved and respaced, "
+        "other families, held-out ones, real airfoils where data/ has aerosandbox's wheel); 0 skips it "
+        "(default: 200)",
+    )
+
+
+def add_model_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("model (offline: onnxruntime on the exported graphs, no server)")
+    g.add_argument("--model-dir", default="", help="exported model directory (default: the shipped model, models/)")
+    g.add_argument(
+        "--providers", choices=["cpu", "cuda", "auto"], default="cpu", help="onnxruntime providers (default: cpu)"
+    )
+    g.add_argument("--batch-size", type=int, default=64, help="curves per ONNX run and per .npy chunk (default: 64)")
+
+
+def add_generate_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "-o",
+        "--output",
+        default="-",
+        help="output: .json (as the REST endpoint answers), .npy (curves only, float32), "
+        "or - for JSON on stdout (default: -)",
+    )
+    p.add_argument("--count", type=int, required=True, help="how many curves")
+    p.add_argument(
+        "--seed", type=int, default=None, help="seed: the same seed gives the same curves (default: fresh, reported)"
+    )
+    p.add_argument(
+        "--n-points", type=int, default=None, help="points per curve (default: the model's 161, or the inputs' length)"
+    )
+    p.add_argument(
+        "--spacing", choices=["parameter", "arc_length"], default="parameter", help="point spacing (default: parameter)"
+    )
+    p.add_argument(
+        "--metrics", action="store_true", help="add smoothness, self-intersection and length per curve (JSON only)"
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar (none either when not on a terminal)")
+
+
+def model_runtime(a: argparse.Namespace):
+    from service.runtime import CurveRuntime
+    from service.settings import DEFAULT_MODEL_DIR
+
+    model_dir = a.model_dir or DEFAULT_MODEL_DIR
+    return CurveRuntime.load(model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)

@@ -1,0 +1,193 @@
+"""`curve-vae train` and `average`: training runs (training/train.py), checkpoint averages (training/average.py)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from dataclasses import fields
+from pathlib import Path
+
+from curve_vae.commands.options import (
+    DATA_HELP,
+    add_data_options,
+    data_config,
+    data_path,
+)
+from curve_vae.files import refuse_overwrite
+from curve_vae.progress import shown
+
+
+def add_train_options(p: argparse.ArgumentParser) -> None:
+    from training.config import SCHEDULES, VARIANTS, TrainConfig
+
+    g = p.add_argument_group("model (paper §3.5)")
+    g.add_argument(
+        "--variant",
+        default="inception",
+        help=f"architecture: {', '.join(VARIANTS)} "
+        "(cnn6 = inception, the paper's model; cnn1…cnn5: Table 1's ablations) (default: inception)",
+    )
+    g.add_argument("--latent-dim", type=int, default=32, help="latent size, paper Table 2 (default: 32)")
+    g.add_argument(
+        "--spline-ctrl",
+        type=int,
+        default=None,
+        help="B-spline output head: project decoded points onto a clamped cubic B-spline with this many "
+        "control points, 7k+3 to keep the data's knots (0: raw points) (default: the --init-from or resumed "
+        "checkpoint's head, else 0)",
+    )
+    d = TrainConfig()
+    g = p.add_argument_group("training")
+    helps = {
+        "epochs": "epochs (passes over the training curves)",
+        "batch_size": "global batch size, split across DDP processes",
+        "lr": "Adam learning rate; the peak rate of the onecycle schedule",
+        "schedule": f"learning-rate schedule: {' | '.join(SCHEDULES)}",
+        "warmup": "onecycle: fraction of the steps spent warming up",
+        "beta": "weight of the KL term",
+        "lap_weight": "weight of the Laplacian smoothness term (0: off)",
+        "grad_clip": "clip the gradient norm to this (0: off)",
+        "patience": "early stopping: epochs without a better validation MSE (0: off)",
+        "bf16": "bf16 autocast (fast only with AMX/AVX512-BF16 CPUs or GPUs)",
+        "compile": "torch.compile the model",
+        "seed": "seed of initialisation, batch order and sampling noise",
+        "threads": "torch CPU threads (0: torch's default)",
+        "device": "auto | cpu | cuda",
+        "train_limit": "use only the first N training curves (0: all)",
+        "time_budget": "seconds of training; the schedule follows elapsed training time and the run "
+        "stops when it is spent, whatever the throughput (0: off; --epochs stays an upper bound)",
+        "snapshots": "keep the weights of the latest N epochs as RUN_DIR/epoch-NNNN.pt, to average them "
+        "afterwards with curve-vae average (0: off)",
+    }
+    for f in fields(TrainConfig):
+        flag = "--" + f.name.replace("_", "-")
+        default = getattr(d, f.name)
+        if isinstance(default, bool):
+            g.add_argument(
+                flag,
+                action=argparse.BooleanOptionalAction,
+                default=default,
+                help=f"{helps[f.name]} (default: {default})",
+            )
+        else:
+            g.add_argument(flag, type=type(default), default=default, help=f"{helps[f.name]} (default: {default})")
+
+
+def cmd_train(a: argparse.Namespace) -> int:
+
+    from training.config import ModelConfig, TrainConfig
+    from training.evaluate import run_evaluation, torch_codec
+    from training.figures import plot_training
+    from training.train import train
+
+    spline_ctrl = a.spline_ctrl
+    if spline_ctrl is None:  # keep the head of the weights a run continues from: dropping it would go unnoticed
+        start = Path(a.run_dir) / "last.pt" if a.resume and (Path(a.run_dir) / "last.pt").exists() else a.init_from
+        spline_ctrl = 0
+        if start:
+            from training.checkpoint import load_weights
+
+            spline_ctrl = load_weights(start)[0].spline_ctrl
+    model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim, spline_ctrl=spline_ctrl)
+    cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
+    run_dir = Path(a.run_dir)
+    state = train(
+        run_dir,
+        model_cfg,
+        data_config(a),
+        cfg,
+        data_cache=data_path(a, data_config(a)),
+        data_workers=a.workers,
+        resume=a.resume,
+        progress=shown(a.no_progress),
+        stop_after=a.stop_after,
+        init_from=a.init_from or None,
+    )
+    if int(os.environ.get("RANK", "0")) != 0:
+        return 0
+    print(f"best validation MSE {state.best_val:.4f} at epoch {state.best_epoch}; checkpoints in {run_dir}")
+    finished = (
+        state.epoch >= cfg.epochs
+        or (cfg.patience and state.epoch - state.best_epoch >= cfg.patience)
+        or 0 < cfg.time_budget <= state.trained_seconds
+    )
+    if finished:
+        from training.data import load_or_generate
+
+        ds = load_or_generate(data_config(a), data_path(a, data_config(a)))
+        enc, dec, _ = torch_codec(run_dir / "best.pt")
+        report = run_evaluation(enc, dec, {"test": ds.test}, run_dir, log_path=run_dir / "log.jsonl")
+        print(
+            f"test MSE (paper eq. 4) {report['test_sets']['test']['mse']:.4f}; "
+            f"report {run_dir / 'report.json'}, figures {run_dir}/*.png"
+        )
+    elif (run_dir / "log.jsonl").exists():
+        plot_training(run_dir / "log.jsonl", run_dir / "training.png")
+    return 0
+
+
+def cmd_average(a: argparse.Namespace) -> int:
+    import torch
+
+    from training.average import average_checkpoints
+    from training.checkpoint import atomic_save, load_checkpoint
+    from training.data import DataConfig, load_or_generate
+
+    if a.threads > 0:
+        torch.set_num_threads(a.threads)
+    for p in a.checkpoints:
+        if not Path(p).is_file():
+            raise SystemExit(f"curve-vae average: no checkpoint at {p}")
+    refuse_overwrite(a.out, a.force, "--out")
+    d = load_checkpoint(a.checkpoints[-1])["data_config"]
+    data_cfg = DataConfig(**{**d, "center": tuple(d["center"])})
+    ds = load_or_generate(data_cfg, data_path(a, data_cfg))
+    train_curves = ds.train[: a.bn_curves] if a.bn_curves > 0 else None
+    ckpt = average_checkpoints(a.checkpoints, train_curves=train_curves, val_curves=ds.val)
+    atomic_save(ckpt, Path(a.out))
+    print(f"averaged {len(a.checkpoints)} checkpoints → {a.out} (export it with curve-vae export --checkpoint)")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser("train", help="train a VAE (resumable; DDP under torchrun)")
+    s.add_argument(
+        "--run-dir", default="runs/default", help="checkpoints, log and report go here (default: runs/default)"
+    )
+    s.add_argument("--resume", action="store_true", help="continue from RUN_DIR/last.pt if it exists")
+    s.add_argument(
+        "--stop-after",
+        type=int,
+        default=0,
+        help="stop after this many epochs of this call; resume later (default: 0 = run to --epochs)",
+    )
+    s.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress bar (none either when stderr is not a terminal); one line per epoch",
+    )
+    s.add_argument(
+        "--init-from",
+        default="",
+        help="start a new run from these weights (a checkpoint, or models/vae.pt to continue the shipped model)",
+    )
+    add_data_options(s)
+    add_train_options(s)
+    s.set_defaults(func=cmd_train)
+
+    s = sub.add_parser(
+        "average", help="average the weights of checkpoints and re-measure BatchNorm statistics (SWA-style)"
+    )
+    s.add_argument("checkpoints", nargs="+", help="training checkpoints of one run (e.g. best.pt last.pt)")
+    s.add_argument("--out", required=True, help="the averaged checkpoint (training format, for export)")
+    s.add_argument(
+        "--data", default=None, help=f"data set cache of the checkpoints' data config (default: {DATA_HELP})"
+    )
+    s.add_argument(
+        "--bn-curves",
+        type=int,
+        default=20_000,
+        help="training curves to measure BatchNorm statistics on; 0 keeps the averaged ones (default: 20000)",
+    )
+    s.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's default)")
+    s.set_defaults(func=cmd_average)
