@@ -186,3 +186,11 @@ def load_or_generate(
         if say:
             print(f"generated the data set ({len(ds.train)} / {len(ds.val)} / {len(ds.test)} curves) into {cache}")
     return ds
+
+
+def load_test_split(config: DataConfig, cache: str | Path | None) -> np.ndarray:
+    """The test split of `config`'s data set, without drawing the broad mix's training split (its test curves are
+    the paper's, paper_test_curves); other mixes load or generate their whole data set."""
+    if config.mix == "broad":
+        return paper_test_curves(config)[0]
+    return load_or_generate(config, cache).test

@@ -19,7 +19,7 @@ from curve_vae.commands.options import (
 
 def cmd_export(a: argparse.Namespace) -> int:
     from training.checkpoint import load_checkpoint, model_from_checkpoint
-    from training.data import DataConfig, generate_curves, load_or_generate
+    from training.data import DataConfig, generate_curves, load_or_generate, load_test_split
     from training.evaluate import onnx_codec, run_evaluation
     from training.export import export, model_size_of
     from training.io import atomic_write_text
@@ -37,10 +37,9 @@ def cmd_export(a: argparse.Namespace) -> int:
     ckpt = load_checkpoint(a.checkpoint)
     data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
     if data_cfg.mix == "broad":  # posed at one size, tested on the paper's curves: no training split to draw
-        from training.data import paper_test_curves
         from training.families import MODEL_SIZE
 
-        train, test, model_size = None, paper_test_curves(data_cfg)[0], MODEL_SIZE
+        train, test, model_size = None, load_test_split(data_cfg, None), MODEL_SIZE
     else:
         ds = load_or_generate(data_cfg, data_path(a, data_cfg))
         train, test, model_size = ds.train, ds.test, model_size_of(ds.train)
@@ -123,7 +122,7 @@ def cmd_export(a: argparse.Namespace) -> int:
 
 
 def cmd_evaluate(a: argparse.Namespace) -> int:
-    from training.data import DataConfig, generate_curves, load_or_generate
+    from training.data import DataConfig, generate_curves, load_test_split
     from training.evaluate import onnx_codec, run_evaluation, torch_codec
 
     runtime = None
@@ -139,8 +138,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
         runtime = CurveRuntime.load(a.model_dir, providers="cpu")
         data_cfg_d = meta.get("training", {}).get("data")
     data_cfg = DataConfig(**{**data_cfg_d, "center": tuple(data_cfg_d["center"])}) if data_cfg_d else DataConfig()
-    ds = load_or_generate(data_cfg, data_path(a, data_cfg))
-    sets = {"test": ds.test}
+    sets = {"test": load_test_split(data_cfg, data_path(a, data_cfg))}
     if a.fresh_seed >= 0:
         sets[f"fresh_seed_{a.fresh_seed}"] = generate_curves(
             1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points

@@ -100,3 +100,11 @@ def test_broad_mix_is_versioned_and_its_test_split_is_the_papers(tmp_path):
         load_or_generate(cfg, tmp_path / "old.npz")
     with pytest.raises(ValueError, match="mix_version"):
         DataConfig(mix_version=2)
+
+
+def test_the_test_split_of_a_broad_mix_is_read_without_drawing_its_training_curves(tmp_path):
+    from training.data import load_test_split
+
+    cfg = DataConfig(n_train=10_000_000, n_val=20, n_test=10, mix="broad")  # far too many to draw in this test
+    np.testing.assert_array_equal(load_test_split(cfg, tmp_path / "never.npz"), generate_curves(70_030, 0)[0][-10:])
+    assert not (tmp_path / "never.npz").exists()
