@@ -201,6 +201,148 @@ def _rng_state(gen: np.random.Generator) -> dict[str, Any]:
     return {"torch": torch.get_rng_state(), "numpy": json.dumps(gen.bit_generator.state)}
 
 
+@dataclass
+class _Process:
+    """Where this process trains: its device, and its place among the DDP processes (rank 0 alone writes)."""
+
+    device: torch.device
+    rank: int = 0
+    world: int = 1
+
+    @property
+    def distributed(self) -> bool:
+        return self.world > 1
+
+    def say(self, message: str) -> None:
+        if self.rank == 0:
+            print(message, flush=True)
+
+
+def _start_process(cfg: TrainConfig) -> _Process:
+    device = pick_device(cfg.device)
+    if int(os.environ.get("WORLD_SIZE", "1")) > 1:
+        if device.type == "cuda":
+            device = torch.device("cuda", int(os.environ.get("LOCAL_RANK", "0")))
+            torch.cuda.set_device(device)
+        dist.init_process_group("nccl" if device.type == "cuda" else "gloo")
+    if cfg.threads > 0:
+        torch.set_num_threads(cfg.threads)
+    if device.type == "cuda":
+        torch.backends.cudnn.benchmark = True  # every batch has the same shape: pick the fastest kernels once
+    if dist.is_initialized():
+        return _Process(device, dist.get_rank(), dist.get_world_size())
+    return _Process(device)
+
+
+def _load_splits(
+    proc: _Process, data_cfg: DataConfig, cfg: TrainConfig, cache: str | Path | None, workers: int
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Training and validation curves as tensors; rank 0 generates or loads (and writes the cache) first."""
+    ds = load_or_generate(data_cfg, cache, workers=workers) if proc.rank == 0 else None
+    if proc.distributed:
+        dist.barrier()
+        if proc.rank != 0:
+            ds = load_or_generate(data_cfg, cache)
+    assert ds is not None
+    train_np = ds.train[: cfg.train_limit] if cfg.train_limit else ds.train
+    return torch.from_numpy(np.ascontiguousarray(train_np)), torch.from_numpy(np.ascontiguousarray(ds.val))
+
+
+def _restore(
+    proc: _Process,
+    last: Path,
+    model: VAE,
+    opt: torch.optim.Optimizer,
+    sched: Any,
+    cfg: TrainConfig,
+    gen: np.random.Generator,
+    *,
+    resume: bool,
+    init_from: str | Path | None,
+) -> RunState:
+    """Resume from `last` (weights, optimiser, schedule, RNG, run state) or start anew, from `init_from`'s weights
+    if given; the state the run starts from."""
+    if resume and last.exists():
+        ckpt = load_checkpoint(last)
+        was = ckpt["train_config"]["epochs"]
+        if sched is not None and cfg.schedule in ("onecycle", "cosine") and was != cfg.epochs:
+            raise ValueError(
+                f"{last} was trained for a {was}-epoch {cfg.schedule} schedule; resume it with --epochs {was}, "
+                "or start a new run directory (use --init-from to start from its weights)"
+            )
+        model.load_state_dict(ckpt["model"])
+        opt.load_state_dict(ckpt["optimizer"])
+        if sched is not None and ckpt.get("scheduler") is not None:
+            sched.load_state_dict(ckpt["scheduler"])
+        torch.set_rng_state(ckpt["rng"]["torch"])
+        gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
+        state = RunState(**ckpt["state"])
+        proc.say(f"resumed {last} at epoch {state.epoch}/{cfg.epochs}")
+        return state
+    if resume:
+        proc.say(f"no checkpoint at {last}: starting a new run")
+    if init_from:
+        init_cfg, weights = load_weights(init_from)
+        if not init_cfg.same_weights(model.cfg):
+            raise ValueError(f"{init_from} holds a {asdict(init_cfg)} model, not {asdict(model.cfg)}")
+        model.load_state_dict(weights)
+        proc.say(f"initialised from {init_from}")
+    return RunState()
+
+
+def _wrap(proc: _Process, model: VAE, cfg: TrainConfig) -> nn.Module:
+    """The module the steps run: DDP across processes, compiled if asked."""
+    net: nn.Module = model
+    if proc.distributed:
+        net = nn.parallel.DistributedDataParallel(
+            model, device_ids=[proc.device.index] if proc.device.type == "cuda" else None
+        )
+    return torch.compile(net) if cfg.compile else net
+
+
+def _budget_bar(cfg: TrainConfig, state: RunState, shown: bool) -> tqdm | None:
+    """A time-budgeted run ends with its budget, not after an epoch count: its bar shows seconds."""
+    if cfg.time_budget <= 0:
+        return None
+    return tqdm(
+        total=round(cfg.time_budget),
+        initial=round(min(state.trained_seconds, cfg.time_budget)),
+        desc="time budget",
+        unit="s",
+        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total:.0f} s{postfix}",
+        disable=not shown,
+        leave=False,
+        dynamic_ncols=True,
+    )
+
+
+def _agreed_val_mse(proc: _Process, model: VAE, val: torch.Tensor) -> float:
+    """The validation MSE, rank 0's on every process, so that all stop together."""
+    val_mse = validation_mse(model, val, device=proc.device)
+    if proc.distributed:
+        v = torch.tensor([val_mse], dtype=torch.float64)
+        dist.broadcast(v, 0)
+        val_mse = float(v)
+    return val_mse
+
+
+def _record_epoch(run_dir: Path, ckpt: dict[str, Any], row: dict[str, float], improved: bool, cfg: TrainConfig) -> None:
+    """Rank 0's files of an epoch: best.pt if it improved, last.pt, the snapshot, the log line; and its line."""
+    if improved:
+        atomic_save(ckpt, run_dir / "best.pt")
+    atomic_save(ckpt, run_dir / "last.pt")
+    if cfg.snapshots:
+        _keep_snapshot(run_dir, ckpt, row["epoch"], cfg.snapshots)
+    with open(run_dir / "log.jsonl", "a") as f:
+        f.write(json.dumps(row) + "\n")
+    print(  # one line per epoch, with or without the progress bar
+        f"epoch {row['epoch']}/{cfg.epochs}  loss {row['train_loss']:.4g}  mse {row['train_mse']:.4g}  "
+        f"kl {row['train_kl']:.4g}  lap {row['train_lap']:.4g}  val_mse {row['val_mse']:.4g}"
+        f"{' *' if improved else ''}  {row['curves_per_s']:.0f} curves/s",
+        flush=True,
+    )
+
+
 def train(
     run_dir: str | Path,
     model_cfg: ModelConfig,
@@ -222,129 +364,52 @@ def train(
     fresh optimiser and schedule: fine-tuning, or continuing the shipped model on a new machine.
     """
     run_dir = Path(run_dir)
-    distributed = int(os.environ.get("WORLD_SIZE", "1")) > 1
-    device = pick_device(cfg.device)
-    if distributed:
-        if device.type == "cuda":
-            device = torch.device("cuda", int(os.environ.get("LOCAL_RANK", "0")))
-            torch.cuda.set_device(device)
-        dist.init_process_group("nccl" if device.type == "cuda" else "gloo")
-    rank = dist.get_rank() if distributed else 0
-    world = dist.get_world_size() if distributed else 1
-    if cfg.threads > 0:
-        torch.set_num_threads(cfg.threads)
-    if device.type == "cuda":
-        torch.backends.cudnn.benchmark = True  # every batch has the same shape: pick the fastest kernels once
-
+    proc = _start_process(cfg)
     try:
         torch.manual_seed(cfg.seed)
         random.seed(cfg.seed)
-        ds = load_or_generate(data_cfg, data_cache, workers=data_workers) if rank == 0 else None
-        if distributed:  # rank 0 generates or loads (and writes the cache) first
-            dist.barrier()
-            if rank != 0:
-                ds = load_or_generate(data_cfg, data_cache)
-        assert ds is not None
-        train_np = ds.train[: cfg.train_limit] if cfg.train_limit else ds.train
-        data = torch.from_numpy(np.ascontiguousarray(train_np))
-        val = torch.from_numpy(np.ascontiguousarray(ds.val))
-
-        model = VAE(model_cfg).to(device)
-        opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
-        steps_per_epoch = len(data) // world // (cfg.batch_size // world)
+        data, val = _load_splits(proc, data_cfg, cfg, data_cache, data_workers)
+        per_rank = cfg.batch_size // proc.world
+        steps_per_epoch = len(data) // proc.world // per_rank
         if steps_per_epoch < 1:
             raise ValueError(f"{len(data)} training curves are fewer than one batch of {cfg.batch_size}")
+
+        model = VAE(model_cfg).to(proc.device)
+        opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
         clock = Clock(cfg.time_budget, 0.0)
         sched = _make_schedule(opt, cfg, steps_per_epoch, clock)
         gen = np.random.default_rng(cfg.seed)
-        state = RunState()
-
-        last = run_dir / "last.pt"
-        if resume and last.exists():
-            ckpt = load_checkpoint(last)
-            if (
-                sched is not None
-                and cfg.schedule in ("onecycle", "cosine")
-                and (ckpt["train_config"]["epochs"] != cfg.epochs)
-            ):
-                raise ValueError(
-                    f"{last} was trained for a {ckpt['train_config']['epochs']}-epoch {cfg.schedule} "
-                    f"schedule; resume it with --epochs {ckpt['train_config']['epochs']}, or start a "
-                    "new run directory (use --init-from to start from its weights)"
-                )
-            model.load_state_dict(ckpt["model"])
-            opt.load_state_dict(ckpt["optimizer"])
-            if sched is not None and ckpt.get("scheduler") is not None:
-                sched.load_state_dict(ckpt["scheduler"])
-            state = RunState(**ckpt["state"])
-            clock.spent = state.trained_seconds
-            torch.set_rng_state(ckpt["rng"]["torch"])
-            gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
-            if rank == 0:
-                print(f"resumed {last} at epoch {state.epoch}/{cfg.epochs}", flush=True)
-        else:
-            if resume and rank == 0:
-                print(f"no checkpoint at {last}: starting a new run", flush=True)
-            if init_from:
-                init_cfg, weights = load_weights(init_from)
-                if not init_cfg.same_weights(model_cfg):
-                    raise ValueError(f"{init_from} holds a {asdict(init_cfg)} model, not {asdict(model_cfg)}")
-                model.load_state_dict(weights)
-                if rank == 0:
-                    print(f"initialised from {init_from}", flush=True)
-
-        net: nn.Module = model
-        if distributed:
-            net = nn.parallel.DistributedDataParallel(
-                model, device_ids=[device.index] if device.type == "cuda" else None
-            )
-        if cfg.compile:
-            net = torch.compile(net)
-
-        if rank == 0:
+        state = _restore(proc, run_dir / "last.pt", model, opt, sched, cfg, gen, resume=resume, init_from=init_from)
+        clock.spent = state.trained_seconds
+        net = _wrap(proc, model, cfg)
+        if proc.rank == 0:
             run_dir.mkdir(parents=True, exist_ok=True)
             (run_dir / "config.json").write_text(
                 json.dumps({"model": asdict(model_cfg), "data": asdict(data_cfg), "train": asdict(cfg)}, indent=2)
             )
 
         end = cfg.epochs if not stop_after else min(cfg.epochs, state.epoch + stop_after)
-        budget_bar = (  # a time-budgeted run ends with its budget, not after an epoch count: its bar shows time
-            tqdm(
-                total=round(cfg.time_budget),
-                initial=round(min(state.trained_seconds, cfg.time_budget)),
-                desc="time budget",
-                unit="s",
-                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total:.0f} s{postfix}",
-                disable=not progress or rank != 0,
-                leave=False,
-                dynamic_ncols=True,
-            )
-            if cfg.time_budget > 0
-            else None
-        )
+        shown = progress and proc.rank == 0
+        budget_bar = _budget_bar(cfg, state, shown)
         while state.epoch < end:
             t0 = time.perf_counter()
             perm = torch.from_numpy(gen.permutation(len(data)))  # same on every rank
-            order = perm[rank::world][: steps_per_epoch * (cfg.batch_size // world)]
+            order = perm[proc.rank :: proc.world][: steps_per_epoch * per_rank]
             bar = budget_bar or tqdm(
                 total=len(order),
                 desc=f"epoch {state.epoch + 1}/{cfg.epochs}",
                 unit="curve",
-                disable=not progress or rank != 0,
+                disable=not shown,
                 leave=False,
                 dynamic_ncols=True,
             )
             with clock:
-                terms = train_one_epoch(net, data, order, opt, sched, cfg, device, bar=bar, clock=clock)
+                terms = train_one_epoch(net, data, order, opt, sched, cfg, proc.device, bar=bar, clock=clock)
             if budget_bar is None:
                 bar.close()
             train_time = time.perf_counter() - t0
             state.trained_seconds = clock.spent
-            val_mse = validation_mse(model, val, device=device)
-            if distributed:  # decide on rank 0's number so every rank stops together
-                v = torch.tensor([val_mse], dtype=torch.float64)
-                dist.broadcast(v, 0)
-                val_mse = float(v)
+            val_mse = _agreed_val_mse(proc, model, val)
             if sched is not None and cfg.schedule == "plateau":
                 sched.step(val_mse)
             state.epoch += 1
@@ -362,7 +427,7 @@ def train(
             improved = val_mse < state.best_val
             if improved:
                 state.best_val, state.best_epoch = val_mse, state.epoch
-            if rank == 0:
+            if proc.rank == 0:
                 ckpt = {
                     "version": CHECKPOINT_VERSION,
                     "model_config": asdict(model_cfg),
@@ -374,30 +439,16 @@ def train(
                     "state": asdict(state),
                     "rng": _rng_state(gen),
                 }
-                if improved:
-                    atomic_save(ckpt, run_dir / "best.pt")
-                atomic_save(ckpt, last)
-                if cfg.snapshots:
-                    _keep_snapshot(run_dir, ckpt, state.epoch, cfg.snapshots)
-                with open(run_dir / "log.jsonl", "a") as f:
-                    f.write(json.dumps(row) + "\n")
-                print(  # one line per epoch, with or without the progress bar
-                    f"epoch {state.epoch}/{cfg.epochs}  loss {terms['loss']:.4g}  mse {terms['mse']:.4g}  "
-                    f"kl {terms['kl']:.4g}  lap {terms['lap']:.4g}  val_mse {val_mse:.4g}"
-                    f"{' *' if improved else ''}  {row['curves_per_s']:.0f} curves/s",
-                    flush=True,
-                )
+                _record_epoch(run_dir, ckpt, row, improved, cfg)
             if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
-                if rank == 0:
-                    print(f"early stop: no better validation MSE for {cfg.patience} epochs", flush=True)
+                proc.say(f"early stop: no better validation MSE for {cfg.patience} epochs")
                 break
             if clock.over():
-                if rank == 0:
-                    print(f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs", flush=True)
+                proc.say(f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs")
                 break
         if budget_bar is not None:
             budget_bar.close()
         return state
     finally:
-        if distributed and dist.is_initialized():
+        if proc.distributed and dist.is_initialized():
             dist.destroy_process_group()
