@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from curve_vae.files import atomic_path
+
 PRIOR_FILE = "prior.npz"
 
 
@@ -51,11 +53,8 @@ class LatentPrior:
 
     def save(self, path: str | Path) -> None:
         """Write atomically (a temporary file renamed over `path`)."""
-        path = Path(path)
-        tmp = path.with_name(f".{path.name}.tmp")
-        with open(tmp, "wb") as f:
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.savez(f, weights=self.weights, means=self.means, cholesky=self.cholesky)
-        tmp.replace(path)
 
     @classmethod
     def load(cls, path: str | Path) -> LatentPrior:

@@ -22,8 +22,8 @@ from typing import Any
 
 import torch
 
+from curve_vae.files import atomic_path
 from training.config import ModelConfig
-from training.io import atomic_path
 from training.model import VAE
 
 CHECKPOINT_VERSION = 1

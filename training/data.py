@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
+from curve_vae.files import atomic_path
 from geometry import random_control_points, sample_bspline, self_intersects
-from training.io import atomic_path
 
 FORMAT_VERSION = 1
 MIXES = ("paper", "broad", "files")

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from curve_vae.files import atomic_write_text
 from geometry import mse_per_curve, self_intersects, smoothness
-from training.io import atomic_write_text
 
 Reconstructor = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, N, 2), decoding the mean
 Encoder = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, Z) latent means

@@ -23,11 +23,11 @@ import numpy as np
 import torch
 from torch import nn
 
+from curve_vae.files import atomic_path, atomic_write_text
 from geometry import clamped_uniform_knots
 from service.model_files import file_sha256
 from service.prior import PRIOR_FILE, LatentPrior
 from training.checkpoint import save_weights
-from training.io import atomic_path, atomic_write_text
 from training.model import VAE, ModelConfig
 
 MANIFEST_VERSION = 1

@@ -11,9 +11,9 @@ from typing import Any
 
 import numpy as np
 
+from curve_vae.files import atomic_path
 from geometry import mse_per_curve, self_intersects, smoothness
 from training.evaluate import Decoder, Encoder, batched
-from training.io import atomic_path
 
 
 def plot_samples(samples: np.ndarray, data: np.ndarray, path: Path, *, n: int = 16) -> None:

@@ -103,9 +103,8 @@ def cmd_fit(a: argparse.Namespace) -> int:
 
 
 def cmd_revolve(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curves
+    from curve_vae.files import atomic_path, read_curves
     from geometry import revolve
-    from training.io import atomic_path
 
     refuse_overwrite(a.output, a.force)
     curves = read_curves(a.input)

@@ -18,11 +18,11 @@ from curve_vae.commands.options import (
 
 
 def cmd_export(a: argparse.Namespace) -> int:
+    from curve_vae.files import atomic_write_text
     from training.checkpoint import load_checkpoint, model_from_checkpoint
     from training.data import DataConfig, generate_curves, load_or_generate, load_test_split
     from training.evaluate import onnx_codec, run_evaluation
     from training.export import export, model_size_of
-    from training.io import atomic_write_text
 
     held = [
         f
