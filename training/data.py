@@ -79,16 +79,15 @@ def generate_curves(
 def paper_test_curves(config: DataConfig) -> tuple[np.ndarray, np.ndarray]:
     """The broad mix's test split and its control points: the paper data set's own test curves (DataConfig()'s
     sizes, this seed), so eq. 4's MSE is measured on the paper's test curves whatever the mix and its size."""
-    paper_total = DataConfig().n_train + config.n_val + config.n_test
-    curves, ctrl = generate_curves(
-        paper_total,
-        config.seed,
-        n_ctrl=config.n_ctrl,
-        n_points=config.n_points,
-        radius=config.radius,
-        center=config.center,
-    )
+    curves, ctrl = _paper_curves(config, DataConfig().n_train + config.n_val + config.n_test)
     return curves[-config.n_test :], ctrl[-config.n_test :]
+
+
+def _paper_curves(config: DataConfig, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """`count` curves of the paper's generator with `config`'s seed and parameters."""
+    return generate_curves(
+        count, config.seed, n_ctrl=config.n_ctrl, n_points=config.n_points, radius=config.radius, center=config.center
+    )
 
 
 @dataclass(frozen=True)
@@ -118,15 +117,7 @@ class CurveDataset:
             curves, ctrl = paper_test_curves(config)
             mixed = broad_mix(b, config.seed + 1, n_points=config.n_points, workers=workers)
             return cls(config, mixed[:a], mixed[a:b], curves, ctrl)
-        total = config.n_train + config.n_val + config.n_test
-        curves, ctrl = generate_curves(
-            total,
-            config.seed,
-            n_ctrl=config.n_ctrl,
-            n_points=config.n_points,
-            radius=config.radius,
-            center=config.center,
-        )
+        curves, ctrl = _paper_curves(config, config.n_train + config.n_val + config.n_test)
         return cls(config, curves[:a], curves[a:b], curves[b:], ctrl[b:])
 
     def save(self, path: str | Path) -> None:
