@@ -166,14 +166,18 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
     return out
 
 
-def measure(model_dir: Path, *, seconds: float = 5.0, cores: int | None = None, eager: bool = True) -> dict[str, Any]:
-    """All in-process figures of the report; the ceiling is the best of default and per-core; `eager` adds C."""
+def measure(
+    model_dir: Path, *, seconds: float = 5.0, cores: int | None = None, eager: bool = True, details: bool = True
+) -> dict[str, Any]:
+    """All in-process figures of the report; the ceiling is the best of default and per-core; `eager` adds C,
+    `details` the breakdown of a request."""
     cores = cores or len(os.sched_getaffinity(0))
     out: dict[str, Any] = {"cores": cores}
     out["default_b128"] = onnx_default(model_dir, seconds=seconds)
     out["per_core_b128"] = onnx_per_core(model_dir, cores=cores, seconds=seconds)
     out["ceiling"] = max(out["default_b128"], out["per_core_b128"])
-    out["breakdown"] = breakdown(model_dir, seconds=min(seconds, 3.0))
+    if details:
+        out["breakdown"] = breakdown(model_dir, seconds=min(seconds, 3.0))
     for batch in (1, 128) if eager else ():
         ort_rate = onnx_threads(model_dir, threads=1, batch=batch, seconds=seconds)
         eager = torch_eager(model_dir, threads=1, batch=batch, seconds=seconds)

@@ -17,7 +17,7 @@ the same model input. "arc_length" resamples evenly by arc length instead, for p
 spaced arbitrarily (hand-drawn strokes). Nothing here imports torch. Reading and checking model
 files is `service.model_files`; the learned latent distribution is `service.prior`.
 
-Length (~870 lines): one class whose methods share the sessions, the frame/length adaptation and the
+Length (~890 lines): one class whose methods share the sessions, the frame/length adaptation and the
 choice of pose (which needs both graphs);
 issue 20 moves that adaptation into `geometry/` and the mixing weights and augment plans out,
 which is where this module should shrink next.

@@ -3,9 +3,9 @@
 Measured on this project's 2-core machine (docs/BENCHMARKS.md, bench/ceiling.py): one session with
 onnxruntime's defaults runs ≈570 curves/s at batch 128, two 1-thread sessions run side by side ≈1000; the
 default intra-op pool spin-waits after each run, burning 4–6 ms of CPU per single-curve request that the
-other inference needed. So the service opens `sessions` pairs (by default one per inference running at
-once), each with `intra_op_threads` threads, one inter-op thread and spinning off, and each inference
-thread keeps to its own pair (`SessionPool.pair`): no two runs share a session's thread pool or arena.
+other inference needed (issue 16's prototypes). So the service opens `sessions` pairs (by default one per
+inference running at once), each with `intra_op_threads` threads, one inter-op thread and spinning off, and
+each inference thread keeps to its own pair (`SessionPool.pair`): no two runs share a session's pool or arena.
 """
 
 from __future__ import annotations

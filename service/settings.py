@@ -40,12 +40,12 @@ class Settings(BaseSettings):
     inference_concurrency: int = Field(0, ge=0)
     sessions: int = Field(0, ge=0)  # encoder/decoder session pairs per worker; 0: one per inference running at once
     # Micro-batching (service/batching.py): concurrent requests' graph runs gathered into one run of at most
-    # micro_batch_rows rows, waiting at most micro_batch_wait_ms for company. Off: on this CPU it bought ~nothing
+    # micro_batch_rows rows, waiting at most micro_batch_wait_ms for company. Off: slower on this CPU
     # (docs/BENCHMARKS.md); on a GPU turn it on.
     micro_batch: bool = False
     micro_batch_rows: int = Field(32, ge=1)
     micro_batch_wait_ms: float = Field(2.0, ge=0, le=1000)
-    access_log: bool = False  # uvicorn's line per request: ~15% of a single-curve request's CPU, so off by default
+    access_log: bool = False  # uvicorn's line per request: log volume (its CPU cost is within noise, BENCHMARKS)
     max_queue: int = Field(64, ge=0)  # requests waiting for an inference slot; beyond them: 503 with Retry-After
     request_timeout: float = Field(60.0, ge=0)  # seconds a request may take, queueing included (504); 0: no limit
     batch_size: int = Field(64, ge=1)  # curves per ONNX run: large requests are split to bound memory
