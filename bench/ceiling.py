@@ -21,8 +21,7 @@ from typing import Any
 
 import numpy as np
 import onnxruntime as ort
-
-from geometry import random_control_points, sample_bspline
+from curve_vae.geometry import random_control_points, sample_bspline
 
 
 def curves(count: int, seed: int = 0) -> np.ndarray:
@@ -102,8 +101,7 @@ def torch_eager(model_dir: Path, *, threads: int, batch: int, seconds: float = 5
     """Curves/s of torch eager (no_grad, eval) on vae.pt with `threads` threads; None without torch or vae.pt."""
     try:
         import torch
-
-        from training.model import VAE, ModelConfig
+        from curve_vae.training.model import VAE, ModelConfig
     except ImportError:
         return None
     weights = model_dir / "vae.pt"
@@ -133,13 +131,12 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
     the raw encoder + decoder run, `CurveRuntime.reconstruct` (pose "as_is": frames, resampling, B-spline
     back), and for 128 curves also parsing and validating the JSON body and rendering the answer."""
     import orjson
-
-    from service.deps import check_curves
-    from service.fastjson import JSON
-    from service.runtime import CurveRuntime
-    from service.schemas import ReconstructRequest
-    from service.sessions import SessionConfig
-    from service.settings import Settings
+    from curve_vae.service.deps import check_curves
+    from curve_vae.service.fastjson import JSON
+    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.service.schemas import ReconstructRequest
+    from curve_vae.service.sessions import SessionConfig
+    from curve_vae.service.settings import Settings
 
     runtime = CurveRuntime.load(model_dir, providers="cpu", sessions=SessionConfig(intra_op_threads=1))
     settings = Settings()

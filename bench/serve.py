@@ -4,8 +4,8 @@
     .venv/bin/python -m bench.serve              # ~4 minutes on 2 cores; --seconds 10 per load run
     .venv/bin/python -m bench.serve --seconds 1 --runs B   # the test suite's smoke run
 
-It starts `python -m service.cli` (uvicorn, the service's defaults unless a run says otherwise) on a loopback port
-for each configuration, drives it with wrk (POST bodies from a small Lua script, tests/bench run through
+It starts `python -m curve_vae.service.cli` (uvicorn, the service's defaults unless a run says otherwise) on a
+loopback port for each configuration, drives it with wrk (POST bodies from a small Lua script, tests/bench run through
 `bench/post.lua`), and reads the server's CPU time from /proc (all its processes), so the server's cost per
 request shows apart from wrk's. Single-curve requests use pose "as_is" (one encoder and one decoder run per
 curve: the ceiling's unit of work); the default pose "auto" tries six poses, 6x the inference. The report is a
@@ -55,14 +55,14 @@ RUNS = (
 
 
 class Server:
-    """`python -m service.cli` on a free loopback port, with extra flags and environment."""
+    """`python -m curve_vae.service.cli` on a free loopback port, with extra flags and environment."""
 
     def __init__(self, model_dir: Path, *flags: str, env: dict[str, str] | None = None) -> None:
         with socket.socket() as s:
             s.bind(("127.0.0.1", 0))
             self.port = s.getsockname()[1]
         self.url = f"http://127.0.0.1:{self.port}"
-        cmd = [sys.executable, "-m", "service.cli", "--port", str(self.port), "--model-dir", str(model_dir)]
+        cmd = [sys.executable, "-m", "curve_vae.service.cli", "--port", str(self.port), "--model-dir", str(model_dir)]
         cmd += ["--providers", "cpu", "--log-level", "warning", *flags]
         self.proc = subprocess.Popen(cmd, cwd=ROOT, env={**os.environ, **(env or {})})
         deadline = time.monotonic() + 90

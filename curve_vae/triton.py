@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 
-from service.model_files import graph_file, read_manifest
+from curve_vae.service.model_files import graph_file, read_manifest
 
 #: onnxruntime's tensor types → Triton's data types
 TRITON_TYPES = {"tensor(float)": "TYPE_FP32", "tensor(double)": "TYPE_FP64", "tensor(int64)": "TYPE_INT64"}

@@ -5,7 +5,7 @@ arc-length resampling, frame normalisation, self-intersection and smoothness met
 A curve is an array of shape (n_points, 2); a batch is (batch, n_points, 2).
 """
 
-from geometry.bspline import (
+from curve_vae.geometry.bspline import (
     BSplineFit,
     arc_length_params,
     clamped_uniform_knots,
@@ -16,7 +16,7 @@ from geometry.bspline import (
     sample_bspline,
     spline_head,
 )
-from geometry.frame import (
+from curve_vae.geometry.frame import (
     Frame,
     arc_fractions,
     at_fractions,
@@ -27,8 +27,8 @@ from geometry.frame import (
     resample,
     signed_turning,
 )
-from geometry.mesh import Mesh, revolve
-from geometry.metrics import (
+from curve_vae.geometry.mesh import Mesh, revolve
+from curve_vae.geometry.metrics import (
     curve_length,
     mse_per_curve,
     self_intersects,

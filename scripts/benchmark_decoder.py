@@ -14,8 +14,7 @@ import argparse
 import time
 
 import torch
-
-from training.model import VAE, ModelConfig
+from curve_vae.training.model import VAE, ModelConfig
 
 
 def main() -> None:

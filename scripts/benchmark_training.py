@@ -16,10 +16,9 @@ import platform
 import time
 
 import torch
-
-from training.config import ModelConfig
-from training.losses import vae_loss
-from training.model import VAE
+from curve_vae.training.config import ModelConfig
+from curve_vae.training.losses import vae_loss
+from curve_vae.training.model import VAE
 
 
 def measure(model: torch.nn.Module, *, bf16: bool, steps: int, warmup: int, batch: int) -> float:

@@ -48,10 +48,11 @@ def fresh_mse(run: Path, seed: int) -> float:
     """Test MSE of a run's best weights on 1,000 curves of a seed never used in training."""
     cache = run / f"fresh_seed_{seed}.json"
     if not cache.exists():
+        from curve_vae.geometry import mse_per_curve
+        from curve_vae.training.data import DataConfig, generate_curves
+        from curve_vae.training.evaluate import batched, torch_codec
+
         from curve_vae.files import atomic_write_text
-        from geometry import mse_per_curve
-        from training.data import DataConfig, generate_curves
-        from training.evaluate import batched, torch_codec
 
         cfg = DataConfig()
         curves, _ = generate_curves(1000, seed, n_ctrl=cfg.n_ctrl, n_points=cfg.n_points)
@@ -73,9 +74,9 @@ def _init_label(path: str) -> str:
 
 def laplacian_figure(runs: list[tuple[float, Path]], data: str, out: Path, *, curve: int = 0) -> None:
     """Tangents of one test curve: the input, then each run's reconstruction (paper Fig. 3)."""
-    from training.data import DataConfig, load_or_generate
-    from training.evaluate import torch_codec
-    from training.figures import plot_tangents
+    from curve_vae.training.data import DataConfig, load_or_generate
+    from curve_vae.training.evaluate import torch_codec
+    from curve_vae.training.figures import plot_tangents
 
     test = load_or_generate(DataConfig(), data).test[curve : curve + 1]
     curves, labels = [test[0]], ["input B-spline"]

@@ -16,10 +16,10 @@ import json
 import time
 from pathlib import Path
 
-import service.runtime as rt
-from geometry import frame as geometry_frame
-from training.data import DataConfig, generate_curves
-from training.suite import run_suite
+import curve_vae.service.runtime as rt
+from curve_vae.geometry import frame as geometry_frame
+from curve_vae.training.data import DataConfig, generate_curves
+from curve_vae.training.suite import run_suite
 
 ROWS = [  # label, pose, chord directions, twins
     ("as is", "as_is", 1, False),

@@ -19,13 +19,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-from service.model_files import file_sha256
-from service.prior import PRIOR_FILE
-from service.runtime import CurveRuntime
-from training.data import DataConfig, default_cache, generate_curves, load_or_generate
-from training.evaluate import sample_quality
-from training.prior import FIT_CURVES, fit_prior
+from curve_vae.service.model_files import file_sha256
+from curve_vae.service.prior import PRIOR_FILE
+from curve_vae.service.runtime import CurveRuntime
+from curve_vae.training.data import DataConfig, default_cache, generate_curves, load_or_generate
+from curve_vae.training.evaluate import sample_quality
+from curve_vae.training.prior import FIT_CURVES, fit_prior
 
 
 def main() -> None:

@@ -3,7 +3,7 @@
     .venv/bin/python scripts/soak.py --clients 32 --duration 60            # the figures of docs/RELIABILITY.md
     .venv/bin/python scripts/soak.py --clients 8 --duration 5              # the short version CI runs
 
-Starts `python -m service.cli` on a free loopback port (the shipped model unless --model-dir), warms
+Starts `python -m curve_vae.service.cli` on a free loopback port (the shipped model unless --model-dir), warms
 every endpoint up, reads the server's resident memory, then runs the clients until the time or the
 request budget is spent. Each request of the mix has an expected status (bad inputs are part of the
 mix and must get their 422): any other answer, or no answer, is an error. Reports requests, errors,
@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _curves(rng: np.random.Generator, count: int, n: int) -> list:
-    from geometry import random_control_points, sample_bspline
+    from curve_vae.geometry import random_control_points, sample_bspline
 
     return (sample_bspline(random_control_points(rng, count), n) * 0.05 - 3).round(4).tolist()
 
@@ -108,7 +108,7 @@ async def _load(url: str, clients: int, duration: float, max_requests: int, seed
 def run(a: argparse.Namespace) -> dict:
     port = _free_port()
     url = f"http://127.0.0.1:{port}"
-    cmd = [sys.executable, "-m", "service.cli", "--port", str(port), "--log-level", "warning",
+    cmd = [sys.executable, "-m", "curve_vae.service.cli", "--port", str(port), "--log-level", "warning",
            "--model-dir", a.model_dir, "--providers", "cpu"]  # fmt: skip
     server = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:

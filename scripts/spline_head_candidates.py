@@ -29,15 +29,14 @@ from typing import Any
 import numpy as np
 import onnxruntime as ort
 import torch
-
-from geometry import smoothness, spline_head
-from service.runtime import CurveRuntime
-from training.airfoils import load_airfoils
-from training.checkpoint import model_from_checkpoint
-from training.data import DataConfig, default_cache, generate_curves, load_or_generate
-from training.evaluate import evaluate_set, interpolation_report, onnx_codec
-from training.export import export
-from training.model import VAE, ModelConfig
+from curve_vae.geometry import smoothness, spline_head
+from curve_vae.service.runtime import CurveRuntime
+from curve_vae.training.airfoils import load_airfoils
+from curve_vae.training.checkpoint import model_from_checkpoint
+from curve_vae.training.data import DataConfig, default_cache, generate_curves, load_or_generate
+from curve_vae.training.evaluate import evaluate_set, interpolation_report, onnx_codec
+from curve_vae.training.export import export
+from curve_vae.training.model import VAE, ModelConfig
 
 
 def load_weights(path: str, spline_ctrl: int) -> VAE:

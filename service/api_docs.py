@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from service import schemas as s
+from curve_vae.service import schemas as s
 
 ERROR_EXAMPLES = {
     413: (

@@ -29,31 +29,30 @@ from functools import partial
 from typing import Any
 
 import anyio
-from fastapi import FastAPI
-from fastapi.exceptions import RequestValidationError
-from fastapi.middleware.cors import CORSMiddleware
-from starlette.exceptions import HTTPException
-
-from service.access import ApiKeyMiddleware
-from service.batching import GraphBatcher
-from service.batching import attach as attach_batcher
-from service.cpus import available_cpus, inference_slots, session_config
-from service.errors import on_http_error, on_input_error, on_validation_error
-from service.metrics import Metrics, MetricsMiddleware
-from service.middleware import BodyLimitMiddleware
-from service.oip import DEFAULT_SIGNATURES, describe, signatures
-from service.openapi import state_bounds
-from service.routes.curves import curves_router
-from service.routes.design import design_router
-from service.routes.oip import oip_router
-from service.routes.ops import ops_router
-from service.runtime import (
+from curve_vae.service.access import ApiKeyMiddleware
+from curve_vae.service.batching import GraphBatcher
+from curve_vae.service.batching import attach as attach_batcher
+from curve_vae.service.cpus import available_cpus, inference_slots, session_config
+from curve_vae.service.errors import on_http_error, on_input_error, on_validation_error
+from curve_vae.service.metrics import Metrics, MetricsMiddleware
+from curve_vae.service.middleware import BodyLimitMiddleware
+from curve_vae.service.oip import DEFAULT_SIGNATURES, describe, signatures
+from curve_vae.service.openapi import state_bounds
+from curve_vae.service.routes.curves import curves_router
+from curve_vae.service.routes.design import design_router
+from curve_vae.service.routes.oip import oip_router
+from curve_vae.service.routes.ops import ops_router
+from curve_vae.service.runtime import (
     CurveRuntime,
     InputError,
     ModelLoadError,
 )
-from service.settings import Settings, get_settings
-from service.web import mount_web
+from curve_vae.service.settings import Settings, get_settings
+from curve_vae.service.web import mount_web
+from fastapi import FastAPI
+from fastapi.exceptions import RequestValidationError
+from fastapi.middleware.cors import CORSMiddleware
+from starlette.exceptions import HTTPException
 
 log = logging.getLogger("service")
 

@@ -14,9 +14,8 @@ import os
 import sys
 from typing import Any
 
+from curve_vae.service.settings import Settings
 from pydantic import ValidationError
-
-from service.settings import Settings
 
 # (flag, settings field, type, help); the default and variable are appended from Settings.
 _OPTIONS: list[tuple[str, str, Any, str]] = [
@@ -117,8 +116,7 @@ def _graceful_server_class() -> type:
 def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
-
-    from service.model_files import ModelLoadError, read_manifest, resolve_providers
+    from curve_vae.service.model_files import ModelLoadError, read_manifest, resolve_providers
 
     try:
         settings = settings_from_args(args)
@@ -141,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     )
     try:
         if settings.workers == 1:
-            from service.app import create_app
+            from curve_vae.service.app import create_app
 
             config = uvicorn.Config(create_app(settings), **common)  # type: ignore[arg-type]
             server = _graceful_server_class()(config)
@@ -151,14 +149,14 @@ def run(args: argparse.Namespace) -> int:
         else:
             # Workers are fresh processes: they rebuild the same settings from the environment.
             os.environ.update(_as_env(settings))
-            uvicorn.run("service.app:create_app_from_env", factory=True, workers=settings.workers, **common)  # type: ignore[arg-type]
+            uvicorn.run("curve_vae.service.app:create_app_from_env", factory=True, workers=settings.workers, **common)  # type: ignore[arg-type]
     except SystemExit as e:  # uvicorn exits 3 when the app fails to start
         return e.code if isinstance(e.code, int) else 1
     return 0
 
 
 def main(argv: list[str] | None = None) -> int:
-    """`python -m service.cli`: the same as `curve-vae serve`."""
+    """`python -m curve_vae.service.cli`: the same as `curve-vae serve`."""
     parser = argparse.ArgumentParser(prog="curve-vae serve", description="Serve the curve VAE over REST.")
     configure_parser(parser)
     return run(parser.parse_args(argv))

@@ -12,9 +12,8 @@ from pathlib import Path
 from typing import Any
 
 import onnxruntime as ort
-
-from geometry.frame import MODEL_CENTER
-from service.prior import PRIOR_FILE
+from curve_vae.geometry.frame import MODEL_CENTER
+from curve_vae.service.prior import PRIOR_FILE
 
 CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
 

@@ -1,4 +1,4 @@
-"""openapi.yaml at the repository root: the app's own schema, written by `python -m service.openapi`.
+"""openapi.yaml at the repository root: the app's own schema, written by `python -m curve_vae.service.openapi`.
 
 A test regenerates it and fails when the committed file drifts from the app.
 """
@@ -52,8 +52,8 @@ def state_bounds(schema: dict[str, Any], settings: Any, latent_dim: int | None) 
 
 def openapi_spec() -> dict[str, Any]:
     """The schema of an app with default settings; the environment and the model play no part."""
-    from service.app import create_app
-    from service.settings import Settings
+    from curve_vae.service.app import create_app
+    from curve_vae.service.settings import Settings
 
     return create_app(Settings.model_construct()).openapi()
 
@@ -85,7 +85,7 @@ def main(argv: list[str] | None = None) -> int:
     text = render()
     if args.check:
         same = args.out.is_file() and args.out.read_text() == text
-        print(f"{args.out}: {'up to date' if same else 'out of date; run python -m service.openapi'}")
+        print(f"{args.out}: {'up to date' if same else 'out of date; run python -m curve_vae.service.openapi'}")
         return 0 if same else 1
     args.out.write_text(text)
     print(f"wrote {args.out}")

@@ -10,9 +10,8 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-
-from geometry import Frame, fit_bspline, fit_bspline_auto
-from service.runtime import InputError, Sampled, Spline, curve_metrics
+from curve_vae.geometry import Frame, fit_bspline, fit_bspline_auto
+from curve_vae.service.runtime import InputError, Sampled, Spline, curve_metrics
 
 
 def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:

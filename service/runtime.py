@@ -34,8 +34,7 @@ from typing import Any, Literal
 
 import numpy as np
 import onnxruntime as ort
-
-from geometry import (
+from curve_vae.geometry import (
     Frame,
     arc_fractions,
     arc_length_params,
@@ -52,10 +51,10 @@ from geometry import (
     self_intersects,
     smoothness,
 )
-from service import batching
-from service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
-from service.prior import PRIOR_FILE, LatentPrior
-from service.sessions import SessionConfig, SessionPool, open_pair
+from curve_vae.service import batching
+from curve_vae.service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
+from curve_vae.service.prior import PRIOR_FILE, LatentPrior
+from curve_vae.service.sessions import SessionConfig, SessionPool, open_pair
 
 log = logging.getLogger(__name__)
 

@@ -14,10 +14,9 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
+from curve_vae.geometry import Frame
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import PydanticCustomError
-
-from geometry import Frame
 
 FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # numbers only: no "1.5", no true
 
@@ -500,7 +499,10 @@ class FileInfo(BaseModel):
 
 class ModelInfo(BaseModel):
     name: str
-    version: str
+    version: str = Field(description="The model's own version (its manifest's).")
+    service_version: str = Field(
+        description="The curve-vae package serving it: the version `curve-vae --version` and the OpenAPI document tell."
+    )
     created: str | None = None
     variant: str | None = None
     n_points: int = Field(description="Points per curve the model sees (161).")

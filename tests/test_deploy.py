@@ -19,8 +19,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-
-from service.settings import Settings
+from curve_vae.service.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCKERFILES = [ROOT / "docker" / "Dockerfile", ROOT / "docker" / "Dockerfile.cuda"]
@@ -87,9 +86,8 @@ def env_of(stage: Stage) -> dict[str, str]:
 
 def app_routes() -> dict[str, set[str]]:
     """Path → methods of the app's route table (routers included as they are: FastAPI ≥ 0.16x nests them)."""
+    from curve_vae.service.app import create_app
     from fastapi.testclient import TestClient
-
-    from service.app import create_app
 
     app = create_app(Settings.model_construct())
     out: dict[str, set[str]] = {}
@@ -218,8 +216,11 @@ def test_the_entry_point_is_the_packages_console_script_with_its_serve_command(p
 
     assert args == ["serve"] and "serve" in build_parser()._subparsers._group_actions[0].choices  # type: ignore[union-attr]
     env = env_of(read_dockerfile(path)[-1])
-    assert env["CURVE_VAE_MODEL_DIR"] == "/app/models"
-    assert any(args.split()[-1] == "/app/models" for args in read_dockerfile(path)[-1].all("COPY")), "model not baked"
+    assert "CURVE_VAE_MODEL_DIR" not in env  # the model baked into the package (curve_vae/models) is the default
+    builder = read_dockerfile(path)[0].instructions
+    install = next(i for i, (instr, args) in enumerate(builder) if instr == "RUN" and args.startswith("pip install"))
+    copied = [args.split()[0] for instr, args in builder[:install] if instr == "COPY"]
+    assert "models" in copied, "model not baked into the installed package"
 
 
 def test_the_cuda_image_installs_the_gpu_extra_and_insists_on_cuda():

@@ -20,3 +20,17 @@ def test_readme_opens_with_run_and_test_commands():
 def test_ci_runs_the_readme_test_command():
     ci = (ROOT / ".ci" / "run").read_text()
     assert _readme_commands()[1] in ci.splitlines()
+
+
+def test_every_package_folder_is_in_the_one_namespace_the_wheel_installs():
+    import tomllib
+
+    tool = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    listed, dirs = set(tool["packages"]), tool["package-dir"]
+    roots = {"curve_vae": ROOT / "curve_vae", **{name: ROOT / path for name, path in dirs.items()}}
+    found = set()
+    for name, root in roots.items():
+        for init in root.rglob("__init__.py"):
+            found.add(".".join([name, *init.parent.relative_to(root).parts]))
+    assert found <= listed, f"package folders missing from pyproject's packages: {sorted(found - listed)}"
+    assert all(n == "curve_vae" or n.startswith("curve_vae.") for n in listed)

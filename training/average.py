@@ -15,12 +15,11 @@ from typing import Any
 
 import numpy as np
 import torch
+from curve_vae.training.checkpoint import CHECKPOINT_VERSION, load_checkpoint
+from curve_vae.training.config import ModelConfig
+from curve_vae.training.model import VAE
+from curve_vae.training.train import validation_mse
 from torch import nn
-
-from training.checkpoint import CHECKPOINT_VERSION, load_checkpoint
-from training.config import ModelConfig
-from training.model import VAE
-from training.train import validation_mse
 
 __all__ = ["average_state_dicts", "recompute_batchnorm", "average_checkpoints"]
 

@@ -8,9 +8,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
 
 from curve_vae.files import atomic_path
-from geometry import random_control_points, sample_bspline, self_intersects
 
 FORMAT_VERSION = 1
 MIXES = ("paper", "broad", "files")
@@ -39,7 +39,7 @@ class DataConfig:
         if self.mix not in MIXES:
             raise ValueError(f"mix must be one of {', '.join(MIXES)}, got {self.mix!r}")
         if self.mix == "broad" and not self.mix_version:
-            from training.families import MIX_VERSION
+            from curve_vae.training.families import MIX_VERSION
 
             object.__setattr__(self, "mix_version", MIX_VERSION)
         elif self.mix != "broad" and self.mix_version:
@@ -104,13 +104,13 @@ class CurveDataset:
     def generate(cls, config: DataConfig, *, workers: int = 1) -> CurveDataset:
         """The data set of `config`; the broad mix is drawn by `workers` processes (the same data however many)."""
         if config.mix == "files":
-            from training.families import own_curves
+            from curve_vae.training.families import own_curves
 
             train, val, test = own_curves(config.source, config.n_train, config.seed, n_points=config.n_points)
             return cls(config, train, val, test, np.zeros((len(test), 0, 2), np.float32))
         a, b = config.n_train, config.n_train + config.n_val
         if config.mix == "broad":
-            from training.families import MIX_VERSION, broad_mix
+            from curve_vae.training.families import MIX_VERSION, broad_mix
 
             if config.mix_version != MIX_VERSION:
                 raise ValueError(f"the broad mix of version {config.mix_version} is no longer made (now {MIX_VERSION})")

@@ -15,9 +15,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from curve_vae.geometry import mse_per_curve, self_intersects, smoothness
 
 from curve_vae.files import atomic_write_text
-from geometry import mse_per_curve, self_intersects, smoothness
 
 Reconstructor = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, N, 2), decoding the mean
 Encoder = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, Z) latent means
@@ -45,8 +45,7 @@ def onnx_codec(model_dir: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]
 def torch_codec(checkpoint: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]:
     """Encoder/decoder callables over a torch checkpoint (last.pt, best.pt or vae.pt)."""
     import torch
-
-    from training.checkpoint import model_from_checkpoint
+    from curve_vae.training.checkpoint import model_from_checkpoint
 
     model = model_from_checkpoint(checkpoint)
 
@@ -184,7 +183,7 @@ def run_evaluation(
     generation report of its priors, the first test set held out and the second as the real reference,
     and with suite_count > 0 the family suite (training/suite.py) of that many curves per set.
     """
-    from training.figures import (
+    from curve_vae.training.figures import (
         plot_latent_tsne,
         plot_latent_vs_pointwise,
         plot_pair_interpolation,
@@ -226,7 +225,7 @@ def run_evaluation(
         )
         plot_latent_tsne(encode, first, out / "latent_tsne.png")
     if runtime is not None and suite_count > 0:
-        from training.suite import paper_test_split, run_suite, suite_sets
+        from curve_vae.training.suite import paper_test_split, run_suite, suite_sets
 
         paper = paper_test_split()  # whatever the model was trained on: the suite's paper sets are the paper's
         report["families"] = run_suite(runtime, paper, count=suite_count)

@@ -16,9 +16,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-
-from geometry import random_control_points, sample_bspline, self_intersects
-from geometry.frame import chord_heading, posed_frame, signed_turning
+from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
+from curve_vae.geometry.frame import chord_heading, posed_frame, signed_turning
 
 MODEL_SIZE = 92.6  # the larger bounding-box side of a posed curve in the model plane: the paper's curves' median
 DENSE = 641  # points per curve before respacing: 4× the model's, so every spacing interpolates finely
@@ -239,8 +238,9 @@ def own_curves(
     SPACINGS ("parameter" keeps the file's own spacing, as the service takes posted points by default), so a
     few hundred curves make a data set of any size. Validation and test curves keep their own spacing.
     """
+    from curve_vae.geometry import resample
+
     from curve_vae.files import read_curve_files
-    from geometry import resample
 
     curves = read_curve_files(source)
     if len(curves) < 3:

@@ -10,10 +10,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from curve_vae.geometry import mse_per_curve, self_intersects, smoothness
+from curve_vae.training.evaluate import Decoder, Encoder, batched
 
 from curve_vae.files import atomic_path
-from geometry import mse_per_curve, self_intersects, smoothness
-from training.evaluate import Decoder, Encoder, batched
 
 
 def plot_samples(samples: np.ndarray, data: np.ndarray, path: Path, *, n: int = 16) -> None:
@@ -69,7 +69,7 @@ def plot_reconstructions(curves: np.ndarray, recon: np.ndarray, path: Path, *, n
 
 def plot_suite(runtime: Any, sets: dict[str, tuple[str, list[np.ndarray]]], path: Path, *, n: int = 5) -> None:
     """A row per set: its first n curves (grey) and their reconstructions (colour), each in its own frame."""
-    from training.suite import relative_rmse
+    from curve_vae.training.suite import relative_rmse
 
     plt = pyplot()
     fig, axes = plt.subplots(len(sets), n, figsize=(1.7 * n, 1.7 * len(sets)), squeeze=False)

@@ -18,16 +18,15 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-from geometry import resample, self_intersects, smoothness
-from training.families import HELD_OUT, TRAIN_FAMILIES, draw_family
+from curve_vae.geometry import resample, self_intersects, smoothness
+from curve_vae.training.families import HELD_OUT, TRAIN_FAMILIES, draw_family
 
 AIRFOIL_WHEEL = Path("data/aerosandbox-4.2.10-py3-none-any.whl")
 
 
 def paper_test_split() -> np.ndarray:
     """The paper's 1,000 test curves: the test split of the default data set (seed 0), generated (about 4 s)."""
-    from training.data import DataConfig, generate_curves
+    from curve_vae.training.data import DataConfig, generate_curves
 
     cfg = DataConfig()
     return generate_curves(cfg.n_train + cfg.n_val + cfg.n_test, cfg.seed, n_points=cfg.n_points)[0][-cfg.n_test :]
@@ -67,7 +66,7 @@ def suite_sets(test_curves: np.ndarray, count: int = 200, seed: int = 2024) -> d
         drawn = draw_family(fam, count, rng, model_size=None).astype(np.float64)
         sets[name] = ("held out", random_moves(list(drawn), rng))
     if AIRFOIL_WHEEL.exists():
-        from training.airfoils import load_airfoils
+        from curve_vae.training.airfoils import load_airfoils
 
         sets["airfoils (UIUC)"] = ("real", load_airfoils(AIRFOIL_WHEEL, count, seed=seed))
     return sets

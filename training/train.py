@@ -21,15 +21,20 @@ from typing import Any
 import numpy as np
 import torch
 import torch.distributed as dist
+from curve_vae.geometry import mse_per_curve
+from curve_vae.training.checkpoint import (
+    CHECKPOINT_VERSION,
+    atomic_save,
+    load_checkpoint,
+    load_weights,
+    without_resume_state,
+)
+from curve_vae.training.config import SCHEDULES, ModelConfig, TrainConfig
+from curve_vae.training.data import DataConfig, load_or_generate
+from curve_vae.training.losses import vae_loss
+from curve_vae.training.model import VAE
 from torch import nn
 from tqdm import tqdm
-
-from geometry import mse_per_curve
-from training.checkpoint import CHECKPOINT_VERSION, atomic_save, load_checkpoint, load_weights, without_resume_state
-from training.config import SCHEDULES, ModelConfig, TrainConfig
-from training.data import DataConfig, load_or_generate
-from training.losses import vae_loss
-from training.model import VAE
 
 __all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch"]
 

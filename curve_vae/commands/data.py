@@ -16,8 +16,8 @@ from curve_vae.files import refuse_overwrite
 def cmd_dataset(a: argparse.Namespace) -> int:
     import time
 
-    from training.data import load_or_generate
-    from training.figures import pyplot, save_figure
+    from curve_vae.training.data import load_or_generate
+    from curve_vae.training.figures import pyplot, save_figure
 
     if a.preview:
         refuse_overwrite(a.preview, a.force, "--preview")

@@ -19,10 +19,10 @@ from curve_vae.commands.options import (
 
 def cmd_export(a: argparse.Namespace) -> int:
     from curve_vae.files import atomic_write_text
-    from training.checkpoint import load_checkpoint, model_from_checkpoint
-    from training.data import DataConfig, generate_curves, load_or_generate, load_test_split
-    from training.evaluate import onnx_codec, run_evaluation
-    from training.export import export, model_size_of
+    from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
+    from curve_vae.training.data import DataConfig, generate_curves, load_or_generate, load_test_split
+    from curve_vae.training.evaluate import onnx_codec, run_evaluation
+    from curve_vae.training.export import export, model_size_of
 
     held = [
         f
@@ -37,7 +37,7 @@ def cmd_export(a: argparse.Namespace) -> int:
     ckpt = load_checkpoint(a.checkpoint)
     data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
     if data_cfg.mix == "broad":  # posed at one size, tested on the paper's curves: no training split to draw
-        from training.families import MODEL_SIZE
+        from curve_vae.training.families import MODEL_SIZE
 
         train, test, model_size = None, load_test_split(data_cfg, None), MODEL_SIZE
     else:
@@ -47,7 +47,7 @@ def cmd_export(a: argparse.Namespace) -> int:
     if a.spline_ctrl is not None and a.spline_ctrl != model.cfg.spline_ctrl:
         from dataclasses import replace
 
-        from training.model import VAE
+        from curve_vae.training.model import VAE
 
         head = VAE(replace(model.cfg, spline_ctrl=a.spline_ctrl))  # the head has no weights: same state dict
         head.load_state_dict(model.state_dict())
@@ -68,7 +68,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         import numpy as np
         import torch
 
-        from training.prior import FIT_CURVES, fit_prior
+        from curve_vae.training.prior import FIT_CURVES, fit_prior
 
         # /sample draws the paper's curves: with the broad mix, the prior is fitted to the paper's training curves
         fit_on = (
@@ -96,7 +96,7 @@ def cmd_export(a: argparse.Namespace) -> int:
     print(f"exported {a.checkpoint} → {a.out}/: {', '.join(manifest['files'])}, manifest.json")
     if a.evaluate:
         fresh, _ = generate_curves(1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
-        from service.runtime import CurveRuntime
+        from curve_vae.service.runtime import CurveRuntime
 
         enc, dec, _ = onnx_codec(a.out)
         report = run_evaluation(
@@ -115,15 +115,15 @@ def cmd_export(a: argparse.Namespace) -> int:
         for name, r in report["test_sets"].items():
             print(f"{name}: MSE {r['mse']:.4f} (median {r['mse_median']:.4f}) over {r['n_curves']} curves")
         if "families" in report:
-            from training.suite import format_suite
+            from curve_vae.training.suite import format_suite
 
             print(format_suite(report["families"]))
     return 0
 
 
 def cmd_evaluate(a: argparse.Namespace) -> int:
-    from training.data import DataConfig, generate_curves, load_test_split
-    from training.evaluate import onnx_codec, run_evaluation, torch_codec
+    from curve_vae.training.data import DataConfig, generate_curves, load_test_split
+    from curve_vae.training.evaluate import onnx_codec, run_evaluation, torch_codec
 
     runtime = None
     if a.checkpoint:
@@ -132,7 +132,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
 
         data_cfg_d = torch.load(a.checkpoint, map_location="cpu", weights_only=True).get("data_config")  # vae.pt: none
     else:
-        from service.runtime import CurveRuntime
+        from curve_vae.service.runtime import CurveRuntime
 
         enc, dec, meta = onnx_codec(a.model_dir)
         runtime = CurveRuntime.load(a.model_dir, providers="cpu")
@@ -171,7 +171,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
                 f"precision {kept['precision_vs_real']:.2f}× of real curves'"
             )
     if "families" in report:
-        from training.suite import format_suite
+        from curve_vae.training.suite import format_suite
 
         print("curve families (relative RMSE: RMSE ÷ bounding-box diagonal, through the service's runtime):")
         print(format_suite(report["families"]))
@@ -180,8 +180,8 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
 
 
 def cmd_triton(a: argparse.Namespace) -> int:
+    from curve_vae.service.settings import DEFAULT_MODEL_DIR
     from curve_vae.triton import smoke_test, write_repository
-    from service.settings import DEFAULT_MODEL_DIR
 
     folders = write_repository(
         a.model_dir or DEFAULT_MODEL_DIR,

@@ -48,13 +48,13 @@ def add_data_options(p: argparse.ArgumentParser) -> None:
 
 def data_path(a: argparse.Namespace, config: Any) -> Path:
     """--data, or the default cache file of this data configuration."""
-    from training.data import default_cache
+    from curve_vae.training.data import default_cache
 
     return Path(a.data) if a.data else default_cache(config)
 
 
 def data_config(a: argparse.Namespace):
-    from training.data import DataConfig
+    from curve_vae.training.data import DataConfig
 
     mix = "files" if a.curves else a.mix
     return DataConfig(
@@ -107,8 +107,8 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
 
 
 def model_runtime(a: argparse.Namespace):
-    from service.runtime import CurveRuntime
-    from service.settings import DEFAULT_MODEL_DIR
+    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.service.settings import DEFAULT_MODEL_DIR
 
     model_dir = a.model_dir or DEFAULT_MODEL_DIR
     return CurveRuntime.load(model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)

@@ -18,7 +18,7 @@ from curve_vae.progress import shown
 
 
 def add_train_options(p: argparse.ArgumentParser) -> None:
-    from training.config import SCHEDULES, VARIANTS, TrainConfig
+    from curve_vae.training.config import SCHEDULES, VARIANTS, TrainConfig
 
     g = p.add_argument_group("model (paper §3.5)")
     g.add_argument(
@@ -75,17 +75,17 @@ def add_train_options(p: argparse.ArgumentParser) -> None:
 
 def cmd_train(a: argparse.Namespace) -> int:
 
-    from training.config import ModelConfig, TrainConfig
-    from training.evaluate import run_evaluation, torch_codec
-    from training.figures import plot_training
-    from training.train import train
+    from curve_vae.training.config import ModelConfig, TrainConfig
+    from curve_vae.training.evaluate import run_evaluation, torch_codec
+    from curve_vae.training.figures import plot_training
+    from curve_vae.training.train import train
 
     spline_ctrl = a.spline_ctrl
     if spline_ctrl is None:  # keep the head of the weights a run continues from: dropping it would go unnoticed
         start = Path(a.run_dir) / "last.pt" if a.resume and (Path(a.run_dir) / "last.pt").exists() else a.init_from
         spline_ctrl = 0
         if start:
-            from training.checkpoint import load_weights
+            from curve_vae.training.checkpoint import load_weights
 
             spline_ctrl = load_weights(start)[0].spline_ctrl
     model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim, spline_ctrl=spline_ctrl)
@@ -112,7 +112,7 @@ def cmd_train(a: argparse.Namespace) -> int:
         or 0 < cfg.time_budget <= state.trained_seconds
     )
     if finished:
-        from training.data import load_or_generate
+        from curve_vae.training.data import load_or_generate
 
         ds = load_or_generate(data_config(a), data_path(a, data_config(a)))
         enc, dec, _ = torch_codec(run_dir / "best.pt")
@@ -129,9 +129,9 @@ def cmd_train(a: argparse.Namespace) -> int:
 def cmd_average(a: argparse.Namespace) -> int:
     import torch
 
-    from training.average import average_checkpoints
-    from training.checkpoint import atomic_save, load_checkpoint
-    from training.data import DataConfig, load_or_generate
+    from curve_vae.training.average import average_checkpoints
+    from curve_vae.training.checkpoint import atomic_save, load_checkpoint
+    from curve_vae.training.data import DataConfig, load_or_generate
 
     if a.threads > 0:
         torch.set_num_threads(a.threads)

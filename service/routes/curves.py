@@ -11,12 +11,9 @@ from collections.abc import AsyncIterator, Callable
 from typing import Annotated, Any
 
 import numpy as np
-from fastapi import APIRouter, Body, Request
-from fastapi.responses import Response, StreamingResponse
-
-from service import schemas as s
-from service.api_docs import C1, C2, C3, POST_ERRORS, curl_sample, example
-from service.deps import (
+from curve_vae.service import schemas as s
+from curve_vae.service.api_docs import C1, C2, C3, POST_ERRORS, curl_sample, example
+from curve_vae.service.deps import (
     RuntimeDep,
     SettingsDep,
     check_curves,
@@ -28,19 +25,21 @@ from service.deps import (
     settings_of,
     splines_wanted,
 )
-from service.fastjson import JSON, FastJSONRoute
-from service.metrics import Metrics
-from service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
-from service.npy import chunk_bytes, npy_header, npy_size
-from service.npy_bodies import OPENAPI_BODY as NPY_BODY
-from service.npy_bodies import npy_route
-from service.payloads import augment_body, frames_json, sample_body, with_metrics, with_output
-from service.runtime import (
+from curve_vae.service.fastjson import JSON, FastJSONRoute
+from curve_vae.service.metrics import Metrics
+from curve_vae.service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
+from curve_vae.service.npy import chunk_bytes, npy_header, npy_size
+from curve_vae.service.npy_bodies import OPENAPI_BODY as NPY_BODY
+from curve_vae.service.npy_bodies import npy_route
+from curve_vae.service.payloads import augment_body, frames_json, sample_body, with_metrics, with_output
+from curve_vae.service.runtime import (
     AugmentPlan,
     CurveRuntime,
     InputError,
     fresh_seed,
 )
+from fastapi import APIRouter, Body, Request
+from fastapi.responses import Response, StreamingResponse
 
 ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'
 curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])

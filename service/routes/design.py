@@ -5,23 +5,22 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
-from fastapi import APIRouter, Body, Request
-from fastapi.responses import Response
-
-from geometry import revolve
-from service import schemas as s
-from service.api_docs import C1, C2, curl_sample, error_docs, example
-from service.deps import (
+from curve_vae.geometry import revolve
+from curve_vae.service import schemas as s
+from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example
+from curve_vae.service.deps import (
     SettingsDep,
     check_curves,
     check_n_points,
     run_inference,
 )
-from service.fastjson import JSON, FastJSONRoute
-from service.payloads import fit_body
-from service.runtime import (
+from curve_vae.service.fastjson import JSON, FastJSONRoute
+from curve_vae.service.payloads import fit_body
+from curve_vae.service.runtime import (
     InputError,
 )
+from fastapi import APIRouter, Body, Request
+from fastapi.responses import Response
 
 design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 

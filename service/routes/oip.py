@@ -16,16 +16,15 @@ import json
 from collections.abc import Awaitable, Callable
 from typing import Any
 
+from curve_vae.service import oip
+from curve_vae.service.api_docs import ERROR_EXAMPLES, curl_sample
+from curve_vae.service.deps import run_inference, runtime_of
+from curve_vae.service.errors import oip_error
+from curve_vae.service.fastjson import JSON
+from curve_vae.service.oip import OipError
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from pydantic import BaseModel, Field
-
-from service import oip
-from service.api_docs import ERROR_EXAMPLES, curl_sample
-from service.deps import run_inference, runtime_of
-from service.errors import oip_error
-from service.fastjson import JSON
-from service.oip import OipError
 
 TAG = "open inference protocol"
 oip_router = APIRouter(tags=[TAG])

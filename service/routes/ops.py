@@ -5,18 +5,19 @@ from __future__ import annotations
 from typing import Any
 
 import onnxruntime as ort
-from fastapi import APIRouter, Request
-from fastapi.responses import Response
-from starlette.exceptions import HTTPException
-
-from service import schemas as s
-from service.api_docs import curl_sample, error_docs
-from service.deps import (
+from curve_vae.service import schemas as s
+from curve_vae.service.api_docs import curl_sample, error_docs
+from curve_vae.service.deps import (
     RuntimeDep,
     SettingsDep,
     execution_of,
     runtime_of,
 )
+from fastapi import APIRouter, Request
+from fastapi.responses import Response
+from starlette.exceptions import HTTPException
+
+from curve_vae import __version__
 
 ops_router = APIRouter(tags=["operations"])
 
@@ -53,6 +54,7 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
     return {
         "name": m.get("name", "curve-vae"),
         "version": str(m.get("version", "")),
+        "service_version": __version__,
         "created": m.get("created"),
         "variant": m.get("variant"),
         "n_points": runtime.n_points,

@@ -2,8 +2,7 @@
 
 import numpy as np
 import pytest
-
-from geometry import (
+from curve_vae.geometry import (
     arc_length_params,
     blend_frames,
     clamped_uniform_knots,

@@ -2,8 +2,7 @@
 
 import numpy as np
 import pytest
-
-from geometry import revolve
+from curve_vae.geometry import revolve
 
 
 def _half_circle(n=21):

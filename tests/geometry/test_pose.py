@@ -2,9 +2,8 @@
 
 import numpy as np
 import pytest
-
-from geometry import Frame, blend_frames, pose_frames, random_control_points, sample_bspline, signed_turning
-from geometry.frame import POSE_CHORDS, chord_heading
+from curve_vae.geometry import Frame, blend_frames, pose_frames, random_control_points, sample_bspline, signed_turning
+from curve_vae.geometry.frame import POSE_CHORDS, chord_heading
 
 SIZE = 92.6
 

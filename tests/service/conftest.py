@@ -18,12 +18,11 @@ from pathlib import Path
 import httpx
 import numpy as np
 import pytest
+from curve_vae.geometry import random_control_points, sample_bspline
+from curve_vae.service.app import create_app
+from curve_vae.service.runtime import CurveRuntime
+from curve_vae.service.settings import Settings
 from fastapi.testclient import TestClient
-
-from geometry import random_control_points, sample_bspline
-from service.app import create_app
-from service.runtime import CurveRuntime
-from service.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ROOT / "models"
@@ -45,10 +44,9 @@ def _export_untrained(out: Path, *, spline_ctrl: int) -> Path:
     """With a learned prior: a mixture around the latent means of four data-set curves (tight, so its samples
     decode near those curves' reconstructions)."""
     import torch
-
-    from service.prior import LatentPrior
-    from training.export import export
-    from training.model import VAE, ModelConfig
+    from curve_vae.service.prior import LatentPrior
+    from curve_vae.training.export import export
+    from curve_vae.training.model import VAE, ModelConfig
 
     torch.manual_seed(0)  # the same untrained weights every run
     model = VAE(ModelConfig(spline_ctrl=spline_ctrl)).eval()
@@ -115,12 +113,12 @@ def free_port() -> int:
 
 
 class LiveServer:
-    """`python -m service.cli` (what `curve-vae serve` runs) in a subprocess on a free loopback port."""
+    """`python -m curve_vae.service.cli` (what `curve-vae serve` runs) in a subprocess on a free loopback port."""
 
     def __init__(self, *args: str, env: dict[str, str] | None = None) -> None:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
-        cmd = [sys.executable, "-m", "service.cli", "--port", str(self.port), "--log-level", "warning", *args]
+        cmd = [sys.executable, "-m", "curve_vae.service.cli", "--port", str(self.port), "--log-level", "warning", *args]
         self.proc = subprocess.Popen(
             cmd,
             cwd=ROOT,

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import pytest
-
-from service.access import accepted, key_of
+from curve_vae.service.access import accepted, key_of
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 KEYS = ["k-one-0123456789", "k-two-abcdefghij"]
@@ -84,7 +83,7 @@ def test_metrics_can_be_switched_off(make_client):
 
 
 def test_keys_come_from_the_environment(monkeypatch):
-    from service.settings import Settings
+    from curve_vae.service.settings import Settings
 
     monkeypatch.setenv("CURVE_VAE_API_KEYS", "a1, b2")
     monkeypatch.setenv("CURVE_VAE_METRICS", "false")
@@ -93,10 +92,9 @@ def test_keys_come_from_the_environment(monkeypatch):
 
 
 def test_an_unexpected_failure_tells_nothing_of_the_inside(model_dir, runtime, monkeypatch):
+    from curve_vae.service.app import create_app
+    from curve_vae.service.settings import Settings
     from fastapi.testclient import TestClient
-
-    from service.app import create_app
-    from service.settings import Settings
 
     def broken(*args, **kwargs):
         raise RuntimeError("failed in /srv/secret/models/decoder.onnx")

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from curve_vae.geometry import fit_frame, mse_per_curve
+from curve_vae.service.app import create_app
+from curve_vae.service.runtime import ModelLoadError
+from curve_vae.service.settings import Settings
 from fastapi.testclient import TestClient
-
-from geometry import fit_frame, mse_per_curve
-from service.app import create_app
-from service.runtime import ModelLoadError
-from service.settings import Settings
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 
@@ -235,7 +234,7 @@ def test_augment(client, curves, runtime, mode, k):
 
 def test_the_shipped_model_is_served_by_default(shipped_runtime, curves):
     """Default settings serve models/; its checksums pass and it keeps the frame behaviour of item 3."""
-    from service.settings import DEFAULT_MODEL_DIR
+    from curve_vae.service.settings import DEFAULT_MODEL_DIR
 
     with TestClient(create_app(Settings(providers="cpu"))) as client:
         info = client.get("/model").json()

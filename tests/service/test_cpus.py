@@ -6,9 +6,8 @@ from __future__ import annotations
 import os
 
 import pytest
-
-from service import cpus
-from service.settings import Settings
+from curve_vae.service import cpus
+from curve_vae.service.settings import Settings
 
 
 def cgroup(tmp_path, v2: str | None = None, v1: tuple[str, str] | None = None):
@@ -74,7 +73,7 @@ def test_inference_slots_default_to_one_per_cpu_of_a_worker(cpus_, workers, conc
 
 
 def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypatch):
-    monkeypatch.setattr("service.cpus.available_cpus", lambda root=None: 6)
+    monkeypatch.setattr("curve_vae.service.cpus.available_cpus", lambda root=None: 6)
     client = make_client(share_runtime=False, providers="cpu", inference_concurrency=3)
     assert client.get("/ready").status_code == 200
     runtime = client.app.state.runtime

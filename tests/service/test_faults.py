@@ -11,10 +11,9 @@ import time
 import httpx
 import pytest
 import uvicorn
-
-from service.app import create_app
-from service.runtime import CurveRuntime
-from service.settings import Settings
+from curve_vae.service.app import create_app
+from curve_vae.service.runtime import CurveRuntime
+from curve_vae.service.settings import Settings
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 

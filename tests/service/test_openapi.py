@@ -7,15 +7,16 @@ import sys
 from pathlib import Path
 
 import yaml
-
-from service.openapi import ROOT_FILE, openapi_spec, render
+from curve_vae.service.openapi import ROOT_FILE, openapi_spec, render
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_openapi_yaml_is_in_sync_with_the_app():
-    assert ROOT_FILE.is_file(), "openapi.yaml is missing: run python -m service.openapi"
-    assert ROOT_FILE.read_text() == render(), "openapi.yaml drifted from the app: run python -m service.openapi"
+    assert ROOT_FILE.is_file(), "openapi.yaml is missing: run python -m curve_vae.service.openapi"
+    assert ROOT_FILE.read_text() == render(), (
+        "openapi.yaml drifted from the app: run python -m curve_vae.service.openapi"
+    )
 
 
 def test_every_status_is_documented_with_an_example():
@@ -59,9 +60,9 @@ def test_the_service_runs_without_torch(model_dir):
 import sys
 sys.modules["torch"] = None  # any `import torch` now raises ImportError
 from fastapi.testclient import TestClient
-from service.app import create_app
-from service.settings import Settings
-import service.cli, service.openapi
+from curve_vae.service.app import create_app
+from curve_vae.service.settings import Settings
+import curve_vae.service.cli, curve_vae.service.openapi
 with TestClient(create_app(Settings(model_dir={str(model_dir)!r}, providers="cpu"))) as client:
     r = client.post("/reconstruct", json={{"curves": [[[0, 0], [1, 2], [2, 3], [3, 3], [4, 1]]]}})
     assert r.status_code == 200, r.text
@@ -73,7 +74,10 @@ print("ok")
 
 
 def test_importing_the_app_loads_no_torch():
-    code = "import sys, service.app, service.cli, service.runtime; assert 'torch' not in sys.modules; print('ok')"
+    code = (
+        "import sys, curve_vae.service.app, curve_vae.service.cli, curve_vae.service.runtime; "
+        "assert 'torch' not in sys.modules; print('ok')"
+    )
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
 
@@ -104,13 +108,12 @@ def test_steps_and_weights_exclude_each_other_even_as_null(client):
 
 def test_the_live_schema_takes_the_latent_length_of_the_loaded_model(tmp_path):
     import torch
+    from curve_vae.service.app import create_app
+    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.service.settings import Settings
+    from curve_vae.training.export import export
+    from curve_vae.training.model import VAE, ModelConfig
     from fastapi.testclient import TestClient
-
-    from service.app import create_app
-    from service.runtime import CurveRuntime
-    from service.settings import Settings
-    from training.export import export
-    from training.model import VAE, ModelConfig
 
     torch.manual_seed(0)
     export(VAE(ModelConfig(latent_dim=8)).eval(), tmp_path, model_size=100.0, weights=False)

@@ -2,8 +2,7 @@
 
 import numpy as np
 import pytest
-
-from geometry import sample_bspline
+from curve_vae.geometry import sample_bspline
 
 
 def _rot(a: float) -> np.ndarray:
@@ -56,6 +55,6 @@ def test_spline_output_matches_the_points_in_a_reversed_pose(shipped_runtime):
     splines = []
     (pts,), _ = shipped_runtime.reconstruct([c], splines=splines)
     s = splines[0]
-    from geometry import evaluate_bspline
+    from curve_vae.geometry import evaluate_bspline
 
     np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params, s.degree), pts, atol=1e-9)

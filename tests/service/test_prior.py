@@ -8,10 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from service.prior import PRIOR_FILE, LatentPrior
-from service.runtime import CurveRuntime, ModelLoadError
-from training.evaluate import nearest_distances, sample_quality
+from curve_vae.service.prior import PRIOR_FILE, LatentPrior
+from curve_vae.service.runtime import CurveRuntime, ModelLoadError
+from curve_vae.training.evaluate import nearest_distances, sample_quality
 
 
 def test_prior_round_trips_and_checks_its_shapes(tmp_path):
@@ -113,7 +112,7 @@ def test_sample_quality_on_known_inputs(curves):
 
 
 def test_evaluate_reports_generation(model_dir, runtime, curves, tmp_path: Path):
-    from training.evaluate import generation_report
+    from curve_vae.training.evaluate import generation_report
 
     report = generation_report(runtime, curves(40, seed=1), curves(40, seed=2), seed=3)
     assert report["n_samples"] == 40 and set(report) >= {"learned", "standard"}

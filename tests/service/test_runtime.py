@@ -9,9 +9,15 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 import pytest
-
-from geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve
-from service.runtime import CurveRuntime, InputError, ModelLoadError, resolve_providers, simplex_grid, simplex_grid_size
+from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve
+from curve_vae.service.runtime import (
+    CurveRuntime,
+    InputError,
+    ModelLoadError,
+    resolve_providers,
+    simplex_grid,
+    simplex_grid_size,
+)
 
 # ----------------------------------------------------------------------------- loading
 
@@ -176,7 +182,7 @@ def test_mse_is_measured_at_the_inputs_own_points(runtime, curves):
 
 
 def _relative_errors(rt: CurveRuntime, ctrl: np.ndarray, n_points: int, spacing: str = "parameter") -> np.ndarray:
-    from geometry import sample_bspline
+    from curve_vae.geometry import sample_bspline
 
     c = sample_bspline(ctrl, n_points)
     out, mse = rt.reconstruct(list(c), spacing=spacing)
@@ -185,7 +191,7 @@ def _relative_errors(rt: CurveRuntime, ctrl: np.ndarray, n_points: int, spacing:
 
 
 def _check_length_independence(rt: CurveRuntime, factor: float, spacing: str = "parameter") -> dict[int, float]:
-    from geometry import random_control_points
+    from curve_vae.geometry import random_control_points
 
     ctrl = random_control_points(np.random.default_rng(11), 24)
     err = {n: float(np.median(_relative_errors(rt, ctrl, n, spacing))) for n in (50, 161, 500)}
@@ -202,9 +208,11 @@ def test_other_lengths_reconstruct_about_as_well(runtime, spacing):
 
 def test_neighbouring_lengths_give_the_same_curve(runtime, curves):
     """160, 161 and 162 samples of a curve are the same curve to the model: no jump at its own length."""
-    from geometry import sample_bspline
+    from curve_vae.geometry import sample_bspline
 
-    ctrl = __import__("geometry").random_control_points(np.random.default_rng(3), 1)[0]
+    ctrl = __import__("curve_vae.geometry", fromlist=["random_control_points"]).random_control_points(
+        np.random.default_rng(3), 1
+    )[0]
     out = {n: runtime.reconstruct([sample_bspline(ctrl, n)], n_points=161)[0][0] for n in (160, 161, 162)}
     size = fit_frame(out[161]).size
     assert np.abs(out[160] - out[161]).max() < 0.02 * size
@@ -308,7 +316,7 @@ def test_missing_or_truncated_model_files_stop_the_server_naming_the_file(model_
     with pytest.raises(ModelLoadError, match=message):
         CurveRuntime.load(copy, providers="cpu")
     serve = subprocess.run(
-        [sys.executable, "-m", "service.cli", "--model-dir", str(copy), "--port", "0"],
+        [sys.executable, "-m", "curve_vae.service.cli", "--model-dir", str(copy), "--port", "0"],
         capture_output=True,
         text=True,
         timeout=60,

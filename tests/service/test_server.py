@@ -136,7 +136,7 @@ def test_a_model_that_fails_at_startup_stops_the_server(server_factory, model_di
 def _serve(*args: str) -> subprocess.CompletedProcess[str]:
     import sys
 
-    cmd = [sys.executable, "-m", "service.cli", *args]
+    cmd = [sys.executable, "-m", "curve_vae.service.cli", *args]
     return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=60)
 
 
@@ -150,7 +150,7 @@ def test_cuda_where_unavailable_is_a_clear_startup_error(model_dir):
 def test_configuration_errors(tmp_path, model_dir, capsys):
     import argparse
 
-    from service.cli import configure_parser, run
+    from curve_vae.service.cli import configure_parser, run
 
     parser = argparse.ArgumentParser()
     configure_parser(parser)
@@ -170,7 +170,7 @@ def test_help_names_defaults_and_variables():
 def test_flags_override_the_environment(monkeypatch):
     import argparse
 
-    from service.cli import configure_parser, settings_from_args
+    from curve_vae.service.cli import configure_parser, settings_from_args
 
     monkeypatch.setenv("CURVE_VAE_PORT", "9001")
     monkeypatch.setenv("CURVE_VAE_WORKERS", "3")

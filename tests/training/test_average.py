@@ -3,11 +3,10 @@
 import numpy as np
 import pytest
 import torch
+from curve_vae.training.average import average_state_dicts, recompute_batchnorm
+from curve_vae.training.config import ModelConfig
+from curve_vae.training.model import VAE
 from torch import nn
-
-from training.average import average_state_dicts, recompute_batchnorm
-from training.config import ModelConfig
-from training.model import VAE
 
 
 def _vae(seed):

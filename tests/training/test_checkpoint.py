@@ -2,8 +2,7 @@
 
 import pytest
 import torch
-
-from training.checkpoint import (
+from curve_vae.training.checkpoint import (
     CHECKPOINT_VERSION,
     WEIGHTS_FORMAT,
     load_checkpoint,
@@ -12,8 +11,8 @@ from training.checkpoint import (
     save_weights,
     without_resume_state,
 )
-from training.config import ModelConfig
-from training.model import VAE
+from curve_vae.training.config import ModelConfig
+from curve_vae.training.model import VAE
 
 
 @pytest.fixture(scope="module")

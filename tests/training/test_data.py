@@ -2,9 +2,8 @@
 
 import numpy as np
 import pytest
-
-from geometry import self_intersects
-from training.data import CurveDataset, DataConfig, default_cache, generate_curves, load_or_generate
+from curve_vae.geometry import self_intersects
+from curve_vae.training.data import CurveDataset, DataConfig, default_cache, generate_curves, load_or_generate
 
 SMALL = DataConfig(n_train=300, n_val=50, n_test=40, seed=11)
 
@@ -35,7 +34,7 @@ def test_no_self_intersections(small):
 
 def test_rejection_actually_happens():
     # Without the filter some curves do intersect; the generator must have dropped them.
-    from geometry import random_control_points, sample_bspline
+    from curve_vae.geometry import random_control_points, sample_bspline
 
     raw = sample_bspline(random_control_points(np.random.default_rng(0), 20_000))
     assert self_intersects(raw).any()
@@ -78,7 +77,7 @@ def test_cache_round_trip_and_mismatch(tmp_path, small):
 
 
 def test_broad_mix_is_versioned_and_its_test_split_is_the_papers(tmp_path):
-    from training.families import MIX_VERSION
+    from curve_vae.training.families import MIX_VERSION
 
     cfg = DataConfig(n_train=300, n_val=20, n_test=10, mix="broad")
     assert cfg.mix_version == MIX_VERSION and DataConfig().mix_version == 0
@@ -103,7 +102,7 @@ def test_broad_mix_is_versioned_and_its_test_split_is_the_papers(tmp_path):
 
 
 def test_the_test_split_of_a_broad_mix_is_read_without_drawing_its_training_curves(tmp_path):
-    from training.data import load_test_split
+    from curve_vae.training.data import load_test_split
 
     cfg = DataConfig(n_train=10_000_000, n_val=20, n_test=10, mix="broad")  # far too many to draw in this test
     np.testing.assert_array_equal(load_test_split(cfg, tmp_path / "never.npz"), generate_curves(70_030, 0)[0][-10:])

@@ -10,10 +10,10 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 import torch
+from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
+from curve_vae.training.export import sha256
 
 from curve_vae.cli import main
-from training.checkpoint import load_checkpoint, model_from_checkpoint
-from training.export import sha256
 
 pytestmark = pytest.mark.slow
 
@@ -260,8 +260,8 @@ def test_snapshots_keep_the_latest_epochs(trained, capsys):
 
 def test_export_with_spline_head(trained):
     """--spline-ctrl puts the B-spline head into decoder.onnx: control points out, curves = basis @ control points."""
-    from geometry import spline_head
-    from service.runtime import CurveRuntime
+    from curve_vae.geometry import spline_head
+    from curve_vae.service.runtime import CurveRuntime
 
     tmp, data, cut, _, _ = trained
     out = tmp / "models_spline"
@@ -287,7 +287,7 @@ def test_export_with_spline_head(trained):
     assert runtime.has_splines
     splines: list = []
     points = runtime.decode(z, n_points=40, spacing="arc_length", splines=splines)
-    from geometry import evaluate_bspline
+    from curve_vae.geometry import evaluate_bspline
 
     for p, s in zip(points, splines):
         assert len(s.params) == 40 and s.control_points.shape == (10, 2)

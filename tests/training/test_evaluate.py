@@ -1,8 +1,7 @@
 """The evaluation report's numbers on inputs whose answer is known."""
 
 import numpy as np
-
-from training.evaluate import evaluate_set
+from curve_vae.training.evaluate import evaluate_set
 
 
 def _curves(n: int = 4, points: int = 161) -> np.ndarray:

@@ -3,9 +3,8 @@
 import warnings
 
 import torch
-
-from training.export import export
-from training.model import VAE, ModelConfig
+from curve_vae.training.export import export
+from curve_vae.training.model import VAE, ModelConfig
 
 
 def test_export_of_a_model_left_in_training_mode_is_quiet_and_exports_eval_graphs(tmp_path, capfd):

@@ -4,11 +4,10 @@ import json
 
 import numpy as np
 import pytest
-
-from geometry import fit_frame, self_intersects, signed_turning, turning_angles
-from geometry.frame import MODEL_CENTER, chord_heading
-from training import families as F
-from training.suite import format_suite, relative_rmse, run_suite, suite_sets
+from curve_vae.geometry import fit_frame, self_intersects, signed_turning, turning_angles
+from curve_vae.geometry.frame import MODEL_CENTER, chord_heading
+from curve_vae.training import families as F
+from curve_vae.training.suite import format_suite, relative_rmse, run_suite, suite_sets
 
 
 @pytest.mark.parametrize("name", [*F.TRAIN_FAMILIES, *F.HELD_OUT])

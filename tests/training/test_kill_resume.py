@@ -10,8 +10,7 @@ import sys
 import time
 
 import pytest
-
-from training.checkpoint import load_checkpoint
+from curve_vae.training.checkpoint import load_checkpoint
 
 pytestmark = pytest.mark.slow
 

@@ -4,8 +4,7 @@ import math
 
 import pytest
 import torch
-
-from training.losses import kl_divergence, laplacian, vae_loss
+from curve_vae.training.losses import kl_divergence, laplacian, vae_loss
 
 
 def test_laplacian_of_a_parabola_is_constant_including_ends():

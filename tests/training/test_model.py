@@ -2,9 +2,8 @@
 
 import pytest
 import torch
-
-from training.config import VARIANTS, ModelConfig
-from training.model import VAE, count_parameters
+from curve_vae.training.config import VARIANTS, ModelConfig
+from curve_vae.training.model import VAE, count_parameters
 
 
 @pytest.mark.parametrize("variant", [*VARIANTS, "cnn6"])

@@ -1,0 +1,144 @@
+"""The wheel serves: built from this tree, installed (not editable) in a fresh virtualenv, run from elsewhere.
+
+The fresh environment gets the wheel alone; its dependencies are the test environment's, reached through a
+.pth path entry (which does not run the editable install's own finder, so this checkout cannot stand in for
+the wheel). The server is started from a folder outside the checkout and must find the shipped model inside
+the package.
+"""
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import sysconfig
+import time
+import urllib.request
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("wheel")
+    build = tmp_path_factory.mktemp("build")  # setuptools' build/ folder, kept out of the checkout
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(out), str(ROOT)],
+        check=True,
+        cwd=build,
+        env={**os.environ, "PIP_NO_INPUT": "1"},
+        capture_output=True,
+    )
+    (whl,) = out.glob("curve_vae-*.whl")
+    return whl
+
+
+@pytest.fixture(scope="module")
+def venv(wheel, tmp_path_factory) -> Path:
+    env = tmp_path_factory.mktemp("venv")
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(env)], check=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "--python",
+            str(env / "bin" / "python"),
+            "install",
+            "-q",
+            "--no-deps",
+            str(wheel),
+        ],
+        check=True,
+        capture_output=True,
+    )
+    site = Path(
+        subprocess.run(
+            [str(env / "bin" / "python"), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+            check=True,
+            capture_output=True,
+            text=True,
+        ).stdout.strip()
+    )
+    (site / "zz_test_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    return env
+
+
+def test_the_wheel_holds_one_namespace_and_the_shipped_model(wheel):
+    names = zipfile.ZipFile(wheel).namelist()
+    tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
+    assert tops == {"curve_vae"}
+    for f in ("manifest.json", "encoder.onnx", "decoder.onnx", "prior.npz"):
+        assert f"curve_vae/models/{f}" in names and f"curve_vae/models/paper/{f}" in names
+    assert "curve_vae/service/static/index.html" in names
+    assert not [n for n in names if n.endswith(".pt")]  # torch weights are for training from a checkout
+
+
+def test_the_installed_command_tells_one_version(venv, tmp_path):
+    from curve_vae import __version__
+
+    out = subprocess.run(
+        [str(venv / "bin" / "curve-vae"), "--version"], capture_output=True, text=True, cwd=tmp_path, check=True
+    )
+    assert out.stdout.strip() == f"curve-vae {__version__}"
+    assert __version__ != "0.0.0"
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_the_installed_wheel_serves_its_shipped_model_from_anywhere(venv, tmp_path):
+    from curve_vae import __version__
+
+    port = _free_port()
+    env = {k: v for k, v in os.environ.items() if not k.startswith("CURVE_VAE_")}
+    proc = subprocess.Popen(
+        [str(venv / "bin" / "curve-vae"), "serve", "--port", str(port), "--log-level", "warning"],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    url = f"http://127.0.0.1:{port}"
+    try:
+        for _ in range(300):
+            try:
+                with urllib.request.urlopen(url + "/ready", timeout=1) as r:
+                    if r.status == 200:
+                        break
+            except OSError:
+                if proc.poll() is not None:
+                    pytest.fail(f"curve-vae serve exited: {proc.stdout.read()}")
+                time.sleep(0.2)
+        else:
+            pytest.fail("the installed service never became ready")
+        with urllib.request.urlopen(url + "/model") as r:
+            model = json.load(r)
+        shipped = json.loads((ROOT / "models" / "manifest.json").read_text())
+        assert model["version"] == shipped["version"]  # the model's own version …
+        assert model["service_version"] == __version__  # … beside the package's
+        for graph in ("encoder.onnx", "decoder.onnx", "prior.npz"):  # checked against the files at load
+            assert model["files"][graph]["sha256"] == shipped["files"][graph]["sha256"]
+        with urllib.request.urlopen(url + "/openapi.json") as r:
+            assert json.load(r)["info"]["version"] == __version__
+        curve = [[float(x), float(x) ** 0.5 * 8] for x in range(0, 100, 5)]
+        req = urllib.request.Request(
+            url + "/reconstruct",
+            data=json.dumps({"curves": [curve]}).encode(),
+            headers={"Content-Type": "application/json"},
+        )
+        with urllib.request.urlopen(req) as r:
+            answer = json.load(r)
+        assert len(answer["curves"][0]) == len(curve)
+    finally:
+        proc.terminate()
+        proc.wait(timeout=30)
