@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 import onnxruntime as ort
+
 from curve_vae.geometry import random_control_points, sample_bspline
 
 
@@ -101,6 +102,7 @@ def torch_eager(model_dir: Path, *, threads: int, batch: int, seconds: float = 5
     """Curves/s of torch eager (no_grad, eval) on vae.pt with `threads` threads; None without torch or vae.pt."""
     try:
         import torch
+
         from curve_vae.training.model import VAE, ModelConfig
     except ImportError:
         return None
@@ -131,6 +133,7 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
     the raw encoder + decoder run, `CurveRuntime.reconstruct` (pose "as_is": frames, resampling, B-spline
     back), and for 128 curves also parsing and validating the JSON body and rendering the answer."""
     import orjson
+
     from curve_vae.service.deps import check_curves
     from curve_vae.service.fastjson import JSON
     from curve_vae.service.runtime import CurveRuntime

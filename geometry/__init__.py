@@ -35,6 +35,7 @@ from curve_vae.geometry.metrics import (
     smoothness,
     turning_angles,
 )
+from curve_vae.geometry.mixing import simplex_grid, simplex_grid_size
 
 __all__ = [
     "arc_length_params",
@@ -58,6 +59,8 @@ __all__ = [
     "revolve",
     "sample_bspline",
     "self_intersects",
+    "simplex_grid",
+    "simplex_grid_size",
     "signed_turning",
     "smoothness",
     "spline_head",

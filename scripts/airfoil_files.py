@@ -12,9 +12,9 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-from curve_vae.training.airfoils import airfoil_texts
 
 from curve_vae.files import parse_dat
+from curve_vae.training.airfoils import airfoil_texts
 
 
 def main() -> None:

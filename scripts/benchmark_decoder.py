@@ -14,6 +14,7 @@ import argparse
 import time
 
 import torch
+
 from curve_vae.training.model import VAE, ModelConfig
 
 

@@ -16,6 +16,7 @@ import platform
 import time
 
 import torch
+
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.losses import vae_loss
 from curve_vae.training.model import VAE

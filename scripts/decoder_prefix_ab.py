@@ -17,9 +17,8 @@ import argparse
 import json
 from pathlib import Path
 
-from curve_vae.training.model import Decoder
-
 from curve_vae.cli import main as cli
+from curve_vae.training.model import Decoder
 
 
 def run(mode: str, a: argparse.Namespace) -> list[dict]:

@@ -48,11 +48,10 @@ def fresh_mse(run: Path, seed: int) -> float:
     """Test MSE of a run's best weights on 1,000 curves of a seed never used in training."""
     cache = run / f"fresh_seed_{seed}.json"
     if not cache.exists():
+        from curve_vae.files import atomic_write_text
         from curve_vae.geometry import mse_per_curve
         from curve_vae.training.data import DataConfig, generate_curves
         from curve_vae.training.evaluate import batched, torch_codec
-
-        from curve_vae.files import atomic_write_text
 
         cfg = DataConfig()
         curves, _ = generate_curves(1000, seed, n_ctrl=cfg.n_ctrl, n_points=cfg.n_points)

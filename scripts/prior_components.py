@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+
 from curve_vae.service.model_files import file_sha256
 from curve_vae.service.prior import PRIOR_FILE
 from curve_vae.service.runtime import CurveRuntime

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 import onnxruntime as ort
 import torch
+
 from curve_vae.geometry import smoothness, spline_head
 from curve_vae.service.runtime import CurveRuntime
 from curve_vae.training.airfoils import load_airfoils

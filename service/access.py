@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import hmac
 
-from curve_vae.service.errors import error_response
 from starlette.types import ASGIApp, Receive, Scope, Send
+
+from curve_vae.service.errors import error_response
 
 #: Paths served without a key: probes must work for orchestrators, and the page must load to ask for the key.
 OPEN_PATHS = frozenset(

@@ -29,6 +29,11 @@ from functools import partial
 from typing import Any
 
 import anyio
+from fastapi import FastAPI
+from fastapi.exceptions import RequestValidationError
+from fastapi.middleware.cors import CORSMiddleware
+from starlette.exceptions import HTTPException
+
 from curve_vae.service.access import ApiKeyMiddleware
 from curve_vae.service.batching import GraphBatcher
 from curve_vae.service.batching import attach as attach_batcher
@@ -49,10 +54,6 @@ from curve_vae.service.runtime import (
 )
 from curve_vae.service.settings import Settings, get_settings
 from curve_vae.service.web import mount_web
-from fastapi import FastAPI
-from fastapi.exceptions import RequestValidationError
-from fastapi.middleware.cors import CORSMiddleware
-from starlette.exceptions import HTTPException
 
 log = logging.getLogger("service")
 

@@ -14,8 +14,9 @@ import os
 import sys
 from typing import Any
 
-from curve_vae.service.settings import Settings
 from pydantic import ValidationError
+
+from curve_vae.service.settings import Settings
 
 # (flag, settings field, type, help); the default and variable are appended from Settings.
 _OPTIONS: list[tuple[str, str, Any, str]] = [
@@ -116,6 +117,7 @@ def _graceful_server_class() -> type:
 def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
+
     from curve_vae.service.model_files import ModelLoadError, read_manifest, resolve_providers
 
     try:

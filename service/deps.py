@@ -11,19 +11,19 @@ from typing import Annotated, Any, TypeVar
 
 import anyio
 import numpy as np
+from fastapi import Depends, Request
+from fastapi.responses import Response
+from starlette.exceptions import HTTPException
+
+from curve_vae.geometry import simplex_grid, simplex_grid_size
 from curve_vae.service import schemas as s
 from curve_vae.service.metrics import Metrics
 from curve_vae.service.runtime import (
     CurveRuntime,
     InputError,
     Spline,
-    simplex_grid,
-    simplex_grid_size,
 )
 from curve_vae.service.settings import Settings
-from fastapi import Depends, Request
-from fastapi.responses import Response
-from starlette.exceptions import HTTPException
 
 T = TypeVar("T")
 

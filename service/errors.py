@@ -9,14 +9,15 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from curve_vae.service.runtime import (
-    InputError,
-    format_loc,
-)
 from fastapi import Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from starlette.exceptions import HTTPException
+
+from curve_vae.service.runtime import (
+    InputError,
+    format_loc,
+)
 
 MAX_ERRORS_SHOWN = 20
 

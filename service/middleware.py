@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from curve_vae.service.errors import error_response
 from fastapi.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from curve_vae.service.errors import error_response
 
 #: How much of an oversized body is read and thrown away before the 413 goes out, as a multiple of the limit (and
 #: at least DRAIN_MIN bytes). Clients that send the whole body before reading the answer (Python's urllib, most

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import onnxruntime as ort
+
 from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.service.prior import PRIOR_FILE
 

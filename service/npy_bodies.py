@@ -17,12 +17,13 @@ from typing import Any
 
 import numpy as np
 import orjson
-from curve_vae.service.runtime import InputError
-from curve_vae.service.settings import Settings
 from fastapi import Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
 from pydantic import BaseModel, ValidationError
+
+from curve_vae.service.runtime import InputError
+from curve_vae.service.settings import Settings
 
 MEDIA_TYPE = "application/x-npy"
 MAGIC = b"\x93NUMPY"

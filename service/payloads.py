@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+
 from curve_vae.geometry import Frame, fit_bspline, fit_bspline_auto
 from curve_vae.service.runtime import InputError, Sampled, Spline, curve_metrics
 

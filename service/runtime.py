@@ -17,10 +17,9 @@ the same model input. "arc_length" resamples evenly by arc length instead, for p
 spaced arbitrarily (hand-drawn strokes). Nothing here imports torch. Reading and checking model
 files is `service.model_files`; the learned latent distribution is `service.prior`.
 
-Length (~890 lines): one class whose methods share the sessions, the frame/length adaptation and the
-choice of pose (which needs both graphs);
-issue 20 moves that adaptation into `geometry/` and the mixing weights and augment plans out,
-which is where this module should shrink next.
+Length (~860 lines): one class whose methods share the sessions, the frame/length adaptation and the
+choice of pose (which needs both graphs). The mixing weights are geometry's (`geometry/mixing.py`); the
+frame/length adaptation and the augment plans are where this module should shrink next.
 """
 
 from __future__ import annotations
@@ -34,6 +33,7 @@ from typing import Any, Literal
 
 import numpy as np
 import onnxruntime as ort
+
 from curve_vae.geometry import (
     Frame,
     arc_fractions,
@@ -51,6 +51,7 @@ from curve_vae.geometry import (
     self_intersects,
     smoothness,
 )
+from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.service import batching
 from curve_vae.service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
 from curve_vae.service.prior import PRIOR_FILE, LatentPrior
@@ -99,32 +100,6 @@ def format_loc(loc: Sequence[str | int]) -> str:
     for part in loc:
         out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
     return out or "body"
-
-
-# --------------------------------------------------------------------------- interpolation weights
-
-
-def simplex_grid(n_curves: int, steps: int) -> np.ndarray:
-    """Evenly spaced affine weights, one column per curve: all (i_1, …, i_n)/(steps-1) summing to 1.
-
-    Two curves give the even sweep of paper eq. 9 from [1, 0] to [0, 1] (steps rows); three
-    give the barycentric grid of eq. 10 (steps·(steps+1)/2 rows). First row: all weight on
-    the first curve; last row: all on the last.
-    """
-    if n_curves < 2 or steps < 2:
-        raise ValueError(f"need ≥ 2 curves and ≥ 2 steps, got {n_curves} and {steps}")
-
-    def compositions(total: int, parts: int) -> list[list[int]]:
-        if parts == 1:
-            return [[total]]
-        return [[i, *rest] for i in range(total, -1, -1) for rest in compositions(total - i, parts - 1)]
-
-    return np.array(compositions(steps - 1, n_curves), dtype=np.float64) / (steps - 1)
-
-
-def simplex_grid_size(n_curves: int, steps: int) -> int:
-    """Rows of `simplex_grid(n_curves, steps)`, without building it."""
-    return math.comb(steps - 1 + n_curves - 1, n_curves - 1)
 
 
 # --------------------------------------------------------------------------- curves in and out
@@ -197,7 +172,7 @@ class CurveRuntime:
         self.knots = clamped_uniform_knots(int(spline["n_ctrl"]), self.spline_degree) if spline else None
         # Where the data lives in the model plane (paper §3.1: a radius-64 disc in the 128×128 plane): the region a
         # valid sample must stay in.
-        self.disc_center = np.asarray(manifest["frame"].get("center", [64.0, 64.0]), np.float64)
+        self.disc_center = np.asarray(manifest["frame"].get("center", list(MODEL_CENTER)), np.float64)
         self.disc_radius = float(manifest.get("training", {}).get("data", {}).get("radius", 64.0))
         self._enc_in = encoder.get_inputs()[0].name
         self._dec_in = decoder.get_inputs()[0].name

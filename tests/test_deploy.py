@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+
 from curve_vae.service.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -86,8 +87,9 @@ def env_of(stage: Stage) -> dict[str, str]:
 
 def app_routes() -> dict[str, set[str]]:
     """Path → methods of the app's route table (routers included as they are: FastAPI ≥ 0.16x nests them)."""
-    from curve_vae.service.app import create_app
     from fastapi.testclient import TestClient
+
+    from curve_vae.service.app import create_app
 
     app = create_app(Settings.model_construct())
     out: dict[str, set[str]] = {}

@@ -15,11 +15,12 @@ from typing import Any
 
 import numpy as np
 import torch
+from torch import nn
+
 from curve_vae.training.checkpoint import CHECKPOINT_VERSION, load_checkpoint
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.model import VAE
 from curve_vae.training.train import validation_mse
-from torch import nn
 
 __all__ = ["average_state_dicts", "recompute_batchnorm", "average_checkpoints"]
 

@@ -21,10 +21,10 @@ from pathlib import Path
 from typing import Any
 
 import torch
-from curve_vae.training.config import ModelConfig
-from curve_vae.training.model import VAE
 
 from curve_vae.files import atomic_path
+from curve_vae.training.config import ModelConfig
+from curve_vae.training.model import VAE
 
 CHECKPOINT_VERSION = 1
 WEIGHTS_FORMAT = "curve-vae weights"

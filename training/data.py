@@ -8,9 +8,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
 
 from curve_vae.files import atomic_path
+from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
 
 FORMAT_VERSION = 1
 MIXES = ("paper", "broad", "files")

@@ -15,9 +15,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from curve_vae.geometry import mse_per_curve, self_intersects, smoothness
 
 from curve_vae.files import atomic_write_text
+from curve_vae.geometry import mse_per_curve, self_intersects, simplex_grid, smoothness
 
 Reconstructor = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, N, 2), decoding the mean
 Encoder = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, Z) latent means
@@ -45,6 +45,7 @@ def onnx_codec(model_dir: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]
 def torch_codec(checkpoint: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]:
     """Encoder/decoder callables over a torch checkpoint (last.pt, best.pt or vae.pt)."""
     import torch
+
     from curve_vae.training.checkpoint import model_from_checkpoint
 
     model = model_from_checkpoint(checkpoint)
@@ -96,12 +97,11 @@ def interpolation_report(
     rng = np.random.default_rng(seed)
     idx = rng.choice(len(curves), size=(pairs, 2), replace=True)
     idx = idx[idx[:, 0] != idx[:, 1]]
-    w = np.linspace(0, 1, steps)[1:-1]  # the interior steps: the new curves
+    w = simplex_grid(2, steps)[1:-1]  # (S, 2): eq. 9's interior steps, the new curves (as /interpolate mixes)
     mu = encode(curves[idx.reshape(-1)]).reshape(len(idx), 2, -1)
-    z = w[None, :, None] * mu[:, None, 0] + (1 - w[None, :, None]) * mu[:, None, 1]  # (P, S, Z)
+    z = np.einsum("sk,pkz->psz", w, mu)
     latent = decode(z.reshape(-1, z.shape[-1])).reshape(len(idx), len(w), *curves.shape[1:])
-    a, b = curves[idx[:, 0]], curves[idx[:, 1]]
-    pointwise = w[None, :, None, None] * a[:, None] + (1 - w[None, :, None, None]) * b[:, None]
+    pointwise = np.einsum("sk,pknd->psnd", w, curves[idx])
     out: dict[str, Any] = {"pairs": len(idx), "steps": steps}
     for name, c in (("latent", latent), ("pointwise", pointwise)):
         flat = c.reshape(-1, *curves.shape[1:])

@@ -21,14 +21,14 @@ from typing import Any
 
 import numpy as np
 import torch
+from torch import nn
+
+from curve_vae.files import atomic_path, atomic_write_text
 from curve_vae.geometry import clamped_uniform_knots
 from curve_vae.service.model_files import file_sha256
 from curve_vae.service.prior import PRIOR_FILE, LatentPrior
 from curve_vae.training.checkpoint import save_weights
 from curve_vae.training.model import VAE, ModelConfig
-from torch import nn
-
-from curve_vae.files import atomic_path, atomic_write_text
 
 MANIFEST_VERSION = 1
 OPSET = 18

@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+
 from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
 from curve_vae.geometry.frame import chord_heading, posed_frame, signed_turning
 
@@ -238,9 +239,8 @@ def own_curves(
     SPACINGS ("parameter" keeps the file's own spacing, as the service takes posted points by default), so a
     few hundred curves make a data set of any size. Validation and test curves keep their own spacing.
     """
-    from curve_vae.geometry import resample
-
     from curve_vae.files import read_curve_files
+    from curve_vae.geometry import resample
 
     curves = read_curve_files(source)
     if len(curves) < 3:

@@ -10,10 +10,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from curve_vae.geometry import mse_per_curve, self_intersects, smoothness
-from curve_vae.training.evaluate import Decoder, Encoder, batched
 
 from curve_vae.files import atomic_path
+from curve_vae.geometry import mse_per_curve, self_intersects, smoothness
+from curve_vae.training.evaluate import Decoder, Encoder, batched
 
 
 def plot_samples(samples: np.ndarray, data: np.ndarray, path: Path, *, n: int = 16) -> None:

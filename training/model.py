@@ -8,9 +8,10 @@ take and return plain pixel coordinates and carry their own normalisation.
 from __future__ import annotations
 
 import torch
+from torch import nn
+
 from curve_vae.geometry import spline_head
 from curve_vae.training.config import CONV_VARIANTS, VARIANTS, ModelConfig
-from torch import nn
 
 __all__ = ["VAE", "Encoder", "Decoder", "Inception", "ModelConfig", "VARIANTS", "count_parameters"]
 

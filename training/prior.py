@@ -8,6 +8,7 @@ own (1.00×), in a 4-second fit; 32 gain little more (scripts/prior_components.p
 from __future__ import annotations
 
 import numpy as np
+
 from curve_vae.service.prior import LatentPrior
 
 COMPONENTS = 8  # measured: 1 → 25% self-intersecting samples, 8 → 13.8%, 32 → 11.6%

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
 from curve_vae.geometry import resample, self_intersects, smoothness
 from curve_vae.training.families import HELD_OUT, TRAIN_FAMILIES, draw_family
 

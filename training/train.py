@@ -21,6 +21,9 @@ from typing import Any
 import numpy as np
 import torch
 import torch.distributed as dist
+from torch import nn
+from tqdm import tqdm
+
 from curve_vae.geometry import mse_per_curve
 from curve_vae.training.checkpoint import (
     CHECKPOINT_VERSION,
@@ -33,8 +36,6 @@ from curve_vae.training.config import SCHEDULES, ModelConfig, TrainConfig
 from curve_vae.training.data import DataConfig, load_or_generate
 from curve_vae.training.losses import vae_loss
 from curve_vae.training.model import VAE
-from torch import nn
-from tqdm import tqdm
 
 __all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch"]
 

@@ -11,6 +11,9 @@ from collections.abc import AsyncIterator, Callable
 from typing import Annotated, Any
 
 import numpy as np
+from fastapi import APIRouter, Body, Request
+from fastapi.responses import Response, StreamingResponse
+
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, C3, POST_ERRORS, curl_sample, example
 from curve_vae.service.deps import (
@@ -38,8 +41,6 @@ from curve_vae.service.runtime import (
     InputError,
     fresh_seed,
 )
-from fastapi import APIRouter, Body, Request
-from fastapi.responses import Response, StreamingResponse
 
 ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'
 curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])

@@ -5,6 +5,9 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
+from fastapi import APIRouter, Body, Request
+from fastapi.responses import Response
+
 from curve_vae.geometry import revolve
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example
@@ -19,8 +22,6 @@ from curve_vae.service.payloads import fit_body
 from curve_vae.service.runtime import (
     InputError,
 )
-from fastapi import APIRouter, Body, Request
-from fastapi.responses import Response
 
 design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 

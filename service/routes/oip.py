@@ -16,15 +16,16 @@ import json
 from collections.abc import Awaitable, Callable
 from typing import Any
 
+from fastapi import APIRouter, Request
+from fastapi.responses import Response
+from pydantic import BaseModel, Field
+
 from curve_vae.service import oip
 from curve_vae.service.api_docs import ERROR_EXAMPLES, curl_sample
 from curve_vae.service.deps import run_inference, runtime_of
 from curve_vae.service.errors import oip_error
 from curve_vae.service.fastjson import JSON
 from curve_vae.service.oip import OipError
-from fastapi import APIRouter, Request
-from fastapi.responses import Response
-from pydantic import BaseModel, Field
 
 TAG = "open inference protocol"
 oip_router = APIRouter(tags=[TAG])

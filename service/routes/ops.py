@@ -5,6 +5,11 @@ from __future__ import annotations
 from typing import Any
 
 import onnxruntime as ort
+from fastapi import APIRouter, Request
+from fastapi.responses import Response
+from starlette.exceptions import HTTPException
+
+from curve_vae import __version__
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import curl_sample, error_docs
 from curve_vae.service.deps import (
@@ -13,11 +18,6 @@ from curve_vae.service.deps import (
     execution_of,
     runtime_of,
 )
-from fastapi import APIRouter, Request
-from fastapi.responses import Response
-from starlette.exceptions import HTTPException
-
-from curve_vae import __version__
 
 ops_router = APIRouter(tags=["operations"])
 

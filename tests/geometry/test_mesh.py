@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 from curve_vae.geometry import revolve
 
 

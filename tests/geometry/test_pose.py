@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 from curve_vae.geometry import Frame, blend_frames, pose_frames, random_control_points, sample_bspline, signed_turning
 from curve_vae.geometry.frame import POSE_CHORDS, chord_heading
 

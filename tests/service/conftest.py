@@ -18,11 +18,12 @@ from pathlib import Path
 import httpx
 import numpy as np
 import pytest
+from fastapi.testclient import TestClient
+
 from curve_vae.geometry import random_control_points, sample_bspline
 from curve_vae.service.app import create_app
 from curve_vae.service.runtime import CurveRuntime
 from curve_vae.service.settings import Settings
-from fastapi.testclient import TestClient
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ROOT / "models"
@@ -44,6 +45,7 @@ def _export_untrained(out: Path, *, spline_ctrl: int) -> Path:
     """With a learned prior: a mixture around the latent means of four data-set curves (tight, so its samples
     decode near those curves' reconstructions)."""
     import torch
+
     from curve_vae.service.prior import LatentPrior
     from curve_vae.training.export import export
     from curve_vae.training.model import VAE, ModelConfig

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+
 from curve_vae.service.access import accepted, key_of
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
@@ -92,9 +93,10 @@ def test_keys_come_from_the_environment(monkeypatch):
 
 
 def test_an_unexpected_failure_tells_nothing_of_the_inside(model_dir, runtime, monkeypatch):
+    from fastapi.testclient import TestClient
+
     from curve_vae.service.app import create_app
     from curve_vae.service.settings import Settings
-    from fastapi.testclient import TestClient
 
     def broken(*args, **kwargs):
         raise RuntimeError("failed in /srv/secret/models/decoder.onnx")

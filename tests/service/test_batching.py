@@ -9,8 +9,9 @@ import threading
 import httpx
 import numpy as np
 import pytest
-from curve_vae.service.batching import GraphBatcher
 from prometheus_client import CollectorRegistry
+
+from curve_vae.service.batching import GraphBatcher
 
 BATCHING = {"micro_batch": True, "micro_batch_rows": 16, "micro_batch_wait_ms": 30.0}
 

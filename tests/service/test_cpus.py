@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 
 import pytest
+
 from curve_vae.service import cpus
 from curve_vae.service.settings import Settings
 

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from fastapi.testclient import TestClient
+
 from curve_vae.geometry import clamped_uniform_knots, fit_bspline, random_control_points, sample_bspline
 from curve_vae.geometry.bspline import AUTO_CTRL
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
-from fastapi.testclient import TestClient
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 VASE = [[0, 0], [3, 0], [4, 1], [3, 3], [2.5, 5], [3, 7], [0, 7]]  # both ends on the axis x = 0

@@ -11,6 +11,7 @@ import time
 import httpx
 import pytest
 import uvicorn
+
 from curve_vae.service.app import create_app
 from curve_vae.service.runtime import CurveRuntime
 from curve_vae.service.settings import Settings

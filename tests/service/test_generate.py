@@ -6,6 +6,7 @@ import io
 
 import numpy as np
 import pytest
+
 from curve_vae.geometry import Frame, curve_length, self_intersects, smoothness
 from curve_vae.service.runtime import curve_metrics
 

@@ -8,11 +8,11 @@ import json
 import numpy as np
 import onnxruntime as ort
 import pytest
+from fastapi.testclient import TestClient
+
 from curve_vae.service import oip
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
-from fastapi.testclient import TestClient
-
 from tests.service.conftest import SHIPPED, bspline_curves
 
 DATATYPE = {"tensor(float)": "FP32"}

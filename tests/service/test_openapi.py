@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import yaml
+
 from curve_vae.service.openapi import ROOT_FILE, openapi_spec, render
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -108,12 +109,13 @@ def test_steps_and_weights_exclude_each_other_even_as_null(client):
 
 def test_the_live_schema_takes_the_latent_length_of_the_loaded_model(tmp_path):
     import torch
+    from fastapi.testclient import TestClient
+
     from curve_vae.service.app import create_app
     from curve_vae.service.runtime import CurveRuntime
     from curve_vae.service.settings import Settings
     from curve_vae.training.export import export
     from curve_vae.training.model import VAE, ModelConfig
-    from fastapi.testclient import TestClient
 
     torch.manual_seed(0)
     export(VAE(ModelConfig(latent_dim=8)).eval(), tmp_path, model_size=100.0, weights=False)

@@ -9,14 +9,13 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 import pytest
-from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve
+
+from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve, simplex_grid, simplex_grid_size
 from curve_vae.service.runtime import (
     CurveRuntime,
     InputError,
     ModelLoadError,
     resolve_providers,
-    simplex_grid,
-    simplex_grid_size,
 )
 
 # ----------------------------------------------------------------------------- loading

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from fastapi.testclient import TestClient
+
 from curve_vae.geometry import clamped_uniform_knots, evaluate_bspline
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
-from fastapi.testclient import TestClient
 
 C1 = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 C2 = [[0, 0], [1.5, 0.5], [3, 2], [4, 4], [5, 6.5], [6.5, 8], [8, 8.5]]

@@ -3,10 +3,11 @@
 import numpy as np
 import pytest
 import torch
+from torch import nn
+
 from curve_vae.training.average import average_state_dicts, recompute_batchnorm
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.model import VAE
-from torch import nn
 
 
 def _vae(seed):

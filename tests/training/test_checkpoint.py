@@ -2,6 +2,7 @@
 
 import pytest
 import torch
+
 from curve_vae.training.checkpoint import (
     CHECKPOINT_VERSION,
     WEIGHTS_FORMAT,

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 from curve_vae.geometry import self_intersects
 from curve_vae.training.data import CurveDataset, DataConfig, default_cache, generate_curves, load_or_generate
 

@@ -10,10 +10,10 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 import torch
-from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
-from curve_vae.training.export import sha256
 
 from curve_vae.cli import main
+from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
+from curve_vae.training.export import sha256
 
 pytestmark = pytest.mark.slow
 

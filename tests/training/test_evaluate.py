@@ -1,6 +1,7 @@
 """The evaluation report's numbers on inputs whose answer is known."""
 
 import numpy as np
+
 from curve_vae.training.evaluate import evaluate_set
 
 

@@ -3,6 +3,7 @@
 import warnings
 
 import torch
+
 from curve_vae.training.export import export
 from curve_vae.training.model import VAE, ModelConfig
 

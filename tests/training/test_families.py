@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+
 from curve_vae.geometry import fit_frame, self_intersects, signed_turning, turning_angles
 from curve_vae.geometry.frame import MODEL_CENTER, chord_heading
 from curve_vae.training import families as F

@@ -4,10 +4,10 @@ import json
 
 import pytest
 import torch
-from curve_vae.training.config import ModelConfig
-from curve_vae.training.model import VAE
 
 from curve_vae.cli import main
+from curve_vae.training.config import ModelConfig
+from curve_vae.training.model import VAE
 
 
 @pytest.mark.slow

@@ -10,6 +10,7 @@ import sys
 import time
 
 import pytest
+
 from curve_vae.training.checkpoint import load_checkpoint
 
 pytestmark = pytest.mark.slow

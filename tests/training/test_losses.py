@@ -4,6 +4,7 @@ import math
 
 import pytest
 import torch
+
 from curve_vae.training.losses import kl_divergence, laplacian, vae_loss
 
 

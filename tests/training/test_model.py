@@ -2,6 +2,7 @@
 
 import pytest
 import torch
+
 from curve_vae.training.config import VARIANTS, ModelConfig
 from curve_vae.training.model import VAE, count_parameters
 
