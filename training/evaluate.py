@@ -25,21 +25,17 @@ Decoder = Callable[[np.ndarray], np.ndarray]  # (B, Z) → (B, N, 2)
 
 
 def onnx_codec(model_dir: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]:
-    """Encoder/decoder callables over the ONNX graphs of an exported model, and its manifest."""
-    import onnxruntime as ort
+    """Encoder/decoder callables over the ONNX graphs of an exported model, and its manifest: loaded as the
+    service loads them (CurveRuntime: the manifest's tensor names, the graphs' sha256 checked), so what is
+    measured is what users receive."""
+    from curve_vae.service.runtime import CurveRuntime
 
-    model_dir = Path(model_dir)
-    manifest = json.loads((model_dir / "manifest.json").read_text())
-    enc = ort.InferenceSession(str(model_dir / "encoder.onnx"), providers=["CPUExecutionProvider"])
-    dec = ort.InferenceSession(str(model_dir / "decoder.onnx"), providers=["CPUExecutionProvider"])
+    return runtime_codec(CurveRuntime.load(model_dir, providers="cpu", warm_up=False))
 
-    def encode(curves: np.ndarray) -> np.ndarray:
-        return enc.run(["mean"], {"curves": np.ascontiguousarray(curves, np.float32)})[0]
 
-    def decode(z: np.ndarray) -> np.ndarray:
-        return dec.run(["curves"], {"latent": np.ascontiguousarray(z, np.float32)})[0]
-
-    return encode, decode, manifest
+def runtime_codec(runtime: Any) -> tuple[Encoder, Decoder, dict[str, Any]]:
+    """Encoder (latent means) and decoder callables in the model plane over a loaded CurveRuntime, and its manifest."""
+    return (lambda curves: runtime.encode_model(curves)[0]), runtime.decode_model, runtime.manifest
 
 
 def torch_codec(checkpoint: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]:

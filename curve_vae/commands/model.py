@@ -123,7 +123,7 @@ def cmd_export(a: argparse.Namespace) -> int:
 
 def cmd_evaluate(a: argparse.Namespace) -> int:
     from curve_vae.training.data import DataConfig, generate_curves, load_test_split
-    from curve_vae.training.evaluate import onnx_codec, run_evaluation, torch_codec
+    from curve_vae.training.evaluate import run_evaluation, runtime_codec, torch_codec
 
     runtime = None
     if a.checkpoint:
@@ -134,8 +134,8 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
     else:
         from curve_vae.service.runtime import CurveRuntime
 
-        enc, dec, meta = onnx_codec(a.model_dir)
         runtime = CurveRuntime.load(a.model_dir, providers="cpu")
+        enc, dec, meta = runtime_codec(runtime)
         data_cfg_d = meta.get("training", {}).get("data")
     data_cfg = DataConfig(**{**data_cfg_d, "center": tuple(data_cfg_d["center"])}) if data_cfg_d else DataConfig()
     sets = {"test": load_test_split(data_cfg, data_path(a, data_cfg))}
