@@ -17,12 +17,9 @@ from starlette.exceptions import HTTPException
 
 from curve_vae.geometry import simplex_grid, simplex_grid_size
 from curve_vae.service import schemas as s
+from curve_vae.service.inputs import InputError
 from curve_vae.service.metrics import Metrics
-from curve_vae.service.runtime import (
-    CurveRuntime,
-    InputError,
-    Spline,
-)
+from curve_vae.service.runtime import CurveRuntime, Spline
 from curve_vae.service.settings import Settings
 
 T = TypeVar("T")

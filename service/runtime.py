@@ -17,16 +17,17 @@ the same model input. "arc_length" resamples evenly by arc length instead, for p
 spaced arbitrarily (hand-drawn strokes). Nothing here imports torch. Reading and checking model
 files is `service.model_files`; the learned latent distribution is `service.prior`.
 
-Length (~860 lines): one class whose methods share the sessions, the frame/length adaptation and the
-choice of pose (which needs both graphs). The mixing weights are geometry's (`geometry/mixing.py`); the
-frame/length adaptation and the augment plans are where this module should shrink next.
+Length (~710 lines): one class whose methods share the sessions, the frame/length adaptation and the
+choice of pose (which needs both graphs). Augmentation is `service.augmenting` (a base class of CurveRuntime),
+the input error `service.inputs`, the mixing weights `geometry.mixing`; the frame/length adaptation is where
+this module should shrink next.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -53,6 +54,8 @@ from curve_vae.geometry import (
 )
 from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.service import batching
+from curve_vae.service.augmenting import Augmenting
+from curve_vae.service.inputs import InputError
 from curve_vae.service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
 from curve_vae.service.prior import PRIOR_FILE, LatentPrior
 from curve_vae.service.sessions import SessionConfig, SessionPool, open_pair
@@ -83,23 +86,6 @@ class Sampled:
     prior: str
     rejected: int  # draws rejected (self-intersecting or outside the disc) and drawn again
     invalid: int  # curves still not valid after max_draws (0 unless the distribution is far off)
-
-
-class InputError(ValueError):
-    """A well-formed request the model cannot process; `loc` names the field, curve and point."""
-
-    def __init__(self, loc: Sequence[str | int], msg: str) -> None:
-        super().__init__(f"{format_loc(loc)}: {msg}")
-        self.loc = tuple(loc)
-        self.msg = msg
-
-
-def format_loc(loc: Sequence[str | int]) -> str:
-    """("curves", 2, 17, 1) -> "curves[2][17][1]"."""
-    out = ""
-    for part in loc:
-        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
-    return out or "body"
 
 
 # --------------------------------------------------------------------------- curves in and out
@@ -141,7 +127,7 @@ class Spline:
         }
 
 
-class CurveRuntime:
+class CurveRuntime(Augmenting):
     """Encoder and decoder sessions of one exported model, with frame and length handling.
 
     Methods that return curves take `splines`: a list to which one `Spline` per returned curve
@@ -689,143 +675,6 @@ class CurveRuntime:
         if ok.any():
             ok[ok] = ~self_intersects(curves[ok])
         return ok
-
-    def plan_augment(
-        self,
-        curves: Sequence[np.ndarray],
-        *,
-        mode: AugmentMode = "pair",
-        seed: int,
-        neighbours: int | None = None,
-        frame: FrameMode = "auto",
-        spacing: Spacing = "parameter",
-        pose: PoseMode = "auto",
-    ) -> AugmentPlan:
-        """Encode the seed curves once and fix who may be mixed with whom; see `AugmentPlan`.
-
-        neighbours: each anchor's partners come from its `neighbours` nearest curves by
-        Euclidean distance between latent means (interpolating near neighbours gives better
-        curves, paper §4); None: from all the other curves.
-        """
-        k = SOURCES_PER_MODE[mode]
-        if len(curves) < k:
-            raise InputError(("curves",), f"mode {mode} needs at least {k} curves, got {len(curves)}")
-        if neighbours is not None and neighbours < k - 1:
-            raise InputError(
-                ("neighbours",), f"mode {mode} mixes each curve with {k - 1} others: at least {k - 1}, got {neighbours}"
-            )
-        if neighbours is not None and neighbours > len(curves) - 1:
-            raise InputError(
-                ("neighbours",),
-                f"at most {len(curves) - 1} (each curve has {len(curves) - 1} others), got {neighbours}; "
-                "omit it to mix any curve with any other",
-            )
-        prep = self.prepare(curves, frame, spacing, pose)
-        mean = self._encoded(prep)[0].astype(np.float64)
-        n = len(mean)
-        distance = np.linalg.norm(mean[:, None, :] - mean[None, :, :], axis=-1)  # (n, n)
-        np.fill_diagonal(distance, np.inf)  # never one's own partner
-        m = n - 1 if neighbours is None else neighbours
-        pools = np.sort(np.argsort(distance, axis=1, kind="stable")[:, :m], axis=1)
-        return AugmentPlan(prep=prep, mean=mean, k=k, seed=seed, pools=pools)
-
-    def augment_batch(
-        self,
-        plan: AugmentPlan,
-        start: int,
-        stop: int,
-        *,
-        n_points: int | None = None,
-        spacing: Spacing = "parameter",
-        splines: list[Spline] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
-        """Items start … stop-1 of the plan's sequence: curves, sources (m, k), weights (m, k), frames."""
-        sources, weights = plan.draw(start, stop)
-        full = np.zeros((len(sources), len(plan.mean)))
-        np.put_along_axis(full, sources, weights, axis=1)
-        out, frames = self._mix(plan.prep, plan.mean, full, n_points, spacing, splines)
-        return out, sources, weights, frames
-
-    def augment_chunks(
-        self,
-        plan: AugmentPlan,
-        start: int,
-        stop: int,
-        *,
-        n_points: int | None = None,
-        spacing: Spacing = "parameter",
-        chunk: int | None = None,
-    ) -> Iterator[np.ndarray]:
-        """The curves of items start … stop-1, `chunk` at a time (default batch_size): bounded memory for any count."""
-        step = chunk or self.batch_size
-        for i in range(start, stop, step):
-            yield self.augment_batch(plan, i, min(i + step, stop), n_points=n_points, spacing=spacing)[0]
-
-    def augment(
-        self,
-        curves: Sequence[np.ndarray],
-        count: int,
-        *,
-        mode: AugmentMode = "pair",
-        seed: int | None = None,
-        neighbours: int | None = None,
-        offset: int = 0,
-        frame: FrameMode = "auto",
-        n_points: int | None = None,
-        spacing: Spacing = "parameter",
-        pose: PoseMode = "auto",
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
-        """`count` random interpolants of the curves, items offset … offset+count-1 of the seeded
-        sequence: data augmentation with the VAE (paper §4).
-
-        Each mixes 2 (pair) or 3 (triplet) distinct source curves with weights uniform on the
-        simplex, so every new curve lies between its sources. Returns curves, sources
-        (count, k), weights (count, k) and frames.
-        """
-        plan = self.plan_augment(
-            curves,
-            mode=mode,
-            seed=fresh_seed() if seed is None else seed,
-            neighbours=neighbours,
-            frame=frame,
-            spacing=spacing,
-            pose=pose,
-        )
-        return self.augment_batch(plan, offset, offset + count, n_points=n_points, spacing=spacing)
-
-
-AugmentMode = Literal["pair", "triplet"]
-SOURCES_PER_MODE: dict[str, int] = {"pair": 2, "triplet": 3}
-
-
-@dataclass(frozen=True)
-class AugmentPlan:
-    """Seed curves encoded once, and the rule that draws item i of a seeded augmentation sequence.
-
-    Item i depends on (seed, i) alone, through its own generator default_rng([seed, i]): a
-    page or chunk of the sequence is the same whatever the page size, and the items can be
-    made in any order. Each item: an anchor curve, uniform; its k-1 partners, distinct and
-    uniform over the anchor's pool; weights from the flat Dirichlet, i.e. uniform on the
-    simplex (each ≥ 0, summing to 1), in the order of the sources.
-    """
-
-    prep: Prepared  # the seed curves brought to the model
-    mean: np.ndarray  # (n_curves, latent_dim) latent means, float64
-    k: int  # sources per new curve: 2 (pair) or 3 (triplet)
-    seed: int
-    pools: np.ndarray  # (n_curves, m) the curves each anchor may be mixed with, ascending
-
-    def draw(self, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
-        """Sources (m, k) (anchor first) and weights (m, k) of items start … stop-1."""
-        sources = np.empty((stop - start, self.k), np.int64)
-        weights = np.empty((stop - start, self.k))
-        for row, i in enumerate(range(start, stop)):
-            rng = np.random.default_rng([self.seed, i])
-            anchor = int(rng.integers(len(self.pools)))
-            sources[row, 0] = anchor
-            sources[row, 1:] = rng.choice(self.pools[anchor], size=self.k - 1, replace=False)
-            weights[row] = rng.dirichlet(np.ones(self.k))
-        return sources, weights
 
 
 def fresh_seed() -> int:

@@ -16,6 +16,7 @@ from fastapi.responses import Response, StreamingResponse
 
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, C3, POST_ERRORS, curl_sample, example
+from curve_vae.service.augmenting import AugmentPlan
 from curve_vae.service.deps import (
     RuntimeDep,
     SettingsDep,
@@ -29,18 +30,14 @@ from curve_vae.service.deps import (
     splines_wanted,
 )
 from curve_vae.service.fastjson import JSON, FastJSONRoute
+from curve_vae.service.inputs import InputError
 from curve_vae.service.metrics import Metrics
 from curve_vae.service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
 from curve_vae.service.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service.npy_bodies import OPENAPI_BODY as NPY_BODY
 from curve_vae.service.npy_bodies import npy_route
 from curve_vae.service.payloads import augment_body, frames_json, sample_body, with_metrics, with_output
-from curve_vae.service.runtime import (
-    AugmentPlan,
-    CurveRuntime,
-    InputError,
-    fresh_seed,
-)
+from curve_vae.service.runtime import CurveRuntime, fresh_seed
 
 ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'
 curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])

@@ -18,10 +18,8 @@ from curve_vae.service.deps import (
     run_inference,
 )
 from curve_vae.service.fastjson import JSON, FastJSONRoute
+from curve_vae.service.inputs import InputError
 from curve_vae.service.payloads import fit_body
-from curve_vae.service.runtime import (
-    InputError,
-)
 
 design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 
