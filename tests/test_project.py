@@ -34,3 +34,23 @@ def test_every_package_folder_is_in_the_one_namespace_the_wheel_installs():
             found.add(".".join([name, *init.parent.relative_to(root).parts]))
     assert found <= listed, f"package folders missing from pyproject's packages: {sorted(found - listed)}"
     assert all(n == "curve_vae" or n.startswith("curve_vae.") for n in listed)
+
+
+def test_the_service_tests_import_no_torch():
+    """tests/service and tests/bench run in the service's own install (no torch): their models are committed."""
+    import ast
+
+    for path in [*(ROOT / "tests" / "service").glob("*.py"), *(ROOT / "tests" / "bench").glob("*.py")]:
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = (
+                [a.name for a in node.names]
+                if isinstance(node, ast.Import)
+                else [node.module or ""]
+                if isinstance(node, ast.ImportFrom)
+                else []
+            )
+            for name in names:
+                assert name.split(".")[0] != "torch", f"{path.name}:{node.lineno} imports {name}"
+                assert not name.startswith(("curve_vae.training.model", "curve_vae.training.export")), (
+                    f"{path.name}:{node.lineno} imports {name}, which needs torch"
+                )

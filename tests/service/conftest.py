@@ -1,13 +1,14 @@
 """Fixtures of the service tests: real exported ONNX models, loaded runtimes, apps and a live server.
 
-The exported model is untrained (fast to make, same graphs as the shipped one); tests that
-need a model that actually reconstructs use `shipped_runtime`, which skips only when
-models/manifest.json is absent.
+The test model is untrained and small (Table 1's cnn1), committed under tests/fixtures/ by
+tests/fixtures/make_models.py, so these tests run in an install without torch; tests that need a
+model that actually reconstructs use `shipped_runtime` (models/).
 """
 
 from __future__ import annotations
 
 import os
+import shutil
 import socket
 import subprocess
 import sys
@@ -27,35 +28,25 @@ from curve_vae.service.settings import Settings
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ROOT / "models"
+FIXTURES = ROOT / "tests" / "fixtures"
 
 
 @pytest.fixture(scope="session")
 def model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """An untrained Inception VAE with the shipped model's B-spline head, exported as training/export.py ships one."""
-    return _export_untrained(tmp_path_factory.mktemp("model"), spline_ctrl=31)
+    """An untrained VAE (cnn1) with the shipped model's B-spline head and a learned prior, exported as
+    training/export.py ships one: committed (tests/fixtures/make_models.py), so these tests need no torch."""
+    return _copy(FIXTURES / "untrained-spline31", tmp_path_factory.mktemp("model"))
 
 
 @pytest.fixture(scope="session")
 def raw_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The same untrained VAE without a B-spline head: its decoder returns the raw points."""
-    return _export_untrained(tmp_path_factory.mktemp("raw_model"), spline_ctrl=0)
+    return _copy(FIXTURES / "untrained-raw", tmp_path_factory.mktemp("raw_model"))
 
 
-def _export_untrained(out: Path, *, spline_ctrl: int) -> Path:
-    """With a learned prior: a mixture around the latent means of four data-set curves (tight, so its samples
-    decode near those curves' reconstructions)."""
-    import torch
-
-    from curve_vae.service.prior import LatentPrior
-    from curve_vae.training.export import export
-    from curve_vae.training.model import VAE, ModelConfig
-
-    torch.manual_seed(0)  # the same untrained weights every run
-    model = VAE(ModelConfig(spline_ctrl=spline_ctrl)).eval()
-    with torch.no_grad():
-        means = model.encoder(torch.tensor(bspline_curves(4, seed=5), dtype=torch.float32))[0].numpy()
-    prior = LatentPrior(np.full(4, 0.25), means.astype(np.float64), np.stack([np.eye(32) * 0.05] * 4))
-    export(model, out, model_size=100.0, weights=False, prior=prior, prior_info={"fitted_on": "4 test curves"})
+def _copy(src: Path, out: Path) -> Path:
+    """A copy a test may change without changing the committed files."""
+    shutil.copytree(src, out, dirs_exist_ok=True)
     return out
 
 

@@ -105,22 +105,3 @@ def test_steps_and_weights_exclude_each_other_even_as_null(client):
     c = [[0, 0], [1, 2], [2, 3], [3, 1]]
     r = client.post("/interpolate", json={"curves": [c, c[::-1]], "steps": 3, "weights": None})
     assert r.status_code == 422 and "either steps or weights" in r.json()["detail"]
-
-
-def test_the_live_schema_takes_the_latent_length_of_the_loaded_model(tmp_path):
-    import torch
-    from fastapi.testclient import TestClient
-
-    from curve_vae.service.app import create_app
-    from curve_vae.service.runtime import CurveRuntime
-    from curve_vae.service.settings import Settings
-    from curve_vae.training.export import export
-    from curve_vae.training.model import VAE, ModelConfig
-
-    torch.manual_seed(0)
-    export(VAE(ModelConfig(latent_dim=8)).eval(), tmp_path, model_size=100.0, weights=False)
-    runtime = CurveRuntime.load(tmp_path, providers="cpu")
-    with TestClient(create_app(Settings(model_dir=tmp_path), runtime=runtime)) as client:
-        latents = client.get("/openapi.json").json()["components"]["schemas"]["DecodeRequest"]["properties"]["latents"]
-        assert latents["items"]["minItems"] == latents["items"]["maxItems"] == 8
-        assert client.post("/decode", json={"latents": [[0.0] * 8]}).status_code == 200
