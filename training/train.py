@@ -4,6 +4,10 @@ Knows nothing about curves beyond "a (N, n_points, 2) float array": the model ow
 architecture, `losses` owns the objective. Run under `torchrun --nproc-per-node K` for
 data-parallel training (gloo on CPU, nccl on GPU); a single process needs no launcher.
 Checkpoint files are training/checkpoint.py's.
+
+Length (~460 lines): the step, the schedules, the clock of a time budget and the run's named steps share
+RunState and the DDP process; `train()` itself (~110 lines) is the epoch loop with its record, and is the
+next to shorten (an epoch's row and checkpoint built by helpers).
 """
 
 from __future__ import annotations
