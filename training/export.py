@@ -203,3 +203,129 @@ def export(
     }
     atomic_write_text(out / "manifest.json", json.dumps(manifest, indent=2) + "\n")
     return manifest
+
+
+# ---------------------------------------------------------------- a training checkpoint into a model directory
+
+
+def export_checkpoint(
+    checkpoint: str | Path,
+    out: str | Path,
+    *,
+    name: str,
+    version: str,
+    data_cache: str | Path | None = None,
+    spline_ctrl: int | None = None,
+    training_info: str | Path | None = None,
+    prior_components: int = 8,
+    say: Any = print,
+) -> tuple[dict[str, Any], Any, np.ndarray]:
+    """Export a training checkpoint (`curve-vae export`): the graphs, the prior (None components: none), the
+    manifest with the run's training record; returns the manifest, the data configuration and its test split.
+
+    data_cache: the data set cache of the checkpoint's configuration (default: its default cache file).
+    spline_ctrl: the B-spline head to export with in place of the checkpoint's (it has no weights).
+    training_info: a JSON file merged into the manifest's training section (wall time, hardware, stages).
+    """
+    from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
+    from curve_vae.training.data import DataConfig, default_cache, load_or_generate, load_test_split
+
+    ckpt = load_checkpoint(checkpoint)
+    data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
+    if data_cfg.mix == "broad":  # posed at one size, tested on the paper's curves: no training split to draw
+        from curve_vae.training.families import MODEL_SIZE
+
+        train, test, model_size = None, load_test_split(data_cfg, None), MODEL_SIZE
+    else:
+        ds = load_or_generate(data_cfg, data_cache or default_cache(data_cfg))
+        train, test, model_size = ds.train, ds.test, model_size_of(ds.train)
+    model = model_from_checkpoint(checkpoint)
+    if spline_ctrl is not None and spline_ctrl != model.cfg.spline_ctrl:
+        from dataclasses import replace
+
+        head = VAE(replace(model.cfg, spline_ctrl=spline_ctrl))  # the head has no weights: same state dict
+        head.load_state_dict(model.state_dict())
+        model = head.eval()
+    prior, prior_info = None, None
+    if prior_components:
+        prior, prior_info = _fit_shipped_prior(model, data_cfg, train, prior_components)
+        say(f"fitted a {prior_components}-component latent prior to {prior_info['curves']} training curves")
+    manifest = export(
+        model,
+        out,
+        name=name,
+        version=version,
+        model_size=model_size,
+        extra={"training": _training_record(ckpt, training_info)},
+        prior=prior,
+        prior_info={"fitted_on": prior_info["fitted_on"]} if prior_info else None,
+    )
+    return manifest, data_cfg, test
+
+
+def _training_record(ckpt: dict[str, Any], training_info: str | Path | None) -> dict[str, Any]:
+    record: dict[str, Any] = {
+        "data": ckpt["data_config"],
+        "train": ckpt["train_config"],
+        "epochs_run": ckpt["state"]["epoch"],
+        "best_epoch": ckpt["state"]["best_epoch"],
+        "best_val_mse": ckpt["state"]["best_val"],
+    }
+    if "averaged" in ckpt:  # made by curve-vae average: which checkpoints, and what it measured
+        record["averaged"] = ckpt["averaged"]
+    if training_info:
+        record.update(json.loads(Path(training_info).read_text()))
+    return record
+
+
+def _fit_shipped_prior(
+    model: VAE, data_cfg: Any, train: np.ndarray | None, components: int
+) -> tuple[LatentPrior, dict[str, Any]]:
+    """The latent prior /sample draws from, fitted to the paper's training curves (with the broad mix too)."""
+    from curve_vae.training.data import generate_curves
+    from curve_vae.training.prior import FIT_CURVES, fit_prior
+
+    fit_on = (
+        train[:FIT_CURVES]
+        if train is not None and data_cfg.mix == "paper"
+        else generate_curves(min(FIT_CURVES, data_cfg.n_train), data_cfg.seed, n_points=data_cfg.n_points)[0]
+    )
+    with torch.no_grad():
+        means = np.concatenate(
+            [model.encoder(torch.from_numpy(fit_on[i : i + 500]))[0].numpy() for i in range(0, len(fit_on), 500)]
+        )
+    fitted_on = f"latent means of the first {len(fit_on)} training curves of the paper's data set"
+    return fit_prior(means, components=components), {"fitted_on": fitted_on, "curves": len(fit_on)}
+
+
+def measure_export(
+    out: str | Path, manifest: dict[str, Any], data_cfg: Any, test: np.ndarray, *, fresh_seed: int, suite_count: int
+) -> dict[str, Any]:
+    """Measure the exported graphs as the service runs them (both test sets, the priors' samples, the family
+    suite) and store the report in the manifest's `metrics`, written atomically; returns the report."""
+    import shutil
+    import tempfile
+
+    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.training.data import generate_curves
+    from curve_vae.training.evaluate import run_evaluation, runtime_codec
+
+    fresh, _ = generate_curves(1000, fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
+    runtime = CurveRuntime.load(out, providers="cpu")
+    enc, dec, _ = runtime_codec(runtime)
+    scratch = Path(tempfile.mkdtemp(prefix="curve-vae-export-"))  # run_evaluation's report.json, not kept
+    try:
+        report = run_evaluation(
+            enc,
+            dec,
+            {"test": test, f"fresh_seed_{fresh_seed}": fresh},
+            scratch,
+            figures=False,
+            runtime=runtime,
+            suite_count=suite_count,
+        )
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    manifest["metrics"] = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
+    atomic_write_text(Path(out) / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+    return report

@@ -4,9 +4,7 @@ measurement (training/evaluate.py, training/suite.py), and a Triton model reposi
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
-from typing import Any
 
 from curve_vae.commands.options import (
     DATA_HELP,
@@ -18,11 +16,7 @@ from curve_vae.commands.options import (
 
 
 def cmd_export(a: argparse.Namespace) -> int:
-    from curve_vae.files import atomic_write_text
-    from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
-    from curve_vae.training.data import DataConfig, generate_curves, load_or_generate, load_test_split
-    from curve_vae.training.evaluate import onnx_codec, run_evaluation
-    from curve_vae.training.export import export, model_size_of
+    from curve_vae.training.export import export_checkpoint, measure_export
 
     held = [
         f
@@ -34,84 +28,19 @@ def cmd_export(a: argparse.Namespace) -> int:
             f"{a.out} already holds a model ({', '.join(held)}) and is left as it is: pass --force to replace it, "
             "or export to a new --out directory"
         )
-    ckpt = load_checkpoint(a.checkpoint)
-    data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
-    if data_cfg.mix == "broad":  # posed at one size, tested on the paper's curves: no training split to draw
-        from curve_vae.training.families import MODEL_SIZE
-
-        train, test, model_size = None, load_test_split(data_cfg, None), MODEL_SIZE
-    else:
-        ds = load_or_generate(data_cfg, data_path(a, data_cfg))
-        train, test, model_size = ds.train, ds.test, model_size_of(ds.train)
-    model = model_from_checkpoint(a.checkpoint)
-    if a.spline_ctrl is not None and a.spline_ctrl != model.cfg.spline_ctrl:
-        from dataclasses import replace
-
-        from curve_vae.training.model import VAE
-
-        head = VAE(replace(model.cfg, spline_ctrl=a.spline_ctrl))  # the head has no weights: same state dict
-        head.load_state_dict(model.state_dict())
-        model = head.eval()
-    training: dict[str, Any] = {
-        "data": ckpt["data_config"],
-        "train": ckpt["train_config"],
-        "epochs_run": ckpt["state"]["epoch"],
-        "best_epoch": ckpt["state"]["best_epoch"],
-        "best_val_mse": ckpt["state"]["best_val"],
-    }
-    if "averaged" in ckpt:  # made by curve-vae average: which checkpoints, and what it measured
-        training["averaged"] = ckpt["averaged"]
-    if a.training_info:
-        training.update(json.loads(Path(a.training_info).read_text()))
-    prior, prior_info = None, None
-    if a.prior:
-        import numpy as np
-        import torch
-
-        from curve_vae.training.prior import FIT_CURVES, fit_prior
-
-        # /sample draws the paper's curves: with the broad mix, the prior is fitted to the paper's training curves
-        fit_on = (
-            train[:FIT_CURVES]
-            if train is not None and data_cfg.mix == "paper"
-            else generate_curves(min(FIT_CURVES, data_cfg.n_train), data_cfg.seed, n_points=data_cfg.n_points)[0]
-        )
-        with torch.no_grad():
-            means = np.concatenate(
-                [model.encoder(torch.from_numpy(fit_on[i : i + 500]))[0].numpy() for i in range(0, len(fit_on), 500)]
-            )
-        prior = fit_prior(means, components=a.prior_components)
-        prior_info = {"fitted_on": f"latent means of the first {len(fit_on)} training curves of the paper's data set"}
-        print(f"fitted a {a.prior_components}-component latent prior to {len(fit_on)} training curves")
-    manifest = export(
-        model,
+    manifest, data_cfg, test = export_checkpoint(
+        a.checkpoint,
         a.out,
         name=a.name,
         version=a.version,
-        model_size=model_size,
-        extra={"training": training},
-        prior=prior,
-        prior_info=prior_info,
+        data_cache=a.data,
+        spline_ctrl=a.spline_ctrl,
+        training_info=a.training_info or None,
+        prior_components=a.prior_components if a.prior else 0,
     )
     print(f"exported {a.checkpoint} → {a.out}/: {', '.join(manifest['files'])}, manifest.json")
     if a.evaluate:
-        fresh, _ = generate_curves(1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
-        from curve_vae.service.runtime import CurveRuntime
-
-        enc, dec, _ = onnx_codec(a.out)
-        report = run_evaluation(
-            enc,
-            dec,
-            {"test": test, f"fresh_seed_{a.fresh_seed}": fresh},
-            Path(a.out) / "report",
-            figures=False,
-            runtime=CurveRuntime.load(a.out, providers="cpu"),
-            suite_count=a.suite_count,
-        )
-        manifest["metrics"] = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
-        atomic_write_text(Path(a.out) / "manifest.json", json.dumps(manifest, indent=2) + "\n")
-        (Path(a.out) / "report" / "report.json").unlink()
-        (Path(a.out) / "report").rmdir()
+        report = measure_export(a.out, manifest, data_cfg, test, fresh_seed=a.fresh_seed, suite_count=a.suite_count)
         for name, r in report["test_sets"].items():
             print(f"{name}: MSE {r['mse']:.4f} (median {r['mse_median']:.4f}) over {r['n_curves']} curves")
         if "families" in report:
