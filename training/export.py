@@ -248,8 +248,9 @@ def export_checkpoint(
         model = head.eval()
     prior, prior_info = None, None
     if prior_components:
-        prior, prior_info = _fit_shipped_prior(model, data_cfg, train, prior_components)
-        say(f"fitted a {prior_components}-component latent prior to {prior_info['curves']} training curves")
+        prior, count = _fit_shipped_prior(model, data_cfg, train, prior_components)
+        prior_info = {"fitted_on": f"latent means of the first {count} training curves of the paper's data set"}
+        say(f"fitted a {prior_components}-component latent prior to {count} training curves")
     manifest = export(
         model,
         out,
@@ -258,7 +259,7 @@ def export_checkpoint(
         model_size=model_size,
         extra={"training": _training_record(ckpt, training_info)},
         prior=prior,
-        prior_info={"fitted_on": prior_info["fitted_on"]} if prior_info else None,
+        prior_info=prior_info,
     )
     return manifest, data_cfg, test
 
@@ -278,10 +279,9 @@ def _training_record(ckpt: dict[str, Any], training_info: str | Path | None) -> 
     return record
 
 
-def _fit_shipped_prior(
-    model: VAE, data_cfg: Any, train: np.ndarray | None, components: int
-) -> tuple[LatentPrior, dict[str, Any]]:
-    """The latent prior /sample draws from, fitted to the paper's training curves (with the broad mix too)."""
+def _fit_shipped_prior(model: VAE, data_cfg: Any, train: np.ndarray | None, components: int) -> tuple[LatentPrior, int]:
+    """The latent prior /sample draws from, fitted to the paper's training curves (with the broad mix too), and
+    how many curves it was fitted to."""
     from curve_vae.training.data import generate_curves
     from curve_vae.training.prior import FIT_CURVES, fit_prior
 
@@ -294,8 +294,7 @@ def _fit_shipped_prior(
         means = np.concatenate(
             [model.encoder(torch.from_numpy(fit_on[i : i + 500]))[0].numpy() for i in range(0, len(fit_on), 500)]
         )
-    fitted_on = f"latent means of the first {len(fit_on)} training curves of the paper's data set"
-    return fit_prior(means, components=components), {"fitted_on": fitted_on, "curves": len(fit_on)}
+    return fit_prior(means, components=components), len(fit_on)
 
 
 def measure_export(

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 from typing import Any
+
+from curve_vae.service.cpus import available_cpus
 
 DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
 DEFAULT_MODELS = "models"
@@ -41,7 +42,7 @@ def add_data_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--workers",
         type=int,
-        default=len(os.sched_getaffinity(0)),
+        default=available_cpus(),
         help="processes drawing the broad mix: the same curves however many (default: the CPUs available, %(default)s)",
     )
 
