@@ -110,12 +110,10 @@ class CurveDataset:
             return cls(config, train, val, test, np.zeros((len(test), 0, 2), np.float32))
         a, b = config.n_train, config.n_train + config.n_val
         if config.mix == "broad":
-            from curve_vae.training.families import MIX_VERSION, broad_mix
+            from curve_vae.training.families import broad_mix
 
-            if config.mix_version != MIX_VERSION:
-                raise ValueError(f"the broad mix of version {config.mix_version} is no longer made (now {MIX_VERSION})")
             curves, ctrl = paper_test_curves(config)
-            mixed = broad_mix(b, config.seed + 1, n_points=config.n_points, workers=workers)
+            mixed = broad_mix(b, config.seed + 1, n_points=config.n_points, workers=workers, version=config.mix_version)
             return cls(config, mixed[:a], mixed[a:b], curves, ctrl)
         curves, ctrl = _paper_curves(config, config.n_train + config.n_val + config.n_test)
         return cls(config, curves[:a], curves[a:b], curves[b:], ctrl[b:])

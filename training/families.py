@@ -14,6 +14,7 @@ and measure generalisation in the evaluation suite (training/suite.py).
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -142,16 +143,38 @@ TRAIN_FAMILIES: dict[str, Family] = {
     "naca": naca,
 }
 HELD_OUT: dict[str, Family] = {"superellipse": superellipse, "stroke": stroke, "lissajous": lissajous}
-#: Share of each training family in the broad mix: the paper's curves stay the largest single share.
-MIX = {"paper": 0.45, "polygon": 0.25, "arc": 0.075, "spiral": 0.075, "wave": 0.075, "naca": 0.075}
-#: Of the paper's share: a third as the paper draws it (its pose and frame, parameter spacing), the rest posed
-#: and respaced with these weights. Arc length weighs most: posted points are rarely spaced by a B-spline
-#: parameter, and the paper's curves at arc-length spacing were the suite's hardest trained set (model 0.8.0).
-PAPER_RAW = 1 / 3
-PAPER_SPACINGS = ("arc_length", "arc_length", "parameter", "warped")
-#: Version of the broad mix's definition (shares, spacings, chunking): part of a data set's configuration, so a
-#: cache made by another version is never read as this one. 1: model 0.8.0's mix; 2: the present one.
-MIX_VERSION = 2
+
+
+@dataclass(frozen=True)
+class MixSpec:
+    """One version of the broad mix: each training family's share, and how the paper's share is drawn."""
+
+    shares: dict[str, float]  # family -> share of the mix; the paper's curves stay the largest single share
+    paper_raw: float  # of the paper's share: drawn as the paper draws them (its pose, frame, parameter spacing)
+    paper_spacings: tuple[str, ...]  # the rest, posed, each respaced at one of these drawn at random
+
+
+#: Every broad mix still made, by version (part of a data set's configuration, so a cache made by another
+#: version is never read as this one; a model's manifest names the version it was trained on). Version 1 (model
+#: 0.8.0: the paper's curves 30%, half as drawn; polygons 30%, the rest 10% each) is no longer made.
+MIXES = {
+    # model 0.9.0's. Arc length weighs most among the posed paper curves: posted points are rarely spaced by a
+    # B-spline parameter, and the paper's curves at arc-length spacing were the suite's hardest set (0.8.0).
+    2: MixSpec(
+        {"paper": 0.45, "polygon": 0.25, "arc": 0.075, "spiral": 0.075, "wave": 0.075, "naca": 0.075},
+        paper_raw=1 / 3,
+        paper_spacings=("arc_length", "arc_length", "parameter", "warped"),
+    ),
+    # model 0.10.0's: the paper's curves at arc-length spacing were still 1.8× the error of the same curves at
+    # parameter spacing (0.9.0), so they go from 15% of the mix to 26%; the raw third shrinks to a fifth.
+    3: MixSpec(
+        {"paper": 0.55, "polygon": 0.21, "arc": 0.06, "spiral": 0.06, "wave": 0.06, "naca": 0.06},
+        paper_raw=0.2,
+        paper_spacings=("arc_length", "arc_length", "arc_length", "parameter", "warped"),
+    ),
+}
+#: The version new data sets are drawn at.
+MIX_VERSION = 3
 #: The broad mix is drawn in chunks of this many curves, each seeded by (seed, chunk index): the same data for a
 #: seed however many processes draw it.
 CHUNK = 8192
@@ -259,19 +282,21 @@ def own_curves(
     return tuple(to_pose(s, rng, model_size).astype(np.float32) for s in (drawn, val, test))  # type: ignore[return-value]
 
 
-def _mix_chunk(args: tuple[int, int, int, int, float]) -> np.ndarray:
-    """Chunk `index` of the broad mix: `count` curves in MIX shares, drawn with its own seed (seed, index)."""
-    seed, index, count, n_points, model_size = args
+def _mix_chunk(args: tuple[int, int, int, int, float, int]) -> np.ndarray:
+    """Chunk `index` of the broad mix of `version`: `count` curves in its shares, drawn with its own seed
+    (seed, index)."""
+    seed, index, count, n_points, model_size, version = args
+    spec = MIXES[version]
     rng = np.random.default_rng([seed, index])
-    sizes = {name: int(count * share) for name, share in MIX.items()}
+    sizes = {name: int(count * share) for name, share in spec.shares.items()}
     sizes["paper"] += count - sum(sizes.values())  # the rounding's few curves: exactly `count` in all
     parts = []
     for name, k in sizes.items():
         if name == "paper":
-            raw = int(round(k * PAPER_RAW))
+            raw = int(round(k * spec.paper_raw))
             parts.append(draw_family(paper, raw, rng, n_points=n_points, model_size=None, spacings=("parameter",)))
             parts.append(
-                draw_family(paper, k - raw, rng, n_points=n_points, model_size=model_size, spacings=PAPER_SPACINGS)
+                draw_family(paper, k - raw, rng, n_points=n_points, model_size=model_size, spacings=spec.paper_spacings)
             )
         else:
             parts.append(draw_family(TRAIN_FAMILIES[name], k, rng, n_points=n_points, model_size=model_size))
@@ -279,14 +304,23 @@ def _mix_chunk(args: tuple[int, int, int, int, float]) -> np.ndarray:
 
 
 def broad_mix(
-    count: int, seed: int, *, n_points: int = 161, model_size: float = MODEL_SIZE, workers: int = 1
+    count: int,
+    seed: int,
+    *,
+    n_points: int = 161,
+    model_size: float = MODEL_SIZE,
+    workers: int = 1,
+    version: int = MIX_VERSION,
 ) -> np.ndarray:
-    """`count` curves of the training mix (MIX shares, shuffled), seeded. The paper's share keeps its own
-    pose, frame and parameter spacing a third of the time (PAPER_RAW), so the model stays as good on the
-    paper's curves. Drawn in CHUNK-curve chunks by `workers` processes; the result does not depend on
+    """`count` curves of the training mix of `version` (MIXES: its shares, shuffled), seeded. Part of the
+    paper's share keeps its own pose, frame and parameter spacing (paper_raw), so the model stays as good on
+    the paper's curves. Drawn in CHUNK-curve chunks by `workers` processes; the result does not depend on
     `workers`."""
+    if version not in MIXES:
+        raise ValueError(f"the broad mix of version {version} is no longer made (made: {sorted(MIXES)})")
     jobs = [
-        (seed, i, min(CHUNK, count - start), n_points, model_size) for i, start in enumerate(range(0, count, CHUNK))
+        (seed, i, min(CHUNK, count - start), n_points, model_size, version)
+        for i, start in enumerate(range(0, count, CHUNK))
     ]
     if workers > 1 and len(jobs) > 1:
         import multiprocessing

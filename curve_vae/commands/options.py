@@ -33,6 +33,13 @@ def add_data_options(p: argparse.ArgumentParser) -> None:
         "other shapes, posed as the service poses curves); the test split is the paper's either way (default: paper)",
     )
     g.add_argument(
+        "--mix-version",
+        type=int,
+        default=0,
+        metavar="N",
+        help="the broad mix's version (training/families.py MIXES; 2 drew model 0.9.0's curves) (default: the latest)",
+    )
+    g.add_argument(
         "--curves",
         default=None,
         metavar="PATH",
@@ -59,7 +66,13 @@ def data_config(a: argparse.Namespace):
 
     mix = "files" if a.curves else a.mix
     return DataConfig(
-        n_train=a.n_train, n_val=a.n_val, n_test=a.n_test, seed=a.data_seed, mix=mix, source=a.curves or ""
+        n_train=a.n_train,
+        n_val=a.n_val,
+        n_test=a.n_test,
+        seed=a.data_seed,
+        mix=mix,
+        source=a.curves or "",
+        mix_version=a.mix_version if mix == "broad" else 0,
     )
 
 

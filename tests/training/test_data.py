@@ -96,10 +96,26 @@ def test_broad_mix_is_versioned_and_its_test_split_is_the_papers(tmp_path):
     arrays["meta"] = np.array(json.dumps(meta))
     np.savez(tmp_path / "old.npz", **arrays)
     assert CurveDataset.load(tmp_path / "old.npz").config.mix_version == 1
-    with pytest.raises(ValueError, match="mix_version 1 .file. vs 2 .asked."):
+    with pytest.raises(ValueError, match=f"mix_version 1 .file. vs {MIX_VERSION} .asked."):
         load_or_generate(cfg, tmp_path / "old.npz")
     with pytest.raises(ValueError, match="mix_version"):
         DataConfig(mix_version=2)
+    # a version no longer made is refused by name, not drawn as the present one
+    with pytest.raises(ValueError, match="version 1 is no longer made"):
+        load_or_generate(DataConfig(n_train=30, n_val=2, n_test=10, mix="broad", mix_version=1), tmp_path / "v1.npz")
+    assert not (tmp_path / "v1.npz").exists()
+
+
+def test_each_mix_version_draws_its_own_shares():
+    """Version 2 (model 0.9.0's) is still drawn as it was; the present version differs from it."""
+    from curve_vae.training.families import MIX_VERSION, MIXES, broad_mix
+
+    assert MIX_VERSION in MIXES and 2 in MIXES
+    for spec in MIXES.values():
+        assert abs(sum(spec.shares.values()) - 1.0) < 1e-9 and 0 <= spec.paper_raw <= 1
+    old = broad_mix(400, 5, version=2)
+    np.testing.assert_array_equal(old, broad_mix(400, 5, version=2))
+    assert not np.array_equal(old, broad_mix(400, 5, version=MIX_VERSION))
 
 
 def test_the_test_split_of_a_broad_mix_is_read_without_drawing_its_training_curves(tmp_path):
