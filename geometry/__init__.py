@@ -1,10 +1,12 @@
 """Curve geometry shared by training and service: pure numpy/scipy, no torch.
 
 One place for everything the project knows about curves: B-spline sampling and fitting,
-arc-length resampling, frame normalisation, self-intersection and smoothness metrics.
+arc-length resampling, frame normalisation, adaptation of any curve to the model's plane and
+point count and back, self-intersection and smoothness metrics.
 A curve is an array of shape (n_points, 2); a batch is (batch, n_points, 2).
 """
 
+from curve_vae.geometry.adapt import BeyondFloat32, polyline_to_caller, spline_to_caller, to_model_plane
 from curve_vae.geometry.bspline import (
     BSplineFit,
     arc_length_params,
@@ -41,6 +43,7 @@ __all__ = [
     "arc_length_params",
     "arc_fractions",
     "at_fractions",
+    "BeyondFloat32",
     "BSplineFit",
     "Frame",
     "Mesh",
@@ -52,6 +55,7 @@ __all__ = [
     "fit_bspline_auto",
     "fit_frame",
     "mse_per_curve",
+    "polyline_to_caller",
     "pose_frames",
     "posed_frame",
     "random_control_points",
@@ -64,5 +68,7 @@ __all__ = [
     "signed_turning",
     "smoothness",
     "spline_head",
+    "spline_to_caller",
+    "to_model_plane",
     "turning_angles",
 ]

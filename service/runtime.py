@@ -5,9 +5,9 @@ one onnxruntime session per graph on the requested providers and runs a warm-up.
 methods take and return numpy arrays, so everything the service does can be tested
 without HTTP:
 
-    caller's curve (n, 2)  --fit_frame/to_model-->  model plane  --resample-->  (161, 2)
+    caller's curve (n, 2)  --fit_frame, to_model_plane-->  (161, 2) in the model plane
         --encoder--> mean, log_var --(affine mix)--> decoder --> (161, 2) in the model plane
-        --back to n points, same spacing--> --from_model--> caller's frame
+        --polyline_to_caller / spline_to_caller: n points, same spacing--> caller's frame
 
 With frame "model" the frame steps are skipped. Resampling ("spacing"): the model was
 trained on points evenly spaced in the B-spline parameter, so by default a curve's points
@@ -17,10 +17,12 @@ the same model input. "arc_length" resamples evenly by arc length instead, for p
 spaced arbitrarily (hand-drawn strokes). Nothing here imports torch. Reading and checking model
 files is `service.model_files`; the learned latent distribution is `service.prior`.
 
-Length (~710 lines): one class whose methods share the sessions, the frame/length adaptation and the
-choice of pose (which needs both graphs). Augmentation is `service.augmenting` (a base class of CurveRuntime),
-the input error `service.inputs`, the mixing weights `geometry.mixing`; the frame/length adaptation is where
-this module should shrink next.
+Length (~690 lines): one class whose methods share the sessions and the choice of pose (which needs both
+graphs), and carry a batch's frames, input positions and splines from `prepare` through the graphs to the
+result, turning geometry's errors into the service's InputError with the field and curve they concern. The
+pure frame and length adaptation (caller's frame -> model plane at the model's point count, and back as
+points or as a spline) is `geometry.adapt`; augmentation is `service.augmenting` (a base class of
+CurveRuntime), the input error `service.inputs`, the mixing weights `geometry.mixing`.
 """
 
 from __future__ import annotations
@@ -36,22 +38,21 @@ import numpy as np
 import onnxruntime as ort
 
 from curve_vae.geometry import (
+    BeyondFloat32,
     Frame,
-    arc_fractions,
-    arc_length_params,
-    at_fractions,
     blend_frames,
     clamped_uniform_knots,
     curve_length,
-    evaluate_bspline,
     fit_frame,
     mse_per_curve,
+    polyline_to_caller,
     pose_frames,
-    resample,
-    sample_bspline,
     self_intersects,
     smoothness,
+    spline_to_caller,
+    to_model_plane,
 )
+from curve_vae.geometry.adapt import F32_MAX
 from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.service import batching
 from curve_vae.service.augmenting import Augmenting
@@ -68,7 +69,6 @@ PoseMode = Literal["auto", "as_is"]
 #: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
 POSE_CHORD_COUNT = 3
-_F32_MAX = float(np.finfo(np.float32).max)
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
 
 
@@ -361,22 +361,15 @@ class CurveRuntime(Augmenting):
         self, pts: np.ndarray, f: Frame | None, spacing: Spacing, i: int
     ) -> tuple[np.ndarray, np.ndarray | None]:
         """One caller curve -> its model-plane points (n_points, 2) and where its own points sit along them."""
-        m = f.to_model(pts, self.model_size) if f is not None else pts
-        fraction = None
-        if spacing == "arc_length":
-            fraction = arc_fractions(m)
-            m = resample(m, self.n_points)
-        elif len(pts) != self.n_points:
-            fraction = np.linspace(0.0, 1.0, len(pts))
-            m = resample(m, self.n_points, spacing=spacing)
-        if not (np.abs(m) <= _F32_MAX).all():  # also false for inf and nan
+        try:
+            return to_model_plane(pts, f, model_size=self.model_size, n_points=self.n_points, spacing=spacing)
+        except BeyondFloat32:
             raise InputError(
                 ("curves", i),
                 "its extent is too small or too large to map to the model's frame"
                 if f is not None
                 else 'coordinates beyond float32 range; use frame "auto"',
-            )
-        return m, fraction
+            ) from None
 
     def _encoded(self, prep: Prepared) -> tuple[np.ndarray, np.ndarray]:
         """Latent means and log-variances of prepared curves (computed once)."""
@@ -399,36 +392,24 @@ class CurveRuntime(Augmenting):
         ctrl: np.ndarray | None = None,
         splines: list[Spline] | None = None,
     ) -> np.ndarray:
-        """One model-plane result (n_points_model, 2) -> the caller's frame and length.
-
-        n_points given: that many points, spaced as `spacing` says (with "parameter" and the
-        model's count, the model's own points). Otherwise at the input's positions
-        (`fractions`), or the model's points as they are. With the control points of a
-        B-spline head (`ctrl`) the points are the spline's at those parameters, not a polyline
-        interpolation, and the spline is appended to `splines`.
-        """
+        """One model-plane result (n_points_model, 2) -> the caller's frame and length (geometry.adapt): n_points
+        spaced as `spacing` says, else at the input's positions (`fractions`), else the model's points. With the
+        control points of a B-spline head (`ctrl`) the points are the spline's, and the spline is appended to
+        `splines`."""
         if ctrl is None:
-            curve = np.asarray(out, np.float64)
-            if n_points is not None:
-                curve = resample(curve, n_points, spacing=spacing)
-            elif fractions is not None:
-                curve = at_fractions(curve, fractions)
-            return frame.from_model(curve, self.model_size) if frame is not None else curve
-        c = np.asarray(ctrl, np.float64)
-        if n_points is not None and spacing == "arc_length":
-            u = arc_length_params(c, n_points)
-        elif n_points is None and fractions is not None:
-            u = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
-        else:  # evenly in the parameter: the basis is the same for every curve (cached by sample_bspline)
-            u = None
-            count = n_points or self.n_points
-        if u is None:
-            curve, u = sample_bspline(c, count, self.spline_degree), np.linspace(0.0, 1.0, count)
-        else:
-            curve = evaluate_bspline(c, u, self.spline_degree)
-        if frame is not None:  # a similarity maps a spline's points as it maps its control points
-            curve, c = frame.from_model(curve, self.model_size), frame.from_model(c, self.model_size)
-            u = frame.to_caller_params(u)
+            return polyline_to_caller(
+                out, frame, model_size=self.model_size, n_points=n_points, spacing=spacing, fractions=fractions
+            )
+        curve, c, u = spline_to_caller(
+            ctrl,
+            frame,
+            model_size=self.model_size,
+            degree=self.spline_degree,
+            model_points=self.n_points,
+            n_points=n_points,
+            spacing=spacing,
+            fractions=fractions,
+        )
         if splines is not None:
             assert self.knots is not None
             splines.append(Spline(c, self.knots, self.spline_degree, u))
@@ -706,6 +687,6 @@ def _check_finite(a: np.ndarray, field: str, msg: str) -> None:
 
 
 def _check_range(a: np.ndarray, field: str) -> None:
-    bad = ~(np.abs(a) <= _F32_MAX).reshape(len(a), -1).all(axis=1)
+    bad = ~(np.abs(a) <= F32_MAX).reshape(len(a), -1).all(axis=1)
     if bad.any():
         raise InputError((field, int(np.argmax(bad))), "values beyond float32 range")

@@ -1,0 +1,112 @@
+"""Frame and length adaptation: a caller's curve to the model's plane and point count, and a result back.
+
+The model takes `n_points` points (161) in its 128×128 plane, evenly spaced in the curve's
+B-spline parameter. `to_model_plane` brings a caller's curve there — through its `Frame` when it
+has one (frame.py), then to `n_points` points: along the point index with spacing "parameter"
+(points taken to be evenly spaced in the parameter, so a curve of `n_points` passes untouched),
+evenly by arc length with "arc_length" — and says where each of the caller's points sits along
+the result. `polyline_to_caller` and `spline_to_caller` bring a model-plane result back: at those
+positions, or at any count spaced as asked, mapped through the frame. From a B-spline head's
+control points the points are the spline's at the returned parameters, and the control points
+and parameters come back in the caller's frame and point order: a similarity maps a spline's
+points as it maps its control points.
+
+Pure numpy: the service's runtime (service/runtime.py) calls these around its ONNX sessions.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline, sample_bspline
+from curve_vae.geometry.frame import Frame, arc_fractions, at_fractions, resample
+
+#: Largest float32: the graphs' input type, so the bound of a model-plane coordinate.
+F32_MAX = float(np.finfo(np.float32).max)
+
+
+class BeyondFloat32(ValueError):
+    """A curve whose model-plane points are not finite float32 numbers (its frame's scale under- or overflows, or
+    its own coordinates are that large)."""
+
+
+def to_model_plane(
+    points: np.ndarray, frame: Frame | None, *, model_size: float, n_points: int, spacing: str = "parameter"
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """One caller curve (n, 2) -> its model-plane points (n_points, 2) and where its own points sit along them.
+
+    frame None: the points are in the model plane already. The second value is the fraction in [0, 1] of the
+    model's points at which each of the caller's points sits (for `polyline_to_caller`); None when the model's
+    points are the caller's. Raises BeyondFloat32 where a model-plane coordinate does not fit in float32.
+    """
+    pts = np.asarray(points, np.float64)
+    m = frame.to_model(pts, model_size) if frame is not None else pts
+    fractions = None
+    if spacing == "arc_length":
+        fractions = arc_fractions(m)
+        m = resample(m, n_points)
+    elif len(pts) != n_points:
+        fractions = np.linspace(0.0, 1.0, len(pts))
+        m = resample(m, n_points, spacing=spacing)
+    if not (np.abs(m) <= F32_MAX).all():  # also false for inf and nan
+        raise BeyondFloat32("model-plane coordinates beyond float32 range")
+    return m, fractions
+
+
+def polyline_to_caller(
+    out: np.ndarray,
+    frame: Frame | None,
+    *,
+    model_size: float,
+    n_points: int | None = None,
+    spacing: str = "parameter",
+    fractions: np.ndarray | None = None,
+) -> np.ndarray:
+    """A model-plane result (m, 2) -> the caller's frame and length, interpolated along the polyline.
+
+    n_points given: that many points, spaced as `spacing` says (with "parameter" and m points, the result's own).
+    Otherwise at `fractions` of its index range (the caller's positions from `to_model_plane`), or its points as
+    they are. frame None: left in the model plane.
+    """
+    curve = np.asarray(out, np.float64)
+    if n_points is not None:
+        curve = resample(curve, n_points, spacing=spacing)
+    elif fractions is not None:
+        curve = at_fractions(curve, fractions)
+    return frame.from_model(curve, model_size) if frame is not None else curve
+
+
+def spline_to_caller(
+    control_points: np.ndarray,
+    frame: Frame | None,
+    *,
+    model_size: float,
+    degree: int,
+    model_points: int,
+    n_points: int | None = None,
+    spacing: str = "parameter",
+    fractions: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A model-plane clamped uniform B-spline (n_ctrl, 2) -> its points, control points and the points' parameters
+    in the caller's frame and order.
+
+    The points are the spline's exactly, at parameters: n_points of them, evenly in the parameter or (spacing
+    "arc_length") in arc length; else at `fractions` (the caller's positions); else `model_points` evenly in the
+    parameter (the model's own points).
+    """
+    c = np.asarray(control_points, np.float64)
+    if n_points is not None and spacing == "arc_length":
+        u = arc_length_params(c, n_points, degree=degree)
+    elif n_points is None and fractions is not None:
+        u = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
+    else:  # evenly in the parameter: the basis is the same for every curve (cached by sample_bspline)
+        u = None
+        count = n_points or model_points
+    if u is None:
+        curve, u = sample_bspline(c, count, degree), np.linspace(0.0, 1.0, count)
+    else:
+        curve = evaluate_bspline(c, u, degree)
+    if frame is not None:  # a similarity maps a spline's points as it maps its control points
+        curve, c = frame.from_model(curve, model_size), frame.from_model(c, model_size)
+        u = frame.to_caller_params(u)
+    return curve, c, u
