@@ -22,7 +22,7 @@ route shapes the JSON. Every rejected request gets the same JSON error body:
 from __future__ import annotations
 
 import logging
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Callable
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
 from functools import partial
@@ -57,47 +57,14 @@ log = logging.getLogger("service")
 
 @asynccontextmanager
 async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
+    """Load the model (unless the app was given one), start the micro-batcher where asked, serve, and undo it all."""
     settings: Settings = app.state.settings
     owned = app.state.runtime is None
     slots = app.state.slots
     if owned:
-        config = session_config(settings)
-        log.info(
-            "onnxruntime: %d session pairs of %d threads (%s), %d inferences at once (%s), spinning %s",
-            config.sessions,
-            config.intra_op_threads,
-            "CURVE_VAE_INTRA_OP_THREADS" if settings.intra_op_threads else f"{available_cpus()} CPUs shared out",
-            slots,
-            "CURVE_VAE_INFERENCE_CONCURRENCY" if settings.inference_concurrency else f"{settings.workers} workers",
-            "on" if config.spinning else "off",
-        )
-        try:
-            app.state.runtime = await anyio.to_thread.run_sync(
-                partial(
-                    CurveRuntime.load,
-                    settings.model_dir,
-                    providers=settings.providers,
-                    batch_size=settings.batch_size,
-                    sessions=config,
-                )
-            )
-        except ModelLoadError as e:
-            log.error("cannot serve the model: %s", e)
-            raise
+        app.state.runtime = await _load_runtime(settings, slots)
     runtime: CurveRuntime = app.state.runtime
-    batcher = None
-    if settings.micro_batch:
-        batcher = GraphBatcher(
-            runtime.pool,
-            {"encoder": runtime.encoder.get_inputs()[0].name, "decoder": runtime.decoder.get_inputs()[0].name},
-            max_rows=settings.micro_batch_rows,
-            max_wait=settings.micro_batch_wait_ms / 1e3,
-            runners=app.state.slots,
-            registry=app.state.metrics.registry,
-        )
-        app.state.executor.shutdown(wait=False)
-        # Threads enough for a full batch of single-curve requests to wait together; runs are bounded by the slots.
-        app.state.executor = inference_executor(app.state.slots + settings.micro_batch_rows, batcher)
+    batcher = _start_batcher(app, settings, runtime) if settings.micro_batch else None
     app.state.batcher = batcher
     app.state.ready = True
     app.state.metrics.ready.set(1)
@@ -121,6 +88,49 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
             app.state.runtime = None
 
 
+async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
+    """The model of `settings`, loaded in a worker thread with the sessions the CPUs allow (logged, with why)."""
+    config = session_config(settings)
+    log.info(
+        "onnxruntime: %d session pairs of %d threads (%s), %d inferences at once (%s), spinning %s",
+        config.sessions,
+        config.intra_op_threads,
+        "CURVE_VAE_INTRA_OP_THREADS" if settings.intra_op_threads else f"{available_cpus()} CPUs shared out",
+        slots,
+        "CURVE_VAE_INFERENCE_CONCURRENCY" if settings.inference_concurrency else f"{settings.workers} workers",
+        "on" if config.spinning else "off",
+    )
+    try:
+        return await anyio.to_thread.run_sync(
+            partial(
+                CurveRuntime.load,
+                settings.model_dir,
+                providers=settings.providers,
+                batch_size=settings.batch_size,
+                sessions=config,
+            )
+        )
+    except ModelLoadError as e:
+        log.error("cannot serve the model: %s", e)
+        raise
+
+
+def _start_batcher(app: FastAPI, settings: Settings, runtime: CurveRuntime) -> GraphBatcher:
+    """The micro-batcher over the runtime's sessions, and inference threads whose graph runs go through it."""
+    batcher = GraphBatcher(
+        runtime.pool,
+        {"encoder": runtime.encoder.get_inputs()[0].name, "decoder": runtime.decoder.get_inputs()[0].name},
+        max_rows=settings.micro_batch_rows,
+        max_wait=settings.micro_batch_wait_ms / 1e3,
+        runners=app.state.slots,
+        registry=app.state.metrics.registry,
+    )
+    app.state.executor.shutdown(wait=False)
+    # Threads enough for a full batch of single-curve requests to wait together; runs are bounded by the slots.
+    app.state.executor = inference_executor(app.state.slots + settings.micro_batch_rows, batcher)
+    return batcher
+
+
 def inference_executor(threads: int, batcher: GraphBatcher | None = None) -> ThreadPoolExecutor:
     """The inference threads: the app's own pool, one thread per slot (not anyio's default pool of 40, shared with
     every sync call of the app, which let more inferences run at once than the CPUs hold); with micro-batching,
@@ -142,6 +152,19 @@ data, or by arc length) and come back at their own length, or `n_points`. Errors
 """
 
 
+OPENAPI_TAGS = [
+    {"name": "curves", "description": "Encode, decode, reconstruct, interpolate, sample and augment curves."},
+    {"name": "design", "description": "B-spline fits and surfaces of revolution: geometry, no model needed."},
+    {"name": "operations", "description": "Health, readiness, model metadata and metrics."},
+    {
+        "name": "open inference protocol",
+        "description": "The Open Inference Protocol (KServe v2), as NVIDIA Triton and KServe speak it: the "
+        "same client code calls this server or Triton serving `curve-vae triton`'s export. Raw model-plane "
+        'tensors (no frames, no resampling); errors are `{"error": "..."}`.',
+    },
+]
+
+
 def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None = None) -> FastAPI:
     """The app for `settings` (default: the environment). Pass a loaded `runtime` to share one between apps."""
     from curve_vae import __version__
@@ -155,17 +178,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
         docs_url=None,  # served offline by service.web
         redoc_url=None,
         generate_unique_id_function=lambda route: route.name,  # operationId "encode", not "encode_encode_post"
-        openapi_tags=[
-            {"name": "curves", "description": "Encode, decode, reconstruct, interpolate, sample and augment curves."},
-            {"name": "design", "description": "B-spline fits and surfaces of revolution: geometry, no model needed."},
-            {"name": "operations", "description": "Health, readiness, model metadata and metrics."},
-            {
-                "name": "open inference protocol",
-                "description": "The Open Inference Protocol (KServe v2), as NVIDIA Triton and KServe speak it: the "
-                "same client code calls this server or Triton serving `curve-vae triton`'s export. Raw model-plane "
-                'tensors (no frames, no resampling); errors are `{"error": "..."}`.',
-            },
-        ],
+        openapi_tags=OPENAPI_TAGS,
     )
     app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
     app.state.metrics = Metrics()
@@ -180,7 +193,17 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.add_exception_handler(RequestValidationError, on_validation_error)
     app.add_exception_handler(InputError, on_input_error)
     app.add_exception_handler(HTTPException, on_http_error)
-    # Added last = outermost: metrics see everything, CORS headers reach 413s too.
+    _add_request_middleware(app, settings)
+    app.openapi = _openapi_of(app, settings)  # type: ignore[method-assign]
+    routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *oip_router.routes, *app.routes)
+    paths = [r.path for r in routes if hasattr(r, "path")]
+    app.add_middleware(MetricsMiddleware, metrics=app.state.metrics, known_paths=paths)  # last: outermost
+    return app
+
+
+def _add_request_middleware(app: FastAPI, settings: Settings) -> None:
+    """The body limit, API keys and CORS. Each middleware added wraps those added before it: CORS headers reach
+    the body limit's 413s too, and the metrics, added after these, see everything."""
     app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes)
     if settings.api_keys:  # outside the body limit: a request without a key is refused before its body is read
         app.add_middleware(ApiKeyMiddleware, keys=settings.api_keys)
@@ -201,8 +224,16 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
             max_age=600,
         )
 
+
+def _openapi_of(app: FastAPI, settings: Settings) -> Callable[[], dict[str, Any]]:
+    """The app's `openapi`: FastAPI's schema, with the bounds of these settings and of the loaded model stated in it
+    (built again when the loaded model's latent size changes)."""
+
+    def runtime_dim() -> int | None:
+        rt = app.state.runtime
+        return rt.latent_dim if rt is not None else None
+
     def openapi() -> dict[str, Any]:
-        """FastAPI's schema, with the bounds of these settings and of the loaded model stated in it."""
         if app.openapi_schema is None or getattr(app.state, "openapi_for", None) != runtime_dim():
             app.openapi_schema = None
             app.state.openapi_for = runtime_dim()
@@ -213,15 +244,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
             )
         return app.openapi_schema
 
-    def runtime_dim() -> int | None:
-        rt = app.state.runtime
-        return rt.latent_dim if rt is not None else None
-
-    app.openapi = openapi  # type: ignore[method-assign]
-    routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *oip_router.routes, *app.routes)
-    paths = [r.path for r in routes if hasattr(r, "path")]
-    app.add_middleware(MetricsMiddleware, metrics=app.state.metrics, known_paths=paths)
-    return app
+    return openapi
 
 
 def create_app_from_env() -> FastAPI:

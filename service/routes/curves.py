@@ -1,8 +1,9 @@
 """The model's routes: encode, decode, reconstruct, interpolate, sample, augment. Each validates, calls the
 runtime in a worker thread (deps.run_inference) and shapes the JSON.
 
-Length (~420 lines): six routes, each ~20 lines of work and ~40 of OpenAPI examples beside the
-route they document; one router per resource, as FastAPI's bigger-applications layout has it."""
+Length (~450 lines): six routes, each ~20 lines of work and ~40 of OpenAPI examples beside the
+route they document, with their .npy bodies and /augment's format checks and .npy stream beside
+them; one router per resource, as FastAPI's bigger-applications layout has it."""
 
 from __future__ import annotations
 
@@ -38,6 +39,7 @@ from curve_vae.service.npy_bodies import OPENAPI_BODY as NPY_BODY
 from curve_vae.service.npy_bodies import npy_route
 from curve_vae.service.payloads import augment_body, frames_json, sample_body, with_metrics, with_output
 from curve_vae.service.runtime import CurveRuntime, fresh_seed
+from curve_vae.service.settings import Settings
 
 ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'
 curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
@@ -353,18 +355,7 @@ async def augment(
     each in the blend of its sources' frames: new training data between the given curves. Item i of the sequence
     depends only on (seed, i): page with `offset`, or stream any count as .npy with `format` "npy"."""
     curves = check_curves(req.curves, settings)
-    limit, setting = (
-        (settings.max_curves, "CURVE_VAE_MAX_CURVES")
-        if req.format == "json"
-        else (settings.max_stream_curves, "CURVE_VAE_MAX_STREAM_CURVES")
-    )
-    if req.count > limit:
-        more = "; page through more with offset, or stream them with format npy" if req.format == "json" else ""
-        raise InputError(("count",), f"at most {limit}, got {req.count} (format {req.format}, {setting}){more}")
-    if req.metrics and req.format == "npy":
-        raise InputError(("metrics",), "only with format json: a .npy body carries the curves alone")
-    if req.output != "points" and req.format == "npy":
-        raise InputError(("output",), 'only "points" with format npy: a .npy body carries the curves\' points alone')
+    _check_augment_format(req, settings)
     splines = splines_wanted(req.output, runtime)
     check_n_points(req.n_points, settings)
     seed = fresh_seed() if req.seed is None else req.seed
@@ -392,6 +383,22 @@ async def augment(
         return JSON(with_output(body, splines, req.output))
 
     return await run_inference(request, "/augment", req.count, work)
+
+
+def _check_augment_format(req: s.AugmentRequest, settings: Settings) -> None:
+    """What the body's format allows: the count (a page of JSON, or a stream of .npy) and what a .npy body can carry."""
+    limit, setting = (
+        (settings.max_curves, "CURVE_VAE_MAX_CURVES")
+        if req.format == "json"
+        else (settings.max_stream_curves, "CURVE_VAE_MAX_STREAM_CURVES")
+    )
+    if req.count > limit:
+        more = "; page through more with offset, or stream them with format npy" if req.format == "json" else ""
+        raise InputError(("count",), f"at most {limit}, got {req.count} (format {req.format}, {setting}){more}")
+    if req.metrics and req.format == "npy":
+        raise InputError(("metrics",), "only with format json: a .npy body carries the curves alone")
+    if req.output != "points" and req.format == "npy":
+        raise InputError(("output",), 'only "points" with format npy: a .npy body carries the curves\' points alone')
 
 
 async def _stream_augment(

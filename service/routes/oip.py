@@ -162,31 +162,48 @@ def _session(request: Request, model: str) -> Any:
     return runtime, (runtime.encoder if model == "encoder" else runtime.decoder)
 
 
-def _model_routes(model: str) -> None:
-    graph = "curves (B, n_points, 2) → mean, log_var" if model == "encoder" else "latent → curves, control_points"
-
+def _metadata_route(model: str) -> Callable[[Request], Awaitable[dict[str, Any]]]:
     async def model_metadata(request: Request) -> dict[str, Any]:
         runtime, session = _session(request, model)
         return oip.metadata(model, str(runtime.manifest.get("version", "")), oip.signature(session))
 
+    model_metadata.__doc__ = (
+        f"The {model}'s inputs and outputs (name, datatype, shape with -1 for the batch axis), read from its ONNX "
+        "session, and the model's version."
+    )
+    return model_metadata
+
+
+def _ready_route(model: str) -> Callable[[Request], Awaitable[dict[str, Any]]]:
     async def model_ready(request: Request) -> dict[str, Any]:
         runtime_of(request)
         return {"name": model, "ready": True}
 
+    model_ready.__doc__ = f"200 once the {model} is loaded, 503 before that."
+    return model_ready
+
+
+async def _infer_request(request: Request, model: str, session: Any) -> oip.Request:
+    """The body of an infer request, checked against the session's tensors; OipError says what does not fit."""
+    if "inference-header-content-length" in request.headers:
+        raise OipError(
+            "binary tensor data (Triton's binary data extension) is not served here: send JSON tensors "
+            "(tritonclient.http: binary_data=False on every InferInput and InferRequestedOutput)"
+        )
+    try:
+        body = json.loads(await request.body())
+    except (ValueError, RecursionError) as e:
+        raise OipError(f"body: not JSON ({e})") from None
+    return oip.parse_request(body, model, oip.signature(session), max_batch=request.app.state.settings.max_curves)
+
+
+def _infer_route(model: str) -> Callable[[Request], Awaitable[Response]]:
+    graph = "curves (B, n_points, 2) → mean, log_var" if model == "encoder" else "latent → curves, control_points"
+
     async def model_infer(request: Request) -> Response:
         try:
             runtime, session = _session(request, model)
-            if "inference-header-content-length" in request.headers:
-                raise OipError(
-                    "binary tensor data (Triton's binary data extension) is not served here: send JSON tensors "
-                    "(tritonclient.http: binary_data=False on every InferInput and InferRequestedOutput)"
-                )
-            try:
-                body = json.loads(await request.body())
-            except (ValueError, RecursionError) as e:
-                raise OipError(f"body: not JSON ({e})") from None
-            sig = oip.signature(session)
-            req = oip.parse_request(body, model, sig, max_batch=request.app.state.settings.max_curves)
+            req = await _infer_request(request, model, session)
             version = str(runtime.manifest.get("version", ""))
 
             def work() -> Response:
@@ -198,20 +215,20 @@ def _model_routes(model: str) -> None:
         except OipError as e:
             return oip_error(e.status, e.msg)
 
-    model_metadata.__doc__ = (
-        f"The {model}'s inputs and outputs (name, datatype, shape with -1 for the batch axis), read from its ONNX "
-        "session, and the model's version."
-    )
-    model_ready.__doc__ = f"200 once the {model} is loaded, 503 before that."
     model_infer.__doc__ = (
         f"Run the {model} graph ({graph}) on tensors in the protocol's JSON format; each output comes back "
         f"flattened row-major with its shape. {RAW_TENSORS} Batches of up to CURVE_VAE_MAX_CURVES rows, run like "
         "every other model route (same inference threads, slots and queue). Triton's binary data extension is not "
         "served: JSON tensors only."
     )
+    return model_infer
+
+
+def _model_routes(model: str) -> None:
+    """The protocol's three routes of one model: metadata, ready and infer."""
     oip_router.add_api_route(
         f"/v2/models/{model}",
-        model_metadata,
+        _metadata_route(model),
         methods=["GET"],
         response_model=ModelMetadata,
         responses=oip_errors(401, 503),
@@ -221,7 +238,7 @@ def _model_routes(model: str) -> None:
     )
     oip_router.add_api_route(
         f"/v2/models/{model}/ready",
-        model_ready,
+        _ready_route(model),
         methods=["GET"],
         response_model=ModelReady,
         responses=oip_errors(401, 503),
@@ -231,7 +248,7 @@ def _model_routes(model: str) -> None:
     )
     oip_router.add_api_route(
         f"/v2/models/{model}/infer",
-        model_infer,
+        _infer_route(model),
         methods=["POST"],
         response_model=InferResponse,
         responses=oip_errors(400, 401, 413, 503, 504),
