@@ -5,9 +5,9 @@ architecture, `losses` owns the objective. Run under `torchrun --nproc-per-node 
 data-parallel training (gloo on CPU, nccl on GPU); a single process needs no launcher.
 Checkpoint files are training/checkpoint.py's.
 
-Length (~460 lines): the step, the schedules, the clock of a time budget and the run's named steps share
-RunState and the DDP process; `train()` itself (~110 lines) is the epoch loop with its record, and is the
-next to shorten (an epoch's row and checkpoint built by helpers).
+Length (~510 lines): the step, the schedules, the clock of a time budget and the run's named steps share
+RunState, _Parts (model, optimiser, schedule, clock, generator) and the DDP process; `train()` itself
+(~60 lines) reads top to bottom: set-up, then each epoch's pass, validation, record and stop rules.
 """
 
 from __future__ import annotations
@@ -258,20 +258,31 @@ def _load_splits(
     return torch.from_numpy(np.ascontiguousarray(train_np)), torch.from_numpy(np.ascontiguousarray(ds.val))
 
 
+@dataclass
+class _Parts:
+    """What the steps change beside RunState, and a checkpoint keeps: the model, its optimiser and schedule, the
+    clock of the time budget (the schedule's, on a budget) and the generator of each epoch's order."""
+
+    model: VAE
+    opt: torch.optim.Optimizer
+    sched: Any
+    clock: Clock
+    gen: np.random.Generator
+
+
+def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_per_epoch: int) -> _Parts:
+    model = VAE(model_cfg).to(proc.device)
+    opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
+    clock = Clock(cfg.time_budget, 0.0)
+    return _Parts(model, opt, _make_schedule(opt, cfg, steps_per_epoch, clock), clock, np.random.default_rng(cfg.seed))
+
+
 def _restore(
-    proc: _Process,
-    last: Path,
-    model: VAE,
-    opt: torch.optim.Optimizer,
-    sched: Any,
-    cfg: TrainConfig,
-    gen: np.random.Generator,
-    *,
-    resume: bool,
-    init_from: str | Path | None,
+    proc: _Process, last: Path, parts: _Parts, cfg: TrainConfig, *, resume: bool, init_from: str | Path | None
 ) -> RunState:
     """Resume from `last` (weights, optimiser, schedule, RNG, run state) or start anew, from `init_from`'s weights
     if given; the state the run starts from."""
+    model, sched = parts.model, parts.sched
     if resume and last.exists():
         ckpt = load_checkpoint(last)
         was = ckpt["train_config"]["epochs"]
@@ -281,11 +292,11 @@ def _restore(
                 "or start a new run directory (use --init-from to start from its weights)"
             )
         model.load_state_dict(ckpt["model"])
-        opt.load_state_dict(ckpt["optimizer"])
+        parts.opt.load_state_dict(ckpt["optimizer"])
         if sched is not None and ckpt.get("scheduler") is not None:
             sched.load_state_dict(ckpt["scheduler"])
         torch.set_rng_state(ckpt["rng"]["torch"])
-        gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
+        parts.gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
         state = RunState(**ckpt["state"])
         proc.say(f"resumed {last} at epoch {state.epoch}/{cfg.epochs}")
         return state
@@ -326,13 +337,15 @@ def _budget_bar(cfg: TrainConfig, state: RunState, shown: bool) -> tqdm | None:
     )
 
 
-def _agreed_val_mse(proc: _Process, model: VAE, val: torch.Tensor) -> float:
-    """The validation MSE, rank 0's on every process, so that all stop together."""
-    val_mse = validation_mse(model, val, device=proc.device)
+def _validate(proc: _Process, parts: _Parts, val: torch.Tensor, cfg: TrainConfig) -> float:
+    """The validation MSE, rank 0's on every process, so that all stop together; a plateau schedule steps on it."""
+    val_mse = validation_mse(parts.model, val, device=proc.device)
     if proc.distributed:
         v = torch.tensor([val_mse], dtype=torch.float64)
         dist.broadcast(v, 0)
         val_mse = float(v)
+    if parts.sched is not None and cfg.schedule == "plateau":
+        parts.sched.step(val_mse)
     return val_mse
 
 
@@ -351,6 +364,87 @@ def _record_epoch(run_dir: Path, ckpt: dict[str, Any], row: dict[str, float], im
         f"{' *' if improved else ''}  {row['curves_per_s']:.0f} curves/s",
         flush=True,
     )
+
+
+def _steps_per_epoch(n_curves: int, proc: _Process, cfg: TrainConfig) -> int:
+    """Full batches per epoch on each process (the ragged last batch is dropped)."""
+    steps = n_curves // proc.world // (cfg.batch_size // proc.world)
+    if steps < 1:
+        raise ValueError(f"{n_curves} training curves are fewer than one batch of {cfg.batch_size}")
+    return steps
+
+
+def _write_config(run_dir: Path, configs: dict[str, Any]) -> None:
+    run_dir.mkdir(parents=True, exist_ok=True)
+    (run_dir / "config.json").write_text(json.dumps(configs, indent=2))
+
+
+def _epoch_order(gen: np.random.Generator, n_curves: int, proc: _Process, per_epoch: int) -> torch.Tensor:
+    """This process's share of a fresh permutation (the same on every rank), `per_epoch` curves."""
+    perm = torch.from_numpy(gen.permutation(n_curves))
+    return perm[proc.rank :: proc.world][:per_epoch]
+
+
+def _epoch_bar(cfg: TrainConfig, state: RunState, n_curves: int, shown: bool, budget_bar: tqdm | None):
+    """The coming epoch's bar, closed with the epoch: the run's time-budget bar (left open), or the epoch's curves."""
+    if budget_bar is not None:
+        return nullcontext(budget_bar)
+    return tqdm(
+        total=n_curves,
+        desc=f"epoch {state.epoch + 1}/{cfg.epochs}",
+        unit="curve",
+        disable=not shown,
+        leave=False,
+        dynamic_ncols=True,
+    )
+
+
+def _close_epoch(
+    state: RunState, parts: _Parts, terms: dict[str, float], val_mse: float, seconds: float, cfg: TrainConfig
+) -> tuple[dict[str, float], bool]:
+    """Count the epoch into `state` (training time, its history row, the best validation MSE); the row and whether
+    it improved."""
+    state.epoch += 1
+    state.trained_seconds = parts.clock.spent
+    steps = terms.pop("steps")
+    row = {
+        "epoch": state.epoch,
+        **{f"train_{k}": v for k, v in terms.items()},
+        "val_mse": val_mse,
+        "lr": parts.opt.param_groups[0]["lr"],
+        "seconds": seconds,
+        "curves_per_s": steps * cfg.batch_size / seconds,
+        "trained_seconds": state.trained_seconds,
+    }
+    state.history.append(row)
+    improved = val_mse < state.best_val
+    if improved:
+        state.best_val, state.best_epoch = val_mse, state.epoch
+    return row, improved
+
+
+def _checkpoint(configs: dict[str, Any], parts: _Parts, state: RunState) -> dict[str, Any]:
+    """The checkpoint of the run as it stands: its configs, weights, and what a resume needs."""
+    return {
+        "version": CHECKPOINT_VERSION,
+        "model_config": configs["model"],
+        "data_config": configs["data"],
+        "train_config": configs["train"],
+        "model": parts.model.state_dict(),
+        "optimizer": parts.opt.state_dict(),
+        "scheduler": parts.sched.state_dict() if parts.sched is not None else None,
+        "state": asdict(state),
+        "rng": _rng_state(parts.gen),
+    }
+
+
+def _stop_reason(cfg: TrainConfig, state: RunState, clock: Clock) -> str | None:
+    """Why the run stops before its last epoch (patience out, time budget spent), or None."""
+    if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
+        return f"early stop: no better validation MSE for {cfg.patience} epochs"
+    if clock.over():
+        return f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs"
+    return None
 
 
 def train(
@@ -379,82 +473,33 @@ def train(
         torch.manual_seed(cfg.seed)
         random.seed(cfg.seed)
         data, val = _load_splits(proc, data_cfg, cfg, data_cache, data_workers)
-        per_rank = cfg.batch_size // proc.world
-        steps_per_epoch = len(data) // proc.world // per_rank
-        if steps_per_epoch < 1:
-            raise ValueError(f"{len(data)} training curves are fewer than one batch of {cfg.batch_size}")
-
-        model = VAE(model_cfg).to(proc.device)
-        opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
-        clock = Clock(cfg.time_budget, 0.0)
-        sched = _make_schedule(opt, cfg, steps_per_epoch, clock)
-        gen = np.random.default_rng(cfg.seed)
-        state = _restore(proc, run_dir / "last.pt", model, opt, sched, cfg, gen, resume=resume, init_from=init_from)
-        clock.spent = state.trained_seconds
-        net = _wrap(proc, model, cfg)
+        steps_per_epoch = _steps_per_epoch(len(data), proc, cfg)
+        parts = _new_parts(proc, model_cfg, cfg, steps_per_epoch)
+        state = _restore(proc, run_dir / "last.pt", parts, cfg, resume=resume, init_from=init_from)
+        parts.clock.spent = state.trained_seconds
+        net = _wrap(proc, parts.model, cfg)  # after the restore: DDP starts every process from rank 0's weights
+        configs = {"model": asdict(model_cfg), "data": asdict(data_cfg), "train": asdict(cfg)}
         if proc.rank == 0:
-            run_dir.mkdir(parents=True, exist_ok=True)
-            (run_dir / "config.json").write_text(
-                json.dumps({"model": asdict(model_cfg), "data": asdict(data_cfg), "train": asdict(cfg)}, indent=2)
-            )
+            _write_config(run_dir, configs)
 
         end = cfg.epochs if not stop_after else min(cfg.epochs, state.epoch + stop_after)
         shown = progress and proc.rank == 0
         budget_bar = _budget_bar(cfg, state, shown)
         while state.epoch < end:
             t0 = time.perf_counter()
-            perm = torch.from_numpy(gen.permutation(len(data)))  # same on every rank
-            order = perm[proc.rank :: proc.world][: steps_per_epoch * per_rank]
-            bar = budget_bar or tqdm(
-                total=len(order),
-                desc=f"epoch {state.epoch + 1}/{cfg.epochs}",
-                unit="curve",
-                disable=not shown,
-                leave=False,
-                dynamic_ncols=True,
-            )
-            with clock:
-                terms = train_one_epoch(net, data, order, opt, sched, cfg, proc.device, bar=bar, clock=clock)
-            if budget_bar is None:
-                bar.close()
+            order = _epoch_order(parts.gen, len(data), proc, steps_per_epoch * (cfg.batch_size // proc.world))
+            with _epoch_bar(cfg, state, len(order), shown, budget_bar) as bar, parts.clock as clock:
+                terms = train_one_epoch(
+                    net, data, order, parts.opt, parts.sched, cfg, proc.device, bar=bar, clock=clock
+                )
             train_time = time.perf_counter() - t0
-            state.trained_seconds = clock.spent
-            val_mse = _agreed_val_mse(proc, model, val)
-            if sched is not None and cfg.schedule == "plateau":
-                sched.step(val_mse)
-            state.epoch += 1
-            steps = terms.pop("steps")
-            row = {
-                "epoch": state.epoch,
-                **{f"train_{k}": v for k, v in terms.items()},
-                "val_mse": val_mse,
-                "lr": opt.param_groups[0]["lr"],
-                "seconds": train_time,
-                "curves_per_s": steps * cfg.batch_size / train_time,
-                "trained_seconds": state.trained_seconds,
-            }
-            state.history.append(row)
-            improved = val_mse < state.best_val
-            if improved:
-                state.best_val, state.best_epoch = val_mse, state.epoch
+            val_mse = _validate(proc, parts, val, cfg)
+            row, improved = _close_epoch(state, parts, terms, val_mse, train_time, cfg)
             if proc.rank == 0:
-                ckpt = {
-                    "version": CHECKPOINT_VERSION,
-                    "model_config": asdict(model_cfg),
-                    "data_config": asdict(data_cfg),
-                    "train_config": asdict(cfg),
-                    "model": model.state_dict(),
-                    "optimizer": opt.state_dict(),
-                    "scheduler": sched.state_dict() if sched is not None else None,
-                    "state": asdict(state),
-                    "rng": _rng_state(gen),
-                }
-                _record_epoch(run_dir, ckpt, row, improved, cfg)
-            if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
-                proc.say(f"early stop: no better validation MSE for {cfg.patience} epochs")
-                break
-            if clock.over():
-                proc.say(f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs")
+                _record_epoch(run_dir, _checkpoint(configs, parts, state), row, improved, cfg)
+            stop = _stop_reason(cfg, state, parts.clock)
+            if stop:
+                proc.say(stop)
                 break
         if budget_bar is not None:
             budget_bar.close()
