@@ -162,6 +162,58 @@ def generation_report(
 MIN_FIGURE_CURVES = 32  # the interpolation figures take curves 0-13; t-SNE needs more points than its perplexity
 
 
+def _test_set_reports(
+    encode: Encoder, decode: Decoder, test_sets: dict[str, np.ndarray], out: Path, figures: bool
+) -> dict[str, Any]:
+    """Each test set's report (reconstruction, and interpolation where it has a pair), with its figures if asked."""
+    from curve_vae.training.figures import plot_reconstructions, plot_tangents
+
+    reports: dict[str, Any] = {}
+    for name, curves in test_sets.items():
+        recon = batched(lambda x: decode(encode(x)), curves)
+        reports[name] = evaluate_set(curves, recon)
+        if len(curves) >= 2:  # a data set of one's own may hold a single test curve: no pairs to interpolate
+            reports[name]["interpolation"] = interpolation_report(encode, decode, curves)
+        if figures:
+            plot_reconstructions(curves, recon, out / f"reconstructions_{name}.png", n=min(8, len(curves)))
+            plot_tangents([curves[0], recon[0]], ["input", "reconstruction"], out / f"tangents_{name}.png")
+    return reports
+
+
+def _interpolation_figures(encode: Encoder, decode: Decoder, first: np.ndarray, out: Path) -> None:
+    """The paper's interpolation figures and the latent t-SNE, from the first test set's curves."""
+    from curve_vae.training.figures import (
+        plot_latent_tsne,
+        plot_latent_vs_pointwise,
+        plot_pair_interpolation,
+        plot_triplet,
+    )
+
+    plot_pair_interpolation(
+        encode, decode, [(first[0], first[1]), (first[2], first[3])], out / "interpolation_pair.png"
+    )
+    plot_triplet(encode, decode, first[4:7], out / "interpolation_triplet.png")
+    plot_latent_vs_pointwise(
+        encode,
+        decode,
+        [(first[i % len(first)], first[(i + 1) % len(first)]) for i in (8, 10, 12)],
+        out / "interpolation_latent_vs_pointwise.png",
+    )
+    plot_latent_tsne(encode, first, out / "latent_tsne.png")
+
+
+def _family_suite(runtime: Any, suite_count: int, out: Path, figures: bool) -> dict[str, Any]:
+    """The family suite's report (training/suite.py) on the paper's test split, with its figure if asked."""
+    from curve_vae.training.figures import plot_suite
+    from curve_vae.training.suite import paper_test_split, run_suite, suite_sets
+
+    paper = paper_test_split()  # whatever the model was trained on: the suite's paper sets are the paper's
+    report = run_suite(runtime, paper, count=suite_count)
+    if figures:
+        plot_suite(runtime, suite_sets(paper, suite_count), out / "families.png")
+    return report
+
+
 def run_evaluation(
     encode: Encoder,
     decode: Decoder,
@@ -179,28 +231,10 @@ def run_evaluation(
     generation report of its priors, the first test set held out and the second as the real reference,
     and with suite_count > 0 the family suite (training/suite.py) of that many curves per set.
     """
-    from curve_vae.training.figures import (
-        plot_latent_tsne,
-        plot_latent_vs_pointwise,
-        plot_pair_interpolation,
-        plot_reconstructions,
-        plot_samples,
-        plot_suite,
-        plot_tangents,
-        plot_training,
-        plot_triplet,
-    )
+    from curve_vae.training.figures import plot_samples, plot_training
 
     out = Path(out_dir)
-    report: dict[str, Any] = {"test_sets": {}}
-    for name, curves in test_sets.items():
-        recon = batched(lambda x: decode(encode(x)), curves)
-        report["test_sets"][name] = evaluate_set(curves, recon)
-        if len(curves) >= 2:  # a data set of one's own may hold a single test curve: no pairs to interpolate
-            report["test_sets"][name]["interpolation"] = interpolation_report(encode, decode, curves)
-        if figures:
-            plot_reconstructions(curves, recon, out / f"reconstructions_{name}.png", n=min(8, len(curves)))
-            plot_tangents([curves[0], recon[0]], ["input", "reconstruction"], out / f"tangents_{name}.png")
+    report: dict[str, Any] = {"test_sets": _test_set_reports(encode, decode, test_sets, out, figures)}
     first = next(iter(test_sets.values()))
     if runtime is not None and len(test_sets) >= 2:
         reference = list(test_sets.values())[1]
@@ -209,24 +243,9 @@ def run_evaluation(
             made = runtime.sample(16, seed=0)
             plot_samples(made.curves, first, out / "samples.png")
     if figures and len(first) >= MIN_FIGURE_CURVES:
-        plot_pair_interpolation(
-            encode, decode, [(first[0], first[1]), (first[2], first[3])], out / "interpolation_pair.png"
-        )
-        plot_triplet(encode, decode, first[4:7], out / "interpolation_triplet.png")
-        plot_latent_vs_pointwise(
-            encode,
-            decode,
-            [(first[i % len(first)], first[(i + 1) % len(first)]) for i in (8, 10, 12)],
-            out / "interpolation_latent_vs_pointwise.png",
-        )
-        plot_latent_tsne(encode, first, out / "latent_tsne.png")
+        _interpolation_figures(encode, decode, first, out)
     if runtime is not None and suite_count > 0:
-        from curve_vae.training.suite import paper_test_split, run_suite, suite_sets
-
-        paper = paper_test_split()  # whatever the model was trained on: the suite's paper sets are the paper's
-        report["families"] = run_suite(runtime, paper, count=suite_count)
-        if figures:
-            plot_suite(runtime, suite_sets(paper, suite_count), out / "families.png")
+        report["families"] = _family_suite(runtime, suite_count, out, figures)
     if figures and log_path is not None and log_path.exists():
         plot_training(log_path, out / "training.png")
     atomic_write_text(out / "report.json", json.dumps(report, indent=2) + "\n")

@@ -115,6 +115,56 @@ def model_size_of(curves: np.ndarray) -> float:
     return float(np.median(ext.max(axis=1)))
 
 
+def _export_graphs(model: VAE, out: Path) -> list[str]:
+    """encoder.onnx and decoder.onnx (with control_points from a B-spline head); their file names."""
+    cfg = model.cfg
+    _export(
+        _EncoderGraph(model),
+        torch.zeros(2, cfg.n_points, 2) + 64.0,
+        out / "encoder.onnx",
+        "curves",
+        ["mean", "log_var"],
+    )
+    dec_outputs = ["curves", "control_points"] if cfg.spline_ctrl else ["curves"]
+    _export(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", "latent", dec_outputs)
+    return ["encoder.onnx", "decoder.onnx"]
+
+
+def _graphs_manifest(cfg: ModelConfig) -> dict[str, Any]:
+    """The manifest's `graphs`: each graph's file and the shapes of its inputs and outputs."""
+    return {
+        "encoder": {
+            "file": "encoder.onnx",
+            "inputs": {"curves": ["batch", cfg.n_points, 2]},
+            "outputs": {"mean": ["batch", cfg.latent_dim], "log_var": ["batch", cfg.latent_dim]},
+        },
+        "decoder": {
+            "file": "decoder.onnx",
+            "inputs": {"latent": ["batch", cfg.latent_dim]},
+            "outputs": {
+                "curves": ["batch", cfg.n_points, 2],
+                **({"control_points": ["batch", cfg.spline_ctrl, 2]} if cfg.spline_ctrl else {}),
+            },
+        },
+    }
+
+
+def _prior_manifest(prior: LatentPrior, prior_info: dict[str, Any] | None) -> dict[str, Any]:
+    """The manifest's `prior`: its file, kind, components and how it was fitted."""
+    return {"file": PRIOR_FILE, "kind": "gaussian_mixture", "components": len(prior.weights), **(prior_info or {})}
+
+
+def _frame_manifest(cfg: ModelConfig, model_size: float) -> dict[str, Any]:
+    """The manifest's `frame`: the plane the graphs' curves live in and the size the model is used to."""
+    return {
+        "plane": [128.0, 128.0],
+        "center": [cfg.center, cfg.center],
+        "model_size": model_size,
+        "normalisation": f"inside the graphs: (x - {cfg.center}) / {cfg.scale}; I/O in plane pixels",
+        "sampling": f"{cfg.n_points} points evenly spaced in the B-spline parameter",
+    }
+
+
 def export(
     model: VAE,
     out_dir: str | Path,
@@ -136,16 +186,7 @@ def export(
     out.mkdir(parents=True, exist_ok=True)
     model = model.float().cpu().eval()
     cfg = model.cfg
-    _export(
-        _EncoderGraph(model),
-        torch.zeros(2, cfg.n_points, 2) + 64.0,
-        out / "encoder.onnx",
-        "curves",
-        ["mean", "log_var"],
-    )
-    dec_outputs = ["curves", "control_points"] if cfg.spline_ctrl else ["curves"]
-    _export(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", "latent", dec_outputs)
-    files = ["encoder.onnx", "decoder.onnx"]
+    files = _export_graphs(model, out)
     if prior is not None:
         prior.save(out / PRIOR_FILE)
         files.append(PRIOR_FILE)
@@ -161,41 +202,10 @@ def export(
         "n_points": cfg.n_points,
         "latent_dim": cfg.latent_dim,
         "files": {f: {"sha256": sha256(out / f), "bytes": (out / f).stat().st_size} for f in files},
-        "graphs": {
-            "encoder": {
-                "file": "encoder.onnx",
-                "inputs": {"curves": ["batch", cfg.n_points, 2]},
-                "outputs": {"mean": ["batch", cfg.latent_dim], "log_var": ["batch", cfg.latent_dim]},
-            },
-            "decoder": {
-                "file": "decoder.onnx",
-                "inputs": {"latent": ["batch", cfg.latent_dim]},
-                "outputs": {
-                    "curves": ["batch", cfg.n_points, 2],
-                    **({"control_points": ["batch", cfg.spline_ctrl, 2]} if cfg.spline_ctrl else {}),
-                },
-            },
-        },
+        "graphs": _graphs_manifest(cfg),
         **({"spline": spline_manifest(cfg)} if cfg.spline_ctrl else {}),
-        **(
-            {
-                "prior": {
-                    "file": PRIOR_FILE,
-                    "kind": "gaussian_mixture",
-                    "components": len(prior.weights),
-                    **(prior_info or {}),
-                }
-            }
-            if prior is not None
-            else {}
-        ),
-        "frame": {
-            "plane": [128.0, 128.0],
-            "center": [cfg.center, cfg.center],
-            "model_size": model_size,
-            "normalisation": f"inside the graphs: (x - {cfg.center}) / {cfg.scale}; I/O in plane pixels",
-            "sampling": f"{cfg.n_points} points evenly spaced in the B-spline parameter",
-        },
+        **({"prior": _prior_manifest(prior, prior_info)} if prior is not None else {}),
+        "frame": _frame_manifest(cfg, model_size),
         "model_config": asdict(cfg),
         "opset": OPSET,
         "exported_with": {"torch": torch.__version__, "python": platform.python_version()},
