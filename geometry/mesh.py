@@ -60,6 +60,17 @@ def revolve(
         raise ValueError(f"segments must be ≥ 3, got {segments}")
     if axis not in ("x", "y"):
         raise ValueError(f"axis must be 'x' or 'y', got {axis!r}")
+    pos, r, h, pole = _about_axis(p, axis, axis_position, pole_tolerance)
+    local, index = _rings(r, h, pole, segments)
+    faces = _outwards(local, _bands(index, pole, segments))
+    return Mesh(vertices=_world(local, axis, pos), faces=faces)
+
+
+def _about_axis(
+    p: np.ndarray, axis: str, axis_position: float | None, pole_tolerance: float
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """The axis position, and per profile point its distance from the axis, its height along it and whether it
+    is a pole (on the axis); a profile with points on both sides of the axis is refused."""
     across, along = (0, 1) if axis == "y" else (1, 0)
     pos = float(p[:, across].min()) if axis_position is None else float(axis_position)
     r = p[:, across] - pos
@@ -70,12 +81,15 @@ def revolve(
             f"profile crosses the axis (point {i} lies on the other side); move the axis or split the profile"
         )
     r = np.abs(r)
-    h = p[:, along]
-    pole = r <= pole_tolerance * size
-    theta = np.linspace(0.0, 2 * np.pi, segments, endpoint=False)
+    return pos, r, p[:, along], r <= pole_tolerance * size
 
+
+def _rings(r: np.ndarray, h: np.ndarray, pole: np.ndarray, segments: int) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The vertices (radial, along-axis, tangential; the axis through the origin) of each profile point's ring
+    (one vertex for a pole), and per profile point its ring's vertex ids."""
+    theta = np.linspace(0.0, 2 * np.pi, segments, endpoint=False)
     verts: list[np.ndarray] = []
-    index: list[np.ndarray] = []  # per profile point: its ring's vertex ids (1 for a pole)
+    index: list[np.ndarray] = []
     n = 0
     for ri, hi, is_pole in zip(r, h, pole):
         if is_pole:
@@ -85,8 +99,11 @@ def revolve(
         verts.append(ring)
         index.append(np.arange(n, n + len(ring)))
         n += len(ring)
-    local = np.concatenate(verts)  # (radial, along-axis, tangential), axis through the origin
+    return np.concatenate(verts), index
 
+
+def _bands(index: list[np.ndarray], pole: np.ndarray, segments: int) -> np.ndarray:
+    """The triangles between consecutive rings: a fan to a pole, two triangles a segment between two rings."""
     faces: list[np.ndarray] = []
     nxt = np.roll(np.arange(segments), -1)
     for a, b, pa, pb in zip(index[:-1], index[1:], pole[:-1], pole[1:]):
@@ -101,15 +118,20 @@ def revolve(
             faces.append(np.stack([a, b[nxt], b], axis=1))
     if not faces:
         raise ValueError("the profile lies on the axis: nothing to revolve")
-    f = np.concatenate(faces).astype(np.int64)
-    # Orient outwards: seen from the axis, every band's normal points away from it; the
-    # signed volume swept towards the axis is then positive (closed or open surface alike).
+    return np.concatenate(faces).astype(np.int64)
+
+
+def _outwards(local: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """The faces oriented outwards: seen from the axis, every band's normal points away from it; the signed
+    volume swept towards the axis is then positive (closed or open surface alike)."""
     tri = local[f]
     if np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() < 0:
-        f = f[:, ::-1]
-    # World coordinates: the revolution axis is the plane's y (or x) axis at the caller's position.
+        return f[:, ::-1]
+    return f
+
+
+def _world(local: np.ndarray, axis: str, pos: float) -> np.ndarray:
+    """World coordinates: the revolution axis is the plane's y (or x) axis at the caller's position."""
     if axis == "y":
-        vertices = local + np.array([pos, 0.0, 0.0])
-    else:
-        vertices = local[:, [1, 0, 2]] * np.array([1.0, 1.0, -1.0]) + np.array([0.0, pos, 0.0])  # a rotation
-    return Mesh(vertices=vertices, faces=f)
+        return local + np.array([pos, 0.0, 0.0])
+    return local[:, [1, 0, 2]] * np.array([1.0, 1.0, -1.0]) + np.array([0.0, pos, 0.0])  # a rotation

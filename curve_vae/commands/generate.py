@@ -121,7 +121,7 @@ def cmd_revolve(a: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def _add_sample(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("sample", help="new curves from the latent prior, offline (as POST /sample)")
     add_generate_options(s)
     s.add_argument(
@@ -148,6 +148,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_model_options(s)
     s.set_defaults(func=cmd_sample)
 
+
+def _add_augment(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("augment", help="new curves between given curves, offline (as POST /augment)")
     s.add_argument("input", help="seed curves: .json ([curve, …] or {curves: …}), .npy (N, n, 2), or - (stdin)")
     add_generate_options(s)
@@ -172,6 +174,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_model_options(s)
     s.set_defaults(func=cmd_augment)
 
+
+def _add_fit(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("fit", help="least-squares cubic B-spline of each curve (no model needed)")
     s.add_argument("input", help="curves: .json ([[x, y], …], a list of curves, or {curves: …}), .npy, or - (stdin)")
     s.add_argument("-o", "--output", default="-", help="JSON output file (default: - = stdout)")
@@ -197,6 +201,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--n-points", type=int, default=None, help="also write each fitted spline at this many points")
     s.set_defaults(func=cmd_fit)
 
+
+def _add_revolve(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("revolve", help="surface of revolution of a profile curve, as OBJ or STL (paper Fig. 12)")
     s.add_argument("input", help="one profile curve: .json, .npy, or - (stdin)")
     s.add_argument("-o", "--output", required=True, help="mesh file (.obj or .stl)")
@@ -212,3 +218,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="where that line is (default: through the profile's nearest point)",
     )
     s.set_defaults(func=cmd_revolve)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    _add_sample(sub)
+    _add_augment(sub)
+    _add_fit(sub)
+    _add_revolve(sub)

@@ -126,7 +126,7 @@ def cmd_triton(a: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def _add_export(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("export", help="export a checkpoint to ONNX + manifest (the service's model)")
     s.add_argument("--checkpoint", required=True, help="a training checkpoint (best.pt / last.pt)")
     s.add_argument("--out", default=DEFAULT_MODELS, help=f"output directory (default: {DEFAULT_MODELS})")
@@ -169,6 +169,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_suite_option(s)
     s.set_defaults(func=cmd_export)
 
+
+def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("evaluate", help="reconstruction MSE, smoothness and figures on the test sets")
     src = s.add_mutually_exclusive_group()
     src.add_argument(
@@ -191,6 +193,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_suite_option(s)
     s.set_defaults(func=cmd_evaluate)
 
+
+def _add_triton(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("triton", help="write an NVIDIA Triton model repository of an exported model's graphs")
     s.add_argument("--model-dir", default="", help="exported model directory (default: the shipped model, models/)")
     s.add_argument("--out", required=True, help="the repository directory (model folders are created in it)")
@@ -201,3 +205,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument("--force", action="store_true", help="replace model folders that exist")
     s.set_defaults(func=cmd_triton)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    _add_export(sub)
+    _add_evaluate(sub)
+    _add_triton(sub)
