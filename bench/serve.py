@@ -15,6 +15,7 @@ Markdown section (printed, and written with --markdown FILE) and JSON (--json FI
 from __future__ import annotations
 
 import argparse
+import functools
 import io
 import json
 import os
@@ -26,6 +27,7 @@ import sys
 import tempfile
 import time
 import urllib.request
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -210,6 +212,15 @@ def machine() -> dict[str, Any]:
     }
 
 
+VARIANTS = {  # run as B, each against a server started with these flags
+    "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
+    "access_log": (["--access-log", "true"], "B with the access log on"),
+    "workers": (["--workers", "2", "--inference-concurrency", "1"], "B over 2 worker processes"),
+    "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
+    "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),
+}
+
+
 def run(a: argparse.Namespace) -> dict[str, Any]:
     if shutil.which("wrk") is None:
         sys.exit("bench.serve: wrk is not installed: apt-get install -y wrk")
@@ -218,17 +229,43 @@ def run(a: argparse.Namespace) -> dict[str, Any]:
     command = "python -m bench.serve " + " ".join(sys.argv[1:])
     report: dict[str, Any] = {"machine": machine(), "seconds": secs, "command": command}
     print("in-process ceiling ...", file=sys.stderr)
-    inproc = ceiling.measure(model_dir, seconds=min(secs, 5.0), eager="C" in runs)
-    report["inprocess"] = inproc
+    report["inprocess"] = ceiling.measure(model_dir, seconds=min(secs, 5.0), eager="C" in runs)
+    load = functools.partial(_load, report, secs)
+    _default_server_runs(load, report, model_dir, runs, a.augment_count)
+    _variant_runs(load, model_dir, runs)
+    report["machine"]["load_after"] = os.getloadavg()
+    _ceiling_again(report, model_dir, secs)
+    return report
+
+
+def _load(
+    report: dict[str, Any],
+    secs: float,
+    name: str,
+    server: Server,
+    path: str,
+    body: bytes,
+    ctype: str = "application/json",
+    c: int = 16,
+) -> dict[str, Any]:
+    """One wrk run of `c` connections against `server`, its result stored in the report under `name`."""
+    print(f"{name} ...", file=sys.stderr)
+    report[name] = wrk(server, path, body, ctype, connections=c, seconds=secs)
+    return report[name]
+
+
+def _single() -> bytes:
+    """B's body: one curve, JSON, pose as_is."""
+    return json_body(ceiling.curves(1, seed=1), pose="as_is")
+
+
+def _default_server_runs(
+    load: Callable[..., dict[str, Any]], report: dict[str, Any], model_dir: Path, runs: set[str], augment_count: int
+) -> None:
+    """The runs against one server with the service's defaults: A, B, B_npy, latency, interpolate, augment."""
     one = ceiling.curves(1, seed=1)
     many = ceiling.curves(128, seed=2)
-    single = json_body(one, pose="as_is")
-
-    def load(name: str, server: Server, path: str, body: bytes, ctype: str = "application/json", c: int = 16):
-        print(f"{name} ...", file=sys.stderr)
-        report[name] = wrk(server, path, body, ctype, connections=c, seconds=secs)
-        return report[name]
-
+    single = _single()
     server = Server(model_dir)
     try:
         if "A" in runs:
@@ -247,26 +284,27 @@ def run(a: argparse.Namespace) -> dict[str, Any]:
             load("interpolate_pose_auto", server, "/interpolate", json_body(pair, steps=5))
         if "augment" in runs:
             print("augment ...", file=sys.stderr)
-            report["augment"] = augment(server, ceiling.curves(8, seed=4), a.augment_count)
+            report["augment"] = augment(server, ceiling.curves(8, seed=4), augment_count)
     finally:
         server.stop()
-    variants = {
-        "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
-        "access_log": (["--access-log", "true"], "B with the access log on"),
-        "workers": (["--workers", "2", "--inference-concurrency", "1"], "B over 2 worker processes"),
-        "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
-        "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),
-    }
-    for name, (flags, _) in variants.items():
+
+
+def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: set[str]) -> None:
+    """B against a server of each asked-for variant (VARIANTS), one server each."""
+    single = _single()
+    for name, (flags, _) in VARIANTS.items():
         if name in runs:
             server = Server(model_dir, *flags)
             try:
                 load(name, server, "/reconstruct", single)
             finally:
                 server.stop()
-    report["machine"]["load_after"] = os.getloadavg()
-    # The ceiling again at the end: other work on the machine during the first measurement shows as a difference,
-    # and the better of the two is the ceiling the ratios use.
+
+
+def _ceiling_again(report: dict[str, Any], model_dir: Path, secs: float) -> None:
+    """The ceiling again at the end: other work on the machine during the first measurement shows as a difference,
+    and the better of the two is the ceiling the ratios (each throughput run's curves/s over it) use."""
+    inproc = report["inprocess"]
     print("in-process ceiling again ...", file=sys.stderr)
     again = ceiling.measure(model_dir, seconds=min(secs, 5.0), eager=False, details=False)
     inproc["ceiling_at_start"], inproc["ceiling_at_end"] = inproc["ceiling"], again["ceiling"]
@@ -274,18 +312,39 @@ def run(a: argparse.Namespace) -> dict[str, Any]:
         inproc[key] = max(inproc[key], again[key])
     inproc["ceiling"] = top = max(inproc["ceiling"], again["ceiling"])
     for name, x in report.items():
-        if name in ("A", "B", "B_npy", *variants):
+        if name in ("A", "B", "B_npy", *VARIANTS):
             x["ratio"] = x.get("curves_per_s", x["rps"]) / top
-    return report
 
 
 def _f(x: float | None, digits: int = 2) -> str:
     return "–" if x is None else f"{x:.{digits}f}"
 
 
+ROW_LABELS = {
+    "A": "A: /reconstruct, 128 curves JSON, 2 connections",
+    "B": "B: /reconstruct, 1 curve JSON, 16 connections",
+    "B_npy": "B with .npy bodies",
+    "latency_1": "/reconstruct, 1 curve, 1 connection",
+    "latency_1_pose_auto": '/reconstruct, 1 curve, pose "auto" (6 poses), 1 connection',
+    "interpolate": "/interpolate, pair, 5 steps, 16 connections",
+    "interpolate_pose_auto": '/interpolate, pair, 5 steps, pose "auto", 16 connections',
+    "spinning": "B, spinning on (`--spinning true`)",
+    "access_log": "B, access log on (`--access-log true`)",
+    "workers": "B, `--workers 2 --inference-concurrency 1`",
+    "one_session": "B, one session pair for both threads (`--sessions 1`)",
+    "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
+}
+
+
 def markdown(r: dict[str, Any]) -> str:
+    lines = [*_preamble(r), *_table(r), *_notes(r), *_breakdown(r), *_eager(r["inprocess"])]
+    return "\n".join(lines) + "\n"
+
+
+def _preamble(r: dict[str, Any]) -> list[str]:
+    """The machine, the command, and the in-process ceiling."""
     m, ip = r["machine"], r["inprocess"]
-    lines = [
+    return [
         f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, onnxruntime {m['onnxruntime']}, "
         f"uvicorn {m['uvicorn']}. Load average before {m['load_before'][0]:.2f}, after {m['load_after'][0]:.2f}. "
         f"Command: `{r['command']}` ({r['seconds']:g} s per load run).",
@@ -294,35 +353,33 @@ def markdown(r: dict[str, Any]) -> str:
         f"{ip['default_b128']:.0f}; one 1-thread session per core in parallel, {ip['per_core_b128']:.0f} "
         f"(measured before the load runs: {ip['ceiling_at_start']:.0f}, after: {ip['ceiling_at_end']:.0f}).",
         "",
+    ]
+
+
+def _table(r: dict[str, Any]) -> list[str]:
+    """The table of the load runs, a row each run made."""
+    lines = [
         "| run | requests/s | curves/s | ÷ ceiling | p50 ms | p99 ms | server CPU ms/request | wrk CPU ms/request "
         "| other CPU s | non-2xx |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    names = {
-        "A": "A: /reconstruct, 128 curves JSON, 2 connections",
-        "B": "B: /reconstruct, 1 curve JSON, 16 connections",
-        "B_npy": "B with .npy bodies",
-        "latency_1": "/reconstruct, 1 curve, 1 connection",
-        "latency_1_pose_auto": '/reconstruct, 1 curve, pose "auto" (6 poses), 1 connection',
-        "interpolate": "/interpolate, pair, 5 steps, 16 connections",
-        "interpolate_pose_auto": '/interpolate, pair, 5 steps, pose "auto", 16 connections',
-        "spinning": "B, spinning on (`--spinning true`)",
-        "access_log": "B, access log on (`--access-log true`)",
-        "workers": "B, `--workers 2 --inference-concurrency 1`",
-        "one_session": "B, one session pair for both threads (`--sessions 1`)",
-        "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
-    }
-    for key, label in names.items():
+    single = ("B", "B_npy", "spinning", "access_log", "workers", "one_session", "micro_batch")
+    for key, label in ROW_LABELS.items():
         if key not in r:
             continue
         x = r[key]
-        single = ("B", "B_npy", "spinning", "access_log", "workers", "one_session", "micro_batch")
         cps = x.get("curves_per_s", x["rps"] if key in single else None)
         lines.append(
             f"| {label} | {x['rps']:.0f} | {_f(cps, 0)} | {_f(x.get('ratio'))} | {x['p50_ms']:.1f} | "
             f"{x['p99_ms']:.1f} | {x['server_cpu_ms_per_request']:.2f} | {x['wrk_cpu_ms_per_request']:.2f} | "
             f"{x['other_cpu_s']:.1f} | {x['non_2xx'] + x['errors']} |"
         )
+    return lines
+
+
+def _notes(r: dict[str, Any]) -> list[str]:
+    """The workers' CPU spread and /augment's times, where those runs were made."""
+    lines: list[str] = []
     if "workers" in r:
         spread = ", ".join(f"{s:.1f}" for s in sorted(r["workers"]["cpu_s_by_process"].values(), reverse=True))
         lines += ["", f"`--workers 2`: CPU seconds per server process during the run (supervisor included): {spread}."]
@@ -334,32 +391,43 @@ def markdown(r: dict[str, Any]) -> str:
             f"{g['json_s']:.2f} s ({g['json_cps']:.0f} curves/s); one .npy stream {g['npy_s']:.2f} s "
             f"({g['npy_cps']:.0f} curves/s).",
         ]
-    b = ip.get("breakdown")
-    if b:
-        lines += [
-            "",
-            "In-process, one 1-thread session, ms per request: "
-            f"encoder + decoder {b['onnx_b1_ms']:.2f} (1 curve) / {b['onnx_b128_ms']:.0f} (128 curves); "
-            f"`CurveRuntime.reconstruct` pose as_is {b['reconstruct_b1_ms']:.2f} / {b['reconstruct_b128_ms']:.0f}; "
-            f"JSON parse + validation {b['parse_validate_b1_ms']:.2f} / {b['parse_validate_b128_ms']:.1f}; "
-            f"rendering the answer {b['render_b1_ms']:.2f} / {b['render_b128_ms']:.1f}.",
-        ]
-        if "B" in r:
-            rest = r["B"]["server_cpu_ms_per_request"] - b["reconstruct_b1_ms"] - b["parse_validate_b1_ms"]
-            lines.append(
-                f"Of B's {r['B']['server_cpu_ms_per_request']:.2f} ms of server CPU per request, "
-                f"{b['reconstruct_b1_ms']:.2f} are the runtime's work in isolation and "
-                f"{b['parse_validate_b1_ms']:.2f} JSON; the other {rest:.2f} ms are HTTP, the framework, the thread "
-                "hand-offs and inference slowed by sharing the cores (caches) with the event loop and wrk."
-            )
-    if ip.get("C_b1") is not None:
-        lines += [
-            "",
-            "C, onnxruntime ÷ torch eager, encoder + decoder, 1 thread each: "
-            f"batch 1 {ip['onnx_1t_b1']:.0f} vs {ip['torch_1t_b1']:.0f} curves/s = **{ip['C_b1']:.2f}×**; "
-            f"batch 128 {ip['onnx_1t_b128']:.0f} vs {ip['torch_1t_b128']:.0f} = **{ip['C_b128']:.2f}×**.",
-        ]
-    return "\n".join(lines) + "\n"
+    return lines
+
+
+def _breakdown(r: dict[str, Any]) -> list[str]:
+    """Where a request's time goes in-process, and what of B's server CPU that leaves to HTTP and the rest."""
+    b = r["inprocess"].get("breakdown")
+    if not b:
+        return []
+    lines = [
+        "",
+        "In-process, one 1-thread session, ms per request: "
+        f"encoder + decoder {b['onnx_b1_ms']:.2f} (1 curve) / {b['onnx_b128_ms']:.0f} (128 curves); "
+        f"`CurveRuntime.reconstruct` pose as_is {b['reconstruct_b1_ms']:.2f} / {b['reconstruct_b128_ms']:.0f}; "
+        f"JSON parse + validation {b['parse_validate_b1_ms']:.2f} / {b['parse_validate_b128_ms']:.1f}; "
+        f"rendering the answer {b['render_b1_ms']:.2f} / {b['render_b128_ms']:.1f}.",
+    ]
+    if "B" in r:
+        rest = r["B"]["server_cpu_ms_per_request"] - b["reconstruct_b1_ms"] - b["parse_validate_b1_ms"]
+        lines.append(
+            f"Of B's {r['B']['server_cpu_ms_per_request']:.2f} ms of server CPU per request, "
+            f"{b['reconstruct_b1_ms']:.2f} are the runtime's work in isolation and "
+            f"{b['parse_validate_b1_ms']:.2f} JSON; the other {rest:.2f} ms are HTTP, the framework, the thread "
+            "hand-offs and inference slowed by sharing the cores (caches) with the event loop and wrk."
+        )
+    return lines
+
+
+def _eager(ip: dict[str, Any]) -> list[str]:
+    """C: onnxruntime against torch eager, where it was measured."""
+    if ip.get("C_b1") is None:
+        return []
+    return [
+        "",
+        "C, onnxruntime ÷ torch eager, encoder + decoder, 1 thread each: "
+        f"batch 1 {ip['onnx_1t_b1']:.0f} vs {ip['torch_1t_b1']:.0f} curves/s = **{ip['C_b1']:.2f}×**; "
+        f"batch 128 {ip['onnx_1t_b128']:.0f} vs {ip['torch_1t_b128']:.0f} = **{ip['C_b128']:.2f}×**.",
+    ]
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -86,7 +86,7 @@ def laplacian_figure(runs: list[tuple[float, Path]], data: str, out: Path, *, cu
     plot_tangents(curves, labels, out)
 
 
-def main() -> None:
+def _parse_args() -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--table", choices=list(PAPER), required=True)
     p.add_argument("--epochs", type=int, default=5, help="epochs per row (default: 5)")
@@ -103,24 +103,31 @@ def main() -> None:
         "rows whose architecture differs cannot use it)",
     )
     p.add_argument("--figures", default="docs/figures", help="--table lap: figure folder (default: docs/figures)")
-    a = p.parse_args()
-    init = _init_label(a.init_from)
-    rows = []
-    for variant, latent, lap, paper in PAPER[a.table]:
-        run = Path(a.out) / run_name(variant, latent, lap, a.epochs, a.train_limit, init)
-        if not (run / "report.json").exists():
-            args = ["train", "--run-dir", str(run), "--resume", "--no-progress", "--data", a.data]
-            args += ["--variant", variant, "--latent-dim", str(latent), "--lap-weight", str(lap)]
-            args += ["--epochs", str(a.epochs), "--train-limit", str(a.train_limit), "--lr", str(a.lr)]
-            if a.threads:
-                args += ["--threads", str(a.threads)]
-            if a.init_from:
-                args += ["--init-from", a.init_from]
-            cli(args)
-        rep = json.loads((run / "report.json").read_text())
-        log = [json.loads(line) for line in (run / "log.jsonl").read_text().splitlines() if line.strip()]
-        rep["fresh_mse"] = fresh_mse(run, a.fresh_seed)
-        rows.append((variant, latent, lap, paper, rep, sum(r["seconds"] for r in log)))
+    return p.parse_args()
+
+
+def _train_row(run: Path, variant: str, latent: int, lap: float, a: argparse.Namespace) -> None:
+    """`curve-vae train` of one row into `run` (resumed if cut off before), its report.json included."""
+    args = ["train", "--run-dir", str(run), "--resume", "--no-progress", "--data", a.data]
+    args += ["--variant", variant, "--latent-dim", str(latent), "--lap-weight", str(lap)]
+    args += ["--epochs", str(a.epochs), "--train-limit", str(a.train_limit), "--lr", str(a.lr)]
+    if a.threads:
+        args += ["--threads", str(a.threads)]
+    if a.init_from:
+        args += ["--init-from", a.init_from]
+    cli(args)
+
+
+def _row_results(run: Path, fresh_seed: int) -> tuple[dict, float]:
+    """A trained row's report (with the fresh-curve MSE added) and its training seconds."""
+    rep = json.loads((run / "report.json").read_text())
+    log = [json.loads(line) for line in (run / "log.jsonl").read_text().splitlines() if line.strip()]
+    rep["fresh_mse"] = fresh_mse(run, fresh_seed)
+    return rep, sum(r["seconds"] for r in log)
+
+
+def _table(rows: list[tuple], a: argparse.Namespace, init: str) -> str:
+    """The Markdown table: the budget, then a row per run beside the paper's MSE."""
     budget = (
         f"{a.epochs} epochs × {a.train_limit:,} curves ({a.epochs * a.train_limit:,} curves seen), "
         f"one-cycle peak lr {a.lr:g}, batch 128, fp32, "
@@ -143,7 +150,19 @@ def main() -> None:
             f"{100 * t['self_intersecting_outputs']:.1f}% | "
             f"{rep['interpolation']['latent']['roughness']:.2f} | {seconds:.0f} |"
         )
-    text = "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    a = _parse_args()
+    init = _init_label(a.init_from)
+    rows = []
+    for variant, latent, lap, paper in PAPER[a.table]:
+        run = Path(a.out) / run_name(variant, latent, lap, a.epochs, a.train_limit, init)
+        if not (run / "report.json").exists():
+            _train_row(run, variant, latent, lap, a)
+        rows.append((variant, latent, lap, paper, *_row_results(run, a.fresh_seed)))
+    text = _table(rows, a, init)
     Path(a.out).mkdir(parents=True, exist_ok=True)
     (Path(a.out) / f"table_{a.table}.md").write_text(text)
     print(text)

@@ -105,49 +105,57 @@ async def _load(url: str, clients: int, duration: float, max_requests: int, seed
     return out
 
 
-def run(a: argparse.Namespace) -> dict:
-    port = _free_port()
-    url = f"http://127.0.0.1:{port}"
+def _start_server(port: int, model_dir: str) -> subprocess.Popen:
+    """The service on a loopback port, its output (one stream) kept for the report."""
     cmd = [sys.executable, "-m", "curve_vae.service.cli", "--port", str(port), "--log-level", "warning",
-           "--model-dir", a.model_dir, "--providers", "cpu"]  # fmt: skip
-    server = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    try:
-        deadline = time.monotonic() + 60
-        while True:
-            if server.poll() is not None:
-                raise RuntimeError(f"the server exited with {server.returncode}: {server.stdout.read()}")  # type: ignore[union-attr]
-            try:
-                if httpx.get(url + "/ready", timeout=1).status_code == 200:
-                    break
-            except httpx.TransportError:
-                pass
-            if time.monotonic() > deadline:
-                raise TimeoutError(f"{url} not ready after 60 s")
-            time.sleep(0.1)
-        for _, method, path, body, _ in request_mix(a.seed):  # warm every route up before the first reading
-            httpx.request(method, url + path, json=body, timeout=120)
-        # and every inference thread: each has its own session pair, whose memory arena grows on its first large
-        # runs (~100 MB for the shipped model's second pair); that is a one-time cost, not a leak to measure
-        asyncio.run(_load(url, a.clients, min(2.0, a.duration), a.max_requests, a.seed + 1))
-        rss_before = _rss_mb(server.pid)
-        t0 = time.perf_counter()
-        results = asyncio.run(_load(url, a.clients, a.duration, a.max_requests, a.seed))
-        wall = time.perf_counter() - t0
-        rss_after = _rss_mb(server.pid)
-    finally:
-        server.send_signal(signal.SIGTERM)
+           "--model-dir", model_dir, "--providers", "cpu"]  # fmt: skip
+    return subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def _wait_ready(server: subprocess.Popen, url: str, timeout: float = 60) -> None:
+    deadline = time.monotonic() + timeout
+    while True:
+        if server.poll() is not None:
+            raise RuntimeError(f"the server exited with {server.returncode}: {server.stdout.read()}")  # type: ignore[union-attr]
         try:
-            code = server.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            server.kill()
-            code = server.wait()
-        log = server.stdout.read()  # type: ignore[union-attr]
-        server.stdout.close()  # type: ignore[union-attr]
+            if httpx.get(url + "/ready", timeout=1).status_code == 200:
+                return
+        except httpx.TransportError:
+            pass
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"{url} not ready after {timeout:g} s")
+        time.sleep(0.1)
+
+
+def _warm_up(url: str, a: argparse.Namespace) -> None:
+    """Every route once, before the first memory reading, then a short load of a different seed."""
+    for _, method, path, body, _ in request_mix(a.seed):
+        httpx.request(method, url + path, json=body, timeout=120)
+    # and every inference thread: each has its own session pair, whose memory arena grows on its first large
+    # runs (~100 MB for the shipped model's second pair); that is a one-time cost, not a leak to measure
+    asyncio.run(_load(url, a.clients, min(2.0, a.duration), a.max_requests, a.seed + 1))
+
+
+def _stop_server(server: subprocess.Popen) -> tuple[int, str]:
+    """SIGTERM (a kill after 60 s); the exit code and everything the server wrote."""
+    server.send_signal(signal.SIGTERM)
+    try:
+        code = server.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        server.kill()
+        code = server.wait()
+    log = server.stdout.read()  # type: ignore[union-attr]
+    server.stdout.close()  # type: ignore[union-attr]
+    return code, log
+
+
+def _traffic_report(clients: int, results: list, wall: float) -> dict:
+    """Requests, errors (a few examples), bad inputs tried, and latency overall and per kind of request."""
     lat = np.array([r[1] for r in results]) * 1e3
     errors = [r for r in results if not r[2]]
     kinds = sorted({r[0] for r in results})
-    report = {
-        "clients": a.clients,
+    return {
+        "clients": clients,
         "duration_s": round(wall, 1),
         "requests": len(results),
         "requests_per_s": round(len(results) / wall, 1),
@@ -163,11 +171,29 @@ def run(a: argparse.Namespace) -> dict:
             }
             for k in kinds
         },
+    }
+
+
+def run(a: argparse.Namespace) -> dict:
+    port = _free_port()
+    url = f"http://127.0.0.1:{port}"
+    server = _start_server(port, a.model_dir)
+    try:
+        _wait_ready(server, url)
+        _warm_up(url, a)
+        rss_before = _rss_mb(server.pid)
+        t0 = time.perf_counter()
+        results = asyncio.run(_load(url, a.clients, a.duration, a.max_requests, a.seed))
+        wall = time.perf_counter() - t0
+        rss_after = _rss_mb(server.pid)
+    finally:
+        code, log = _stop_server(server)
+    return {
+        **_traffic_report(a.clients, results, wall),
         "server_rss_mb": {"before": round(rss_before, 1), "after": round(rss_after, 1)},
         "server_exit_code": code,
         "server_log_has_traceback": "Traceback" in log,
     }
-    return report
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -95,6 +95,17 @@ def state(page: Page) -> dict:
 
 def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     page, errors = open_page(browser, server.url + "/")
+    _check_pair(page, server.url)
+    s = _check_triplet(page, server.url)
+    _check_downloads(page, s, server.url)
+    _check_vase(page)
+    ARTIFACTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(ARTIFACTS / "page.png"), full_page=True)
+    assert errors == []
+
+
+def _check_pair(page: Page, url: str) -> None:
+    """Two drawn curves: their reconstructions, the mix at the slider's weight and the strip are the API's answers."""
     draw(page, arc(500, 420, 250, np.pi, 2 * np.pi))  # a bowl, drawn left to right
     draw(page, arc(500, 250, 220, 0.9 * np.pi, 0.1 * np.pi))  # a hump
     page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 5")
@@ -103,11 +114,11 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     page.locator("#weight").fill("0.25")  # the slider
     page.wait_for_function("window.curveVae.result && window.curveVae.result.weights[1] === 0.25")
     s = state(page)
-    answer = httpx.post(server.url + "/interpolate", json=s["result"]["body"], timeout=30).json()
+    answer = httpx.post(url + "/interpolate", json=s["result"]["body"], timeout=30).json()
     np.testing.assert_allclose(drawn(page, "#interpolant"), answer["curves"][0], atol=2e-3)  # drawn = API's answer
     strip_body = {**s["result"]["body"], "steps": 5, "n_points": 60, "output": "points", "metrics": False}
     del strip_body["weights"]
-    strip = httpx.post(server.url + "/interpolate", json=strip_body, timeout=30).json()
+    strip = httpx.post(url + "/interpolate", json=strip_body, timeout=30).json()
     np.testing.assert_allclose(s["strip"], strip["curves"], atol=1e-9)
     assert float(page.locator("dd[data-metric=roughness]").inner_text().rstrip("°")) >= 0
 
@@ -115,6 +126,9 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     assert page.locator(".control-polygon").count() == 3  # two reconstructions and the mix
     assert len(s["result"]["spline"]["control_points"]) == 31
 
+
+def _check_triplet(page: Page, url: str) -> dict:
+    """A third curve in triplet mode: the strip as a triangle, and a click on the triangle mixes near B; the state."""
     page.check("#mode-triplet")
     draw(page, arc(500, 350, 150, 0.5 * np.pi, 2.3 * np.pi))  # a third curve
     page.wait_for_function("window.curveVae.curves.length === 3 && window.curveVae.strip.length === 10")
@@ -127,9 +141,13 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     page.wait_for_function("window.curveVae.result && window.curveVae.result.weights.length === 3")
     page.wait_for_function("window.curveVae.result.weights[1] > 0.6")
     s = state(page)
-    answer = httpx.post(server.url + "/interpolate", json=s["result"]["body"], timeout=30).json()
+    answer = httpx.post(url + "/interpolate", json=s["result"]["body"], timeout=30).json()
     np.testing.assert_allclose(drawn(page, "#interpolant"), answer["curves"][0], atol=2e-3)
+    return s
 
+
+def _check_downloads(page: Page, s: dict, url: str) -> None:
+    """The JSON, CSV and SVG downloads hold the three curves and the mix; the curl command is the request's."""
     with page.expect_download() as download:
         page.click("#download-json")
     saved = json.loads(Path(download.value.path()).read_text())
@@ -145,8 +163,11 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
 
     page.click("#copy-curl")
     curl = page.locator("#curl").inner_text()
-    assert curl.startswith(f"curl -s {server.url}/interpolate")
+    assert curl.startswith(f"curl -s {url}/interpolate")
 
+
+def _check_vase(page: Page) -> None:
+    """The vase of the mix: its mesh, and an STL download of as many triangles as its header says."""
     page.click("#vase")
     page.wait_for_function("window.curveVae.vase && window.curveVae.vase.faces.length > 0")
     s = state(page)
@@ -155,10 +176,6 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
         page.click("#download-stl")
     stl = Path(download.value.path()).read_bytes()
     assert len(stl) == 84 + 50 * int.from_bytes(stl[80:84], "little") > 84
-
-    ARTIFACTS.mkdir(exist_ok=True)
-    page.screenshot(path=str(ARTIFACTS / "page.png"), full_page=True)
-    assert errors == []
 
 
 def test_errors_appear_next_to_their_cause(browser, server_factory, model_dir):
