@@ -1,0 +1,119 @@
+"""The serving benchmark's report: the Markdown section docs/BENCHMARKS.md quotes, from bench.serve's results."""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+def _f(x: float | None, digits: int = 2) -> str:
+    return "–" if x is None else f"{x:.{digits}f}"
+
+
+ROW_LABELS = {
+    "A": "A: /reconstruct, 128 curves JSON, 2 connections",
+    "B": "B: /reconstruct, 1 curve JSON, 16 connections",
+    "B_npy": "B with .npy bodies",
+    "latency_1": "/reconstruct, 1 curve, 1 connection",
+    "latency_1_pose_auto": '/reconstruct, 1 curve, pose "auto" (6 poses), 1 connection',
+    "interpolate": "/interpolate, pair, 5 steps, 16 connections",
+    "interpolate_pose_auto": '/interpolate, pair, 5 steps, pose "auto", 16 connections',
+    "spinning": "B, spinning on (`--spinning true`)",
+    "access_log": "B, access log on (`--access-log true`)",
+    "workers": "B, `--workers 2 --inference-concurrency 1`",
+    "one_session": "B, one session pair for both threads (`--sessions 1`)",
+    "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
+}
+
+
+def markdown(r: dict[str, Any]) -> str:
+    lines = [*_preamble(r), *_table(r), *_notes(r), *_breakdown(r), *_eager(r["inprocess"])]
+    return "\n".join(lines) + "\n"
+
+
+def _preamble(r: dict[str, Any]) -> list[str]:
+    """The machine, the command, and the in-process ceiling."""
+    m, ip = r["machine"], r["inprocess"]
+    return [
+        f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, onnxruntime {m['onnxruntime']}, "
+        f"uvicorn {m['uvicorn']}. Load average before {m['load_before'][0]:.2f}, after {m['load_after'][0]:.2f}. "
+        f"Command: `{r['command']}` ({r['seconds']:g} s per load run).",
+        "",
+        f"In-process ceiling: {ip['ceiling']:.0f} curves/s, the better of: one default session at batch 128, "
+        f"{ip['default_b128']:.0f}; one 1-thread session per core in parallel, {ip['per_core_b128']:.0f} "
+        f"(measured before the load runs: {ip['ceiling_at_start']:.0f}, after: {ip['ceiling_at_end']:.0f}).",
+        "",
+    ]
+
+
+def _table(r: dict[str, Any]) -> list[str]:
+    """The table of the load runs, a row each run made."""
+    lines = [
+        "| run | requests/s | curves/s | ÷ ceiling | p50 ms | p99 ms | server CPU ms/request | wrk CPU ms/request "
+        "| other CPU s | non-2xx |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    single = ("B", "B_npy", "spinning", "access_log", "workers", "one_session", "micro_batch")
+    for key, label in ROW_LABELS.items():
+        if key not in r:
+            continue
+        x = r[key]
+        cps = x.get("curves_per_s", x["rps"] if key in single else None)
+        lines.append(
+            f"| {label} | {x['rps']:.0f} | {_f(cps, 0)} | {_f(x.get('ratio'))} | {x['p50_ms']:.1f} | "
+            f"{x['p99_ms']:.1f} | {x['server_cpu_ms_per_request']:.2f} | {x['wrk_cpu_ms_per_request']:.2f} | "
+            f"{x['other_cpu_s']:.1f} | {x['non_2xx'] + x['errors']} |"
+        )
+    return lines
+
+
+def _notes(r: dict[str, Any]) -> list[str]:
+    """The workers' CPU spread and /augment's times, where those runs were made."""
+    lines: list[str] = []
+    if "workers" in r:
+        spread = ", ".join(f"{s:.1f}" for s in sorted(r["workers"]["cpu_s_by_process"].values(), reverse=True))
+        lines += ["", f"`--workers 2`: CPU seconds per server process during the run (supervisor included): {spread}."]
+    if "augment" in r:
+        g = r["augment"]
+        lines += [
+            "",
+            f"/augment, {g['count']:,} curves (8 seeds, pose as_is): JSON in pages of 256 "
+            f"{g['json_s']:.2f} s ({g['json_cps']:.0f} curves/s); one .npy stream {g['npy_s']:.2f} s "
+            f"({g['npy_cps']:.0f} curves/s).",
+        ]
+    return lines
+
+
+def _breakdown(r: dict[str, Any]) -> list[str]:
+    """Where a request's time goes in-process, and what of B's server CPU that leaves to HTTP and the rest."""
+    b = r["inprocess"].get("breakdown")
+    if not b:
+        return []
+    lines = [
+        "",
+        "In-process, one 1-thread session, ms per request: "
+        f"encoder + decoder {b['onnx_b1_ms']:.2f} (1 curve) / {b['onnx_b128_ms']:.0f} (128 curves); "
+        f"`CurveRuntime.reconstruct` pose as_is {b['reconstruct_b1_ms']:.2f} / {b['reconstruct_b128_ms']:.0f}; "
+        f"JSON parse + validation {b['parse_validate_b1_ms']:.2f} / {b['parse_validate_b128_ms']:.1f}; "
+        f"rendering the answer {b['render_b1_ms']:.2f} / {b['render_b128_ms']:.1f}.",
+    ]
+    if "B" in r:
+        rest = r["B"]["server_cpu_ms_per_request"] - b["reconstruct_b1_ms"] - b["parse_validate_b1_ms"]
+        lines.append(
+            f"Of B's {r['B']['server_cpu_ms_per_request']:.2f} ms of server CPU per request, "
+            f"{b['reconstruct_b1_ms']:.2f} are the runtime's work in isolation and "
+            f"{b['parse_validate_b1_ms']:.2f} JSON; the other {rest:.2f} ms are HTTP, the framework, the thread "
+            "hand-offs and inference slowed by sharing the cores (caches) with the event loop and wrk."
+        )
+    return lines
+
+
+def _eager(ip: dict[str, Any]) -> list[str]:
+    """C: onnxruntime against torch eager, where it was measured."""
+    if ip.get("C_b1") is None:
+        return []
+    return [
+        "",
+        "C, onnxruntime ÷ torch eager, encoder + decoder, 1 thread each: "
+        f"batch 1 {ip['onnx_1t_b1']:.0f} vs {ip['torch_1t_b1']:.0f} curves/s = **{ip['C_b1']:.2f}×**; "
+        f"batch 128 {ip['onnx_1t_b128']:.0f} vs {ip['torch_1t_b128']:.0f} = **{ip['C_b128']:.2f}×**.",
+    ]
