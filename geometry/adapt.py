@@ -1,9 +1,9 @@
 """Frame and length adaptation: a caller's curve to the model's plane and point count, and a result back.
 
-The model takes `n_points` points (161) in its 128×128 plane, evenly spaced in the curve's
-B-spline parameter. `to_model_plane` brings a caller's curve there — through its `Frame` when it
-has one (frame.py), then to `n_points` points: along the point index with spacing "parameter"
-(points taken to be evenly spaced in the parameter, so a curve of `n_points` passes untouched),
+The model takes `n_points` points (161) in its 128×128 plane. `to_model_plane` brings a caller's
+curve there — through its `Frame` when it has one (frame.py), then to `n_points` points: along the
+point index with spacing "parameter" (the caller's own spacing kept, so a curve of `n_points`
+passes untouched),
 evenly by arc length with "arc_length" — and says where each of the caller's points sits along
 the result. `polyline_to_caller` and `spline_to_caller` bring a model-plane result back: at those
 positions, or at any count spaced as asked, mapped through the frame. From a B-spline head's

@@ -9,13 +9,13 @@ without HTTP:
         --encoder--> mean, log_var --(affine mix)--> decoder --> (161, 2) in the model plane
         --polyline_to_caller / spline_to_caller: n points, same spacing--> caller's frame
 
-With frame "model" the frame steps are skipped. Resampling ("spacing"): the model was
-trained on points evenly spaced in the B-spline parameter, so by default a curve's points
-are taken to be spaced that way and are interpolated along the index ("parameter"); a
-161-point curve then passes untouched and 50, 160 or 500 points of the same curve give
-the same model input. "arc_length" resamples evenly by arc length instead, for points
-spaced arbitrarily (hand-drawn strokes). Nothing here imports torch. Reading and checking model
-files is `service.model_files`; the learned latent distribution is `service.prior`.
+With frame "model" the frame steps are skipped. Resampling ("spacing"): by default a curve's
+points are taken as given and interpolated along the index ("parameter": the paper's B-spline
+samples are spaced so, and the default model was also trained at arc-length and uneven spacings);
+a 161-point curve then passes untouched and 50, 160 or 500 points of the same curve give the same
+model input. "arc_length" resamples evenly by arc length instead (geometry.adapt). Nothing here
+imports torch. Reading and checking model files is `service.model_files`; the learned latent
+distribution is `service.prior`.
 
 Length (~690 lines): one class whose methods share the sessions and the choice of pose (which needs both
 graphs), and carry a batch's frames, input positions and splines from `prepare` through the graphs to the
