@@ -5,7 +5,7 @@ architecture, `losses` owns the objective. Run under `torchrun --nproc-per-node 
 data-parallel training (gloo on CPU, nccl on GPU); a single process needs no launcher.
 Checkpoint files are training/checkpoint.py's.
 
-Length (~510 lines): the step, the schedules, the clock of a time budget and the run's named steps share
+Length (~530 lines): the step, the schedules, the clock of a time budget and the run's named steps share
 RunState, _Parts (model, optimiser, schedule, clock, generator) and the DDP process; `train()` itself
 (~60 lines) reads top to bottom: set-up, then each epoch's pass, validation, record and stop rules.
 """
@@ -277,6 +277,23 @@ def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_p
     return _Parts(model, opt, _make_schedule(opt, cfg, steps_per_epoch, clock), clock, np.random.default_rng(cfg.seed))
 
 
+def _check_resumed_data(last: Path, data_cfg: DataConfig, resume: bool) -> None:
+    """On resume, refuse to go on from `last` on other data than it was trained on (another mix version, size or
+    seed), before any data is drawn."""
+    if not resume or not last.exists():
+        return
+    stored = dict(load_checkpoint(last).get("data_config") or {})
+    stored.setdefault("mix_version", 1 if stored.get("mix") == "broad" else 0)  # written before mix versions
+    asked = asdict(data_cfg)
+    differ = {k: (stored[k], v) for k, v in asked.items() if k in stored and stored[k] != v}
+    if differ:
+        said = ", ".join(f"{k} {old!r} (run) vs {new!r} (asked)" for k, (old, new) in differ.items())
+        raise ValueError(
+            f"{last} was trained on other data: {said}; resume it with the same data options "
+            "(e.g. --mix-version, --n-train, --data-seed), or start a new run directory (--init-from for its weights)"
+        )
+
+
 def _restore(
     proc: _Process, last: Path, parts: _Parts, cfg: TrainConfig, *, resume: bool, init_from: str | Path | None
 ) -> RunState:
@@ -439,10 +456,11 @@ def _checkpoint(configs: dict[str, Any], parts: _Parts, state: RunState) -> dict
 
 
 def _stop_reason(cfg: TrainConfig, state: RunState, clock: Clock) -> str | None:
-    """Why the run stops before its last epoch (patience out, time budget spent), or None."""
+    """Why the run stops before its last epoch (patience out, time budget spent), or None. Every process calls it
+    and gets rank 0's answer, so all stop at the same epoch."""
     if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
         return f"early stop: no better validation MSE for {cfg.patience} epochs"
-    if clock.over():
+    if _agree(clock.over()):
         return f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs"
     return None
 
@@ -472,6 +490,7 @@ def train(
     try:
         torch.manual_seed(cfg.seed)
         random.seed(cfg.seed)
+        _check_resumed_data(run_dir / "last.pt", data_cfg, resume)
         data, val = _load_splits(proc, data_cfg, cfg, data_cache, data_workers)
         steps_per_epoch = _steps_per_epoch(len(data), proc, cfg)
         parts = _new_parts(proc, model_cfg, cfg, steps_per_epoch)

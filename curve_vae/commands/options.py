@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from curve_vae.service.cpus import available_cpus
+from curve_vae.training.families import MIX_VERSION, MIXES
 
 DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
 DEFAULT_MODELS = "models"
@@ -35,9 +36,10 @@ def add_data_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--mix-version",
         type=int,
+        choices=sorted(MIXES),
         default=0,
-        metavar="N",
-        help="the broad mix's version (training/families.py MIXES; 2 drew model 0.9.0's curves) (default: the latest)",
+        help="with --mix broad: the mix's version (training/families.py MIXES; 2 drew model 0.9.0's curves) "
+        f"(default: the latest, {MIX_VERSION})",
     )
     g.add_argument(
         "--curves",
@@ -65,6 +67,8 @@ def data_config(a: argparse.Namespace):
     from curve_vae.training.data import DataConfig
 
     mix = "files" if a.curves else a.mix
+    if a.mix_version and mix != "broad":
+        raise ValueError("--mix-version goes with --mix broad")
     return DataConfig(
         n_train=a.n_train,
         n_val=a.n_val,
