@@ -146,8 +146,8 @@ An Inception VAE for 2D curves (Barzegar Khalilsaraei & Augsdörfer, WSCG 2025) 
 A curve is a JSON array of `[x, y]` points: any frame, any order of magnitude, any length ≥ 4.
 Every endpoint takes a batch. With `frame: "auto"` (the default) each curve is shifted and
 uniformly scaled into the model's frame and results are mapped back. Curves of any length are
-resampled to the model's 161 points (`spacing`: along their parameter, like the training
-data, or by arc length) and come back at their own length, or `n_points`. Errors are JSON:
+resampled to the model's 161 points (`spacing`: along their own order, as given, or by
+arc length) and come back at their own length, or `n_points`. Errors are JSON:
 `detail` names the field, curve and point.
 """
 
