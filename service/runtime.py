@@ -17,31 +17,27 @@ model input. "arc_length" resamples evenly by arc length instead (geometry.adapt
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 
-Length (~690 lines): one class whose methods share the sessions and the choice of pose (which needs both
-graphs), and carry a batch's frames, input positions and splines from `prepare` through the graphs to the
-result, turning geometry's errors into the service's InputError with the field and curve they concern. The
-pure frame and length adaptation (caller's frame -> model plane at the model's point count, and back as
-points or as a spline) is `geometry.adapt`; augmentation is `service.augmenting` (a base class of
-CurveRuntime), the input error `service.inputs`, the mixing weights `geometry.mixing`.
+Length (~430 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a
+batch's frames, input positions and splines from `prepare` through the graphs to the result, turning geometry's
+errors into the service's InputError with the field and curve they concern. Its parts live beside it: the
+sessions, signature checks and raw graph runs are `service.graphs` (the base class `ModelGraphs`); the pure frame
+and length adaptation is `geometry.adapt`; augmentation `service.augmenting` and sampling `service.sampling`
+(base classes too); the input error `service.inputs`; the mixing weights `geometry.mixing`.
 """
 
 from __future__ import annotations
 
-import logging
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import onnxruntime as ort
 
 from curve_vae.geometry import (
     BeyondFloat32,
     Frame,
     blend_frames,
-    clamped_uniform_knots,
     curve_length,
     fit_frame,
     mse_per_curve,
@@ -53,15 +49,10 @@ from curve_vae.geometry import (
     to_model_plane,
 )
 from curve_vae.geometry.adapt import F32_MAX
-from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.service import batching
 from curve_vae.service.augmenting import Augmenting
+from curve_vae.service.graphs import ModelGraphs
 from curve_vae.service.inputs import InputError
-from curve_vae.service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
-from curve_vae.service.prior import PRIOR_FILE, LatentPrior
-from curve_vae.service.sessions import SessionConfig, SessionPool, open_pair
-
-log = logging.getLogger(__name__)
+from curve_vae.service.sampling import Sampling
 
 FrameMode = Literal["auto", "model"]
 Spacing = Literal["parameter", "arc_length"]
@@ -70,22 +61,6 @@ PoseMode = Literal["auto", "as_is"]
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
 POSE_CHORD_COUNT = 3
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
-
-
-Prior = Literal["learned", "standard"]
-MAX_DRAWS = 10  # per sampled curve: the shipped prior rejects 25% of draws, so 10 fail with probability ~1e-6;
-# and a distribution that rejects almost everything (the standard prior) costs at most 10 decodes a curve
-
-
-@dataclass(frozen=True)
-class Sampled:
-    """What `CurveRuntime.sample` made: latents (count, Z), curves, the prior used and the bookkeeping of rejection."""
-
-    latents: np.ndarray
-    curves: np.ndarray
-    prior: str
-    rejected: int  # draws rejected (self-intersecting or outside the disc) and drawn again
-    invalid: int  # curves still not valid after max_draws (0 unless the distribution is far off)
 
 
 # --------------------------------------------------------------------------- curves in and out
@@ -127,179 +102,13 @@ class Spline:
         }
 
 
-class CurveRuntime(Augmenting):
-    """Encoder and decoder sessions of one exported model, with frame and length handling.
+class CurveRuntime(ModelGraphs, Augmenting, Sampling):
+    """An exported model's graphs (`ModelGraphs`) with the frame, length and pose handling that brings any curve to
+    them and back.
 
     Methods that return curves take `splines`: a list to which one `Spline` per returned curve
     is appended, for models with a B-spline head (`has_splines`).
     """
-
-    def __init__(
-        self,
-        encoder: ort.InferenceSession,
-        decoder: ort.InferenceSession,
-        manifest: dict[str, Any],
-        *,
-        batch_size: int = 64,
-        requested_providers: str = "cpu",
-        prior: LatentPrior | None = None,
-        pool: SessionPool | None = None,
-    ) -> None:
-        self.pool = pool or SessionPool([(encoder, decoder)])  # the pair of each inference thread
-        self.manifest = manifest
-        self.prior = prior
-        self.batch_size = batch_size
-        self.requested_providers = requested_providers
-        self.n_points = int(manifest["n_points"])
-        self.latent_dim = int(manifest["latent_dim"])
-        self.model_size = float(manifest["frame"]["model_size"])
-        spline = manifest.get("spline")
-        self.spline_degree = int(spline["degree"]) if spline else 0
-        self.knots = clamped_uniform_knots(int(spline["n_ctrl"]), self.spline_degree) if spline else None
-        # Where the data lives in the model plane (paper §3.1: a radius-64 disc in the 128×128 plane): the region a
-        # valid sample must stay in.
-        self.disc_center = np.asarray(manifest["frame"].get("center", list(MODEL_CENTER)), np.float64)
-        self.disc_radius = float(manifest.get("training", {}).get("data", {}).get("radius", 64.0))
-        self._enc_in = encoder.get_inputs()[0].name
-        self._dec_in = decoder.get_inputs()[0].name
-        self._check_signature()
-
-    @classmethod
-    def load(
-        cls,
-        model_dir: str | Path,
-        *,
-        providers: str = "auto",
-        intra_op_threads: int = 0,
-        batch_size: int = 64,
-        warm_up: bool = True,
-        sessions: SessionConfig | None = None,
-    ) -> CurveRuntime:
-        """Open a model directory; raises ModelLoadError with what to fix when it cannot serve.
-
-        `sessions` sets threads, spinning and the number of session pairs (service.sessions); without it, one pair
-        of `intra_op_threads` threads."""
-        root = Path(model_dir)
-        manifest = read_manifest(root)
-        provider_list = resolve_providers(providers)
-        config = sessions or SessionConfig(intra_op_threads=intra_op_threads)
-        paths = (root / graph_file(manifest, "encoder"), root / graph_file(manifest, "decoder"))
-        pool = SessionPool(
-            [open_pair(paths, provider_list, config, require_cuda=providers == "cuda") for _ in range(config.sessions)]
-        )
-        prior = None
-        if manifest.get("prior"):
-            path = root / str(manifest["prior"].get("file", PRIOR_FILE))
-            try:
-                prior = LatentPrior.load(path)
-            except (OSError, ValueError, KeyError) as e:
-                raise ModelLoadError(f"{path}: not a usable latent prior ({e})") from e
-        runtime = cls(
-            *pool.pairs[0], manifest, batch_size=batch_size, requested_providers=providers, prior=prior, pool=pool
-        )
-        if warm_up:
-            runtime.warm_up()
-        return runtime
-
-    def _check_signature(self) -> None:
-        enc_in, dec_in = self.encoder.get_inputs()[0], self.decoder.get_inputs()[0]
-        enc_out = {o.name for o in self.encoder.get_outputs()}
-        problems = []
-        if list(enc_in.shape[1:]) != [self.n_points, 2]:
-            problems.append(
-                f"encoder input {enc_in.name} has shape {enc_in.shape}, expected [batch, {self.n_points}, 2]"
-            )
-        if not {"mean", "log_var"} <= enc_out:
-            problems.append(f"encoder outputs {sorted(enc_out)}, expected mean and log_var")
-        if list(dec_in.shape[1:]) != [self.latent_dim]:
-            problems.append(
-                f"decoder input {dec_in.name} has shape {dec_in.shape}, expected [batch, {self.latent_dim}]"
-            )
-        dec_out = [o.name for o in self.decoder.get_outputs()]
-        if self.has_splines and dec_out[:2] != ["curves", "control_points"]:
-            problems.append(f"decoder outputs {dec_out}, expected curves and control_points (the manifest's spline)")
-        if self.prior is not None and self.prior.latent_dim != self.latent_dim:
-            problems.append(f"the prior has {self.prior.latent_dim} latent dimensions, the model {self.latent_dim}")
-        if problems:
-            raise ModelLoadError("graphs do not match the manifest: " + "; ".join(problems))
-
-    @property
-    def encoder(self) -> ort.InferenceSession:
-        """The calling thread's encoder session."""
-        return self.pool.pair()[0]
-
-    @property
-    def decoder(self) -> ort.InferenceSession:
-        """The calling thread's decoder session."""
-        return self.pool.pair()[1]
-
-    @property
-    def has_splines(self) -> bool:
-        """Whether the decoder ends in a B-spline head (curves can be returned as splines)."""
-        return self.knots is not None
-
-    @property
-    def providers(self) -> list[str]:
-        """Providers the sessions actually run on (a fallback shows here)."""
-        return list(self.encoder.get_providers())
-
-    def warm_up(self) -> None:
-        """One full encode → decode round trip; raises ModelLoadError if the graphs misbehave."""
-        t = np.linspace(0.0, np.pi, self.n_points)
-        circle = np.stack([64 + 40 * np.cos(t), 64 + 40 * np.sin(t)], axis=1)[None].astype(np.float32)
-        try:
-            mean, log_var = self.encode_model(circle)
-            out = self.decode_model(mean)
-        except Exception as e:
-            raise ModelLoadError(f"warm-up inference failed: {e}") from e
-        if mean.shape != (1, self.latent_dim) or out.shape != (1, self.n_points, 2):
-            raise ModelLoadError(f"warm-up gave shapes {mean.shape}, {out.shape}")
-        if not (np.isfinite(mean).all() and np.isfinite(log_var).all() and np.isfinite(out).all()):
-            raise ModelLoadError("warm-up inference gave non-finite numbers: the weights are broken")
-        for encoder, decoder in self.pool.pairs:  # every pair's first run allocates; not a request's
-            decoder.run(None, {self._dec_in: encoder.run(["mean"], {self._enc_in: circle})[0]})
-
-    # ----------------------------------------------------------------------- raw graphs
-
-    def encode_model(self, curves: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(B, n_points, 2) in the model plane -> mean, log_var (B, latent_dim); split into runs of batch_size."""
-        x = np.ascontiguousarray(curves, dtype=np.float32)
-        encoder = self.encoder
-        means, log_vars = [], []
-        for i in range(0, len(x), self.batch_size):
-            mean, log_var = self._run_graph(encoder, "encoder", x[i : i + self.batch_size], ["mean", "log_var"])
-            means.append(mean)
-            log_vars.append(log_var)
-        if not means:
-            return np.zeros((0, self.latent_dim), np.float32), np.zeros((0, self.latent_dim), np.float32)
-        return np.concatenate(means), np.concatenate(log_vars)
-
-    def _run_graph(
-        self, session: ort.InferenceSession, graph: str, x: np.ndarray, outputs: list[str] | None
-    ) -> list[np.ndarray]:
-        """One run of a graph: gathered with other requests' by the thread's micro-batcher, if it has one."""
-        batcher = batching.current()
-        if batcher is not None:
-            return batcher.run(graph, x, outputs)
-        return session.run(outputs, {self._enc_in if graph == "encoder" else self._dec_in: x})
-
-    def decode_model(self, latents: np.ndarray) -> np.ndarray:
-        """(B, latent_dim) -> (B, n_points, 2) in the model plane."""
-        return self.decode_model_splines(latents)[0]
-
-    def decode_model_splines(self, latents: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """(B, latent_dim) -> curves (B, n_points, 2) and, with a B-spline head, control points (B, n_ctrl, 2)."""
-        z = np.ascontiguousarray(latents, dtype=np.float32)
-        decoder = self.decoder
-        curves, ctrls = [], []
-        for i in range(0, len(z), self.batch_size):
-            out = self._run_graph(decoder, "decoder", z[i : i + self.batch_size], None)
-            curves.append(out[0])
-            ctrls.append(out[1] if self.has_splines else None)
-        if not curves:
-            n_ctrl = len(self.knots) - self.spline_degree - 1 if self.has_splines else 0
-            return np.zeros((0, self.n_points, 2), np.float32), np.zeros((0, n_ctrl, 2), np.float32)
-        return np.concatenate(curves), (np.concatenate(ctrls) if self.has_splines else None)
 
     # ----------------------------------------------------------------------- caller's curves
 
@@ -587,80 +396,6 @@ class CurveRuntime(Augmenting):
     def mix_length(self, prep: Prepared, n_points: int | None) -> int:
         """Points per curve that mixing `prep`'s curves returns: n_points, else their common length, else 161."""
         return n_points or self._common_length(prep) or self.n_points
-
-    def sample(
-        self,
-        count: int,
-        *,
-        seed: int | None = None,
-        temperature: float = 1.0,
-        prior: Prior | None = None,
-        valid: bool = True,
-        max_draws: int = MAX_DRAWS,
-        n_points: int | None = None,
-        spacing: Spacing = "parameter",
-        frame: Frame | None = None,
-        splines: list[Spline] | None = None,
-    ) -> Sampled:
-        """New curves from a latent distribution, decoded into the model plane (or mapped into `frame`).
-
-        prior "learned": the Gaussian mixture fitted to the training curves' latent means (the default where the
-        model ships one); "standard": the VAE's N(0, I). temperature scales the spread (see service/prior.py).
-        valid: a draw whose curve crosses itself or leaves the data's disc is rejected and item i draws again, at
-        most max_draws times in all. Item i's draws come from its own generator default_rng([seed, i]), so the
-        seed decides every curve, across rejections too, and the first items of a larger count are the items of
-        a smaller one.
-        """
-        chosen = prior or ("learned" if self.prior is not None else "standard")
-        if chosen == "learned" and self.prior is None:
-            raise InputError(
-                ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
-            )
-        root = fresh_seed() if seed is None else seed
-        rngs = [np.random.default_rng([root, i]) for i in range(count)]
-
-        def draw(i: int) -> np.ndarray:
-            if chosen == "learned":
-                assert self.prior is not None
-                return self.prior.draw(rngs[i], temperature)
-            return rngs[i].standard_normal(self.latent_dim) * temperature
-
-        z = np.array([draw(i) for i in range(count)]).reshape(count, self.latent_dim)
-        draws, ok, todo = np.ones(count, np.int64), np.zeros(count, bool), np.arange(count)
-        out = np.zeros((count, self.n_points, 2), np.float32)
-        ctrl = np.zeros((count, len(self.knots) - self.spline_degree - 1, 2), np.float32) if self.has_splines else None
-        while len(todo):  # each draw is decoded once; its curve is kept until the item draws again
-            with np.errstate(all="ignore"):
-                decoded, points = self.decode_model_splines(z[todo])
-            out[todo] = decoded
-            if ctrl is not None and points is not None:
-                ctrl[todo] = points
-            if not valid:
-                break
-            good = self.plausible(decoded.astype(np.float64))
-            ok[todo[good]] = True
-            todo = todo[~good & (draws[todo] < max_draws)]
-            for i in todo:
-                z[i] = draw(int(i))
-                draws[i] += 1
-        invalid = int((~ok).sum()) if valid else 0
-        frames = [frame] * count if frame else None
-        curves = self._place(out, ctrl, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
-        return Sampled(z, curves, chosen, rejected=int(draws.sum() - count), invalid=invalid)
-
-    def plausible(self, curves: np.ndarray) -> np.ndarray:
-        """(B, n, 2) model-plane curves -> (B,) bool: finite, free of self-intersections and inside the data's disc."""
-        finite = np.isfinite(curves).all(axis=(1, 2))
-        inside = np.linalg.norm(np.where(finite[:, None, None], curves, 0) - self.disc_center, axis=-1).max(axis=1)
-        ok = finite & (inside <= self.disc_radius)
-        if ok.any():
-            ok[ok] = ~self_intersects(curves[ok])
-        return ok
-
-
-def fresh_seed() -> int:
-    """A random seed for a request that gave none, reported back so the answer can be repeated."""
-    return int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(11))  # 53 bits: exact in JSON
 
 
 def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:

@@ -17,7 +17,7 @@ from curve_vae.progress import bar, counted, shown
 def cmd_sample(a: argparse.Namespace) -> int:
     from curve_vae.files import write_output
     from curve_vae.service.payloads import sample_body, with_output
-    from curve_vae.service.runtime import fresh_seed
+    from curve_vae.service.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
     runtime = model_runtime(a)
@@ -48,7 +48,7 @@ def cmd_augment(a: argparse.Namespace) -> int:
 
     from curve_vae.files import read_curves, write_npy_chunks, write_output
     from curve_vae.service.payloads import augment_body
-    from curve_vae.service.runtime import fresh_seed
+    from curve_vae.service.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
     runtime = model_runtime(a)

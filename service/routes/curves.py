@@ -38,7 +38,8 @@ from curve_vae.service.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service.npy_bodies import OPENAPI_BODY as NPY_BODY
 from curve_vae.service.npy_bodies import npy_route
 from curve_vae.service.payloads import augment_body, frames_json, sample_body, with_metrics, with_output
-from curve_vae.service.runtime import CurveRuntime, fresh_seed
+from curve_vae.service.runtime import CurveRuntime
+from curve_vae.service.sampling import fresh_seed
 from curve_vae.service.settings import Settings
 
 ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'
