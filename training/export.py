@@ -68,11 +68,6 @@ def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
     }
 
 
-def sha256(path: str | Path) -> str:
-    """The checksum the manifest records and the service checks (one definition: service.model_files)."""
-    return file_sha256(Path(path))
-
-
 @contextmanager
 def _quiet_exporter() -> Iterator[None]:
     """Silence what the exporter says that no user can act on: torchvision being absent (its detection ops are not
@@ -201,7 +196,7 @@ def export(
         "variant": cfg.variant,
         "n_points": cfg.n_points,
         "latent_dim": cfg.latent_dim,
-        "files": {f: {"sha256": sha256(out / f), "bytes": (out / f).stat().st_size} for f in files},
+        "files": {f: {"sha256": file_sha256(out / f), "bytes": (out / f).stat().st_size} for f in files},
         "graphs": _graphs_manifest(cfg),
         **({"spline": spline_manifest(cfg)} if cfg.spline_ctrl else {}),
         **({"prior": _prior_manifest(prior, prior_info)} if prior is not None else {}),

@@ -12,8 +12,8 @@ import pytest
 import torch
 
 from curve_vae.cli import main
+from curve_vae.service.model_files import file_sha256
 from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
-from curve_vae.training.export import sha256
 
 pytestmark = pytest.mark.slow
 
@@ -70,7 +70,7 @@ def test_export_parity_and_manifest(trained):
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["version"] == "9.9.9" and manifest["latent_dim"] == 32 and manifest["n_points"] == 161
     for name, meta in manifest["files"].items():
-        assert sha256(out / name) == meta["sha256"], name
+        assert file_sha256(out / name) == meta["sha256"], name
     assert set(manifest["metrics"]["test_sets"]) == {"test", "fresh_seed_7919"}
     assert manifest["training"]["train"]["epochs"] == 3
 
