@@ -19,7 +19,7 @@ from pathlib import Path
 import curve_vae.service.runtime as rt
 from curve_vae.geometry import frame as geometry_frame
 from curve_vae.training.data import DataConfig, generate_curves
-from curve_vae.training.suite import run_suite
+from curve_vae.training.suite import run_suite, suite_sets
 
 ROWS = [  # label, pose, chord directions, twins
     ("as is", "as_is", 1, False),
@@ -42,12 +42,13 @@ def main() -> None:
     runtime = rt.CurveRuntime.load(a.model_dir, providers="cpu")
     chords, candidates = rt.POSE_CHORD_COUNT, rt.pose_frames
     results, base = {}, None
+    suite = suite_sets(test, a.count)
     try:
         for label, pose, n_chords, twins in ROWS:
             rt.POSE_CHORD_COUNT = n_chords
             rt.pose_frames = functools.partial(geometry_frame.pose_frames, flips=twins)
             t0 = time.perf_counter()
-            report = run_suite(runtime, test, count=a.count, pose=pose, spacing=a.spacing)
+            report = run_suite(runtime, suite, pose=pose, spacing=a.spacing)
             seconds = time.perf_counter() - t0
             base = base or seconds
             results[label] = {"time_vs_as_is": seconds / base, **{k: v["rel_rmse_mean"] for k, v in report.items()}}

@@ -208,9 +208,10 @@ def _family_suite(runtime: Any, suite_count: int, out: Path, figures: bool) -> d
     from curve_vae.training.suite import paper_test_split, run_suite, suite_sets
 
     paper = paper_test_split()  # whatever the model was trained on: the suite's paper sets are the paper's
-    report = run_suite(runtime, paper, count=suite_count)
+    sets = suite_sets(paper, suite_count)
+    report = run_suite(runtime, sets)
     if figures:
-        plot_suite(runtime, suite_sets(paper, suite_count), out / "families.png")
+        plot_suite(runtime, sets, out / "families.png")
     return report
 
 

@@ -98,12 +98,10 @@ def measure(runtime: Any, curves: list[np.ndarray], **options: Any) -> dict[str,
     }
 
 
-def run_suite(runtime: Any, test_curves: np.ndarray, *, count: int = 200, **options: Any) -> dict[str, Any]:
-    """Every set of `suite_sets` measured with the given request options."""
-    return {
-        name: {"kind": kind, **measure(runtime, curves, **options)}
-        for name, (kind, curves) in suite_sets(test_curves, count).items()
-    }
+def run_suite(runtime: Any, sets: dict[str, tuple[str, list[np.ndarray]]], **options: Any) -> dict[str, Any]:
+    """Every set of `suite_sets` measured with the given request options (the sets drawn once by the caller, who
+    may measure them again with other options or plot them)."""
+    return {name: {"kind": kind, **measure(runtime, curves, **options)} for name, (kind, curves) in sets.items()}
 
 
 def format_suite(report: dict[str, Any]) -> str:

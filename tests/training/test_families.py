@@ -65,8 +65,9 @@ def test_suite_bookkeeping_with_a_perfect_reconstructor():
             return [np.asarray(c, np.float64) for c in curves], None
 
     test = F.draw_family(F.paper, 12, np.random.default_rng(0), model_size=None)
-    report = run_suite(Echo(), test, count=6)
-    assert set(report) == set(suite_sets(test, 6))
+    sets = suite_sets(test, 6)
+    report = run_suite(Echo(), sets)
+    assert set(report) == set(sets) and len(sets) >= 10
     assert {r["kind"] for r in report.values()} >= {"paper", "trained", "held out"}
     for r in report.values():
         assert r["n_curves"] == 6
