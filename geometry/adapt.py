@@ -86,22 +86,32 @@ def spline_to_caller(
     n_points: int | None = None,
     spacing: str = "parameter",
     fractions: np.ndarray | None = None,
+    model_params: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A model-plane clamped uniform B-spline (n_ctrl, 2) -> its points, control points and the points' parameters
     in the caller's frame and order.
 
-    The points are the spline's exactly, at parameters: n_points of them, evenly in the parameter or (spacing
-    "arc_length") in arc length; else at `fractions` (the caller's positions); else `model_points` evenly in the
-    parameter (the model's own points).
+    The points are the spline's exactly, at parameters: n_points of them, at the model's spacing or (spacing
+    "arc_length") evenly in arc length; else at `fractions` (the caller's positions along the model's points);
+    else the model's own `model_points`. The model's spacing: its points' parameters `model_params` (a head that
+    learns them), interpolated between points; without them, evenly in the parameter.
     """
     c = np.asarray(control_points, np.float64)
+    count = n_points or model_points
     if n_points is not None and spacing == "arc_length":
         u = arc_length_params(c, n_points, degree=degree)
+    elif model_params is not None:
+        own = np.linspace(0.0, 1.0, len(model_params))
+        at = (
+            np.asarray(fractions, np.float64)
+            if n_points is None and fractions is not None
+            else np.linspace(0, 1, count)
+        )
+        u = np.clip(np.interp(at, own, np.asarray(model_params, np.float64)), 0.0, 1.0)
     elif n_points is None and fractions is not None:
         u = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
     else:  # evenly in the parameter: the basis is the same for every curve (cached by sample_bspline)
         u = None
-        count = n_points or model_points
     if u is None:
         curve, u = sample_bspline(c, count, degree), np.linspace(0.0, 1.0, count)
     else:

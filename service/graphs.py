@@ -48,6 +48,7 @@ class ModelGraphs:
         spline = manifest.get("spline")
         self.spline_degree = int(spline["degree"]) if spline else 0
         self.knots = clamped_uniform_knots(int(spline["n_ctrl"]), self.spline_degree) if spline else None
+        self.learned_params = bool(spline and spline.get("learned_params"))
         # Where the data lives in the model plane (paper §3.1: a radius-64 disc in the 128×128 plane): the region a
         # valid sample must stay in.
         self.disc_center = np.asarray(manifest["frame"].get("center", list(MODEL_CENTER)), np.float64)
@@ -108,8 +109,9 @@ class ModelGraphs:
                 f"decoder input {dec_in.name} has shape {dec_in.shape}, expected [batch, {self.latent_dim}]"
             )
         dec_out = [o.name for o in self.decoder.get_outputs()]
-        if self.has_splines and dec_out[:2] != ["curves", "control_points"]:
-            problems.append(f"decoder outputs {dec_out}, expected curves and control_points (the manifest's spline)")
+        expected = ["curves", "control_points", "params"][: 1 + self.has_splines + self.has_params]
+        if dec_out[: len(expected)] != expected:
+            problems.append(f"decoder outputs {dec_out}, expected {', '.join(expected)} (the manifest's spline)")
         if self.prior is not None and self.prior.latent_dim != self.latent_dim:
             problems.append(f"the prior has {self.prior.latent_dim} latent dimensions, the model {self.latent_dim}")
         if problems:
@@ -129,6 +131,11 @@ class ModelGraphs:
     def has_splines(self) -> bool:
         """Whether the decoder ends in a B-spline head (curves can be returned as splines)."""
         return self.knots is not None
+
+    @property
+    def has_params(self) -> bool:
+        """Whether the decoder places its points at spline parameters of its own (output `params`), not evenly."""
+        return self.has_splines and self.learned_params
 
     @property
     def providers(self) -> list[str]:
@@ -179,16 +186,16 @@ class ModelGraphs:
         """(B, latent_dim) -> (B, n_points, 2) in the model plane."""
         return self.decode_model_splines(latents)[0]
 
-    def decode_model_splines(self, latents: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """(B, latent_dim) -> curves (B, n_points, 2) and, with a B-spline head, control points (B, n_ctrl, 2)."""
+    def decode_model_splines(self, latents: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """(B, latent_dim) -> curves (B, n_points, 2); with a B-spline head, control points (B, n_ctrl, 2); with
+        learned parameters (`has_params`), the spline parameter of each point (B, n_points). Absent: None."""
         z = np.ascontiguousarray(latents, dtype=np.float32)
         decoder = self.decoder
-        curves, ctrls = [], []
+        parts: list[list[np.ndarray]] = [[], [], []]
         for i in range(0, len(z), self.batch_size):
-            out = self._run_graph(decoder, "decoder", z[i : i + self.batch_size], None)
-            curves.append(out[0])
-            ctrls.append(out[1] if self.has_splines else None)
-        if not curves:
-            n_ctrl = len(self.knots) - self.spline_degree - 1 if self.has_splines else 0
-            return np.zeros((0, self.n_points, 2), np.float32), np.zeros((0, n_ctrl, 2), np.float32)
-        return np.concatenate(curves), (np.concatenate(ctrls) if self.has_splines else None)
+            for part, out in zip(parts, self._run_graph(decoder, "decoder", z[i : i + self.batch_size], None)):
+                part.append(out)
+        n_ctrl = len(self.knots) - self.spline_degree - 1 if self.knots is not None else 0
+        empty = (np.zeros((0, self.n_points, 2)), np.zeros((0, n_ctrl, 2)), np.zeros((0, self.n_points)))
+        curves, ctrl, params = (np.concatenate(p) if p else e.astype(np.float32) for p, e in zip(parts, empty))
+        return curves, ctrl if self.has_splines else None, params if self.has_params else None

@@ -81,6 +81,7 @@ class Prepared:
     log_var: np.ndarray | None = None
     decoded: np.ndarray | None = None  # (B, n_points, 2) model plane
     ctrl: np.ndarray | None = None  # (B, n_ctrl, 2) with a B-spline head
+    params: np.ndarray | None = None  # (B, n_points) spline parameter of each model point, if the head learns them
 
 
 @dataclass(frozen=True)
@@ -151,7 +152,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
             mean, log_var = self.encode_model(batch)
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
             _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
-            decoded, ctrl = self.decode_model_splines(mean)
+            decoded, ctrl, params = self.decode_model_splines(mean)
             err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
         k = len(batch) // max(len(inputs), 1)  # every curve has the same number of candidates, in a row
         best = list(np.arange(len(inputs)) * k + err.reshape(len(inputs), k).argmin(axis=1))
@@ -164,6 +165,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
             log_var[best],
             decoded[best],
             None if ctrl is None else ctrl[best],
+            None if params is None else params[best],
         )
 
     def _to_model_points(
@@ -199,12 +201,13 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
         spacing: Spacing = "parameter",
         fractions: np.ndarray | None = None,
         ctrl: np.ndarray | None = None,
+        params: np.ndarray | None = None,
         splines: list[Spline] | None = None,
     ) -> np.ndarray:
         """One model-plane result (n_points_model, 2) -> the caller's frame and length (geometry.adapt): n_points
         spaced as `spacing` says, else at the input's positions (`fractions`), else the model's points. With the
-        control points of a B-spline head (`ctrl`) the points are the spline's, and the spline is appended to
-        `splines`."""
+        control points of a B-spline head (`ctrl`) the points are the spline's (at the head's learned `params`
+        where it has them), and the spline is appended to `splines`."""
         if ctrl is None:
             return polyline_to_caller(
                 out, frame, model_size=self.model_size, n_points=n_points, spacing=spacing, fractions=fractions
@@ -218,6 +221,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
             n_points=n_points,
             spacing=spacing,
             fractions=fractions,
+            model_params=params,
         )
         if splines is not None:
             assert self.knots is not None
@@ -252,20 +256,22 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
             raise InputError(("latents",), f"expected rows of {self.latent_dim} numbers, got shape {list(z.shape)}")
         _check_range(z, "latents")
         with np.errstate(all="ignore"):
-            out, ctrl = self.decode_model_splines(z)
-        return self._place(out, ctrl, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
+            out, ctrl, params = self.decode_model_splines(z)
+        return self._place(out, ctrl, params, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
 
     def _place(
         self,
         out: np.ndarray,
         ctrl: np.ndarray | None,
+        params: np.ndarray | None,
         *,
         frames: Sequence[Frame] | None,
         n_points: int | None,
         spacing: Spacing,
         splines: list[Spline] | None,
     ) -> np.ndarray:
-        """Decoded curves (B, n_points_model, 2) (and control points) -> the caller's frames and length, checked."""
+        """Decoded curves (B, n_points_model, 2) (and control points, parameters) -> the caller's frames and length,
+        checked."""
         with np.errstate(all="ignore"):
             _check_finite(
                 out, "latents", "decodes to non-finite coordinates: the latent is far outside the training range"
@@ -277,6 +283,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
                     n_points=n_points,
                     spacing=spacing,
                     ctrl=None if ctrl is None else ctrl[i],
+                    params=None if params is None else params[i],
                     splines=splines,
                 )
                 for i, o in enumerate(out)
@@ -303,21 +310,21 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
         prep = self.prepare(curves, frame, spacing, pose)
         with np.errstate(all="ignore"):
             if prep.decoded is not None:
-                out, ctrl = prep.decoded, prep.ctrl
+                out, ctrl, params = prep.decoded, prep.ctrl, prep.params
             else:
                 mean, _ = self._encoded(prep)
-                out, ctrl = self.decode_model_splines(mean)
+                out, ctrl, params = self.decode_model_splines(mean)
             results, mse = [], np.empty(len(out))
             for i, o in enumerate(out):
-                c = None if ctrl is None else ctrl[i]
+                c, u = None if ctrl is None else ctrl[i], None if params is None else params[i]
                 kept = splines if n_points is None else None
                 own = self._to_caller(
-                    o, prep.frames[i], n_points=None, fractions=prep.fractions[i], ctrl=c, splines=kept
+                    o, prep.frames[i], n_points=None, fractions=prep.fractions[i], ctrl=c, params=u, splines=kept
                 )
                 mse[i] = mse_per_curve(prep.inputs[i][None], own[None])[0]
                 if n_points is not None:
                     own = self._to_caller(
-                        o, prep.frames[i], n_points=n_points, spacing=spacing, ctrl=c, splines=splines
+                        o, prep.frames[i], n_points=n_points, spacing=spacing, ctrl=c, params=u, splines=splines
                     )
                 results.append(own)
                 if not (np.isfinite(results[-1]).all() and np.isfinite(mse[i])):
@@ -361,7 +368,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
             # a curve must not change with the batch or page it is made in.
             z = (w[:, :, None] * mean[None, :, :]).sum(axis=1)  # (rows, latent_dim)
             _check_range(z, "weights")
-            out, ctrl = self.decode_model_splines(z)
+            out, ctrl, params = self.decode_model_splines(z)
             _check_finite(out, "weights", "the weighted latent decodes to non-finite coordinates: weights too extreme")
             given = [f for f in prep.frames if f is not None]
             frames: list[Frame | None] = (
@@ -373,16 +380,20 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
                 n_points = self.n_points
             results = []
             for r, o in enumerate(out):
-                c = None if ctrl is None else ctrl[r]
+                c, u = None if ctrl is None else ctrl[r], None if params is None else params[r]
                 if blend:
                     positions = w[r] @ np.stack(prep.fractions)  # type: ignore[arg-type]
                     positions = np.maximum.accumulate(np.clip(positions, 0.0, 1.0))  # extrapolating rows stay ordered
                     results.append(
-                        self._to_caller(o, frames[r], n_points=None, fractions=positions, ctrl=c, splines=splines)
+                        self._to_caller(
+                            o, frames[r], n_points=None, fractions=positions, ctrl=c, params=u, splines=splines
+                        )
                     )
                 else:
                     results.append(
-                        self._to_caller(o, frames[r], n_points=n_points, spacing=spacing, ctrl=c, splines=splines)
+                        self._to_caller(
+                            o, frames[r], n_points=n_points, spacing=spacing, ctrl=c, params=u, splines=splines
+                        )
                     )
             result = np.stack(results) if results else np.zeros((0, self.mix_length(prep, n_points), 2))
         _check_finite(result, "weights", "the interpolant does not fit in float64")

@@ -46,6 +46,7 @@ class Sampling:
     disc_radius: float
     has_splines: Any
     decode_model_splines: Any
+    has_params: Any
     _place: Any
 
     def sample(
@@ -89,12 +90,15 @@ class Sampling:
         draws, ok, todo = np.ones(count, np.int64), np.zeros(count, bool), np.arange(count)
         out = np.zeros((count, self.n_points, 2), np.float32)
         ctrl = np.zeros((count, len(self.knots) - self.spline_degree - 1, 2), np.float32) if self.has_splines else None
+        params = np.zeros((count, self.n_points), np.float32) if self.has_params else None
         while len(todo):  # each draw is decoded once; its curve is kept until the item draws again
             with np.errstate(all="ignore"):
-                decoded, points = self.decode_model_splines(z[todo])
+                decoded, points, par = self.decode_model_splines(z[todo])
             out[todo] = decoded
             if ctrl is not None and points is not None:
                 ctrl[todo] = points
+            if params is not None and par is not None:
+                params[todo] = par
             if not valid:
                 break
             good = self.plausible(decoded.astype(np.float64))
@@ -105,7 +109,7 @@ class Sampling:
                 draws[i] += 1
         invalid = int((~ok).sum()) if valid else 0
         frames = [frame] * count if frame else None
-        curves = self._place(out, ctrl, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
+        curves = self._place(out, ctrl, params, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
         return Sampled(z, curves, chosen, rejected=int(draws.sum() - count), invalid=invalid)
 
     def plausible(self, curves: np.ndarray) -> np.ndarray:

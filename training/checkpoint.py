@@ -76,6 +76,18 @@ def load_weights(path: str | Path) -> tuple[ModelConfig, dict[str, torch.Tensor]
     return ModelConfig(**ckpt["model_config"]), ckpt["model"]
 
 
+def widen(weights: dict[str, torch.Tensor], model: VAE) -> dict[str, torch.Tensor]:
+    """Weights of a model without learned spline parameters, for `model` with them: the decoder's last layer gains
+    its parameter channel with zero weights, which decodes the same curves at the same even parameters."""
+    layer = len(model.decoder.features) - 1
+    out = dict(weights)
+    for name in (f"decoder.features.{layer}.weight", f"decoder.features.{layer}.bias"):
+        w = weights[name]
+        pad = torch.zeros_like(w.narrow(-1 if w.dim() == 1 else 1, 0, 1))
+        out[name] = torch.cat([w, pad], dim=0 if w.dim() == 1 else 1)
+    return out
+
+
 def model_from_checkpoint(path: str | Path) -> VAE:
     """The model of a training checkpoint or of shipped weights, rebuilt from its stored configuration, in eval mode."""
     cfg, state = load_weights(path)

@@ -32,6 +32,11 @@ class ModelConfig:
     # this many control points (0: raw points). A fixed projector, no weights: it removes the
     # stride-3 upsampling's zig-zag; 7k + 3 keeps the data's knots, so data curves pass unchanged.
     spline_ctrl: int = 0
+    # With the spline head: each point's spline parameter is the decoder's own (a third output channel whose
+    # softmax gives the increments between consecutive points), so points may sit at any spacing along the
+    # spline, such as arc length; off: point i sits at i/(n_points-1). Zero weights in that channel give the
+    # even parameters exactly, so a model without it continues with the channel added (checkpoint.widen).
+    spline_params: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "variant", ALIASES.get(self.variant.lower(), self.variant.lower()))
@@ -41,10 +46,16 @@ class ModelConfig:
             raise ValueError(f"latent_dim must be ≥ 1, got {self.latent_dim}")
         if self.spline_ctrl and not 4 <= self.spline_ctrl <= self.n_points:
             raise ValueError(f"spline_ctrl must be 0 (off) or 4 … {self.n_points}, got {self.spline_ctrl}")
+        if self.spline_params and not self.spline_ctrl:
+            raise ValueError("spline_params needs the B-spline head (spline_ctrl > 0)")
 
     def same_weights(self, other: ModelConfig) -> bool:
-        """Whether the two configs have the same trainable weights (the spline head has none)."""
-        return replace(self, spline_ctrl=0) == replace(other, spline_ctrl=0)
+        """Whether the two configs have the same trainable weights (the spline head has none of its own)."""
+
+        def key(c: ModelConfig) -> tuple[ModelConfig, bool]:  # learned parameters add a channel; the head none
+            return replace(c, spline_ctrl=0, spline_params=False), c.spline_params
+
+        return key(self) == key(other)
 
 
 SCHEDULES = ("onecycle", "cosine", "constant", "plateau")

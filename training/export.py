@@ -44,15 +44,16 @@ class _EncoderGraph(nn.Module):
 
 
 class _DecoderGraph(nn.Module):
-    """The decoder at inference; with a B-spline head it also returns the control points."""
+    """The decoder at inference; with a B-spline head it also returns the control points (and the learned
+    parameters of the points, if the head has them)."""
 
     def __init__(self, vae: VAE) -> None:
         super().__init__()
         self.decoder = vae.decoder
 
-    def forward(self, latent: torch.Tensor) -> torch.Tensor | tuple[torch.Tensor, torch.Tensor]:
-        curves, ctrl = self.decoder.decode(latent)
-        return curves if ctrl is None else (curves, ctrl)
+    def forward(self, latent: torch.Tensor) -> torch.Tensor | tuple[torch.Tensor, ...]:
+        curves, ctrl, params = self.decoder.decode_params(latent)
+        return curves if ctrl is None else (curves, ctrl) if params is None else (curves, ctrl, params)
 
 
 def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
@@ -63,8 +64,12 @@ def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
         "n_ctrl": cfg.spline_ctrl,
         "degree": 3,
         "knots": clamped_uniform_knots(cfg.spline_ctrl, 3).tolist(),
-        "params": f"curve point i is the clamped uniform cubic B-spline at u = i/{cfg.n_points - 1}",
+        "params": "curve point i is the clamped uniform cubic B-spline at u = params[i], the decoder's output params "
+        "(increasing from 0 to 1)"
+        if cfg.spline_params
+        else f"curve point i is the clamped uniform cubic B-spline at u = i/{cfg.n_points - 1}",
         "output": "control_points",
+        **({"learned_params": True} if cfg.spline_params else {}),
     }
 
 
@@ -120,7 +125,7 @@ def _export_graphs(model: VAE, out: Path) -> list[str]:
         "curves",
         ["mean", "log_var"],
     )
-    dec_outputs = ["curves", "control_points"] if cfg.spline_ctrl else ["curves"]
+    dec_outputs = ["curves", "control_points", "params"][: 1 + bool(cfg.spline_ctrl) + cfg.spline_params]
     _export(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", "latent", dec_outputs)
     return ["encoder.onnx", "decoder.onnx"]
 
@@ -139,6 +144,7 @@ def _graphs_manifest(cfg: ModelConfig) -> dict[str, Any]:
             "outputs": {
                 "curves": ["batch", cfg.n_points, 2],
                 **({"control_points": ["batch", cfg.spline_ctrl, 2]} if cfg.spline_ctrl else {}),
+                **({"params": ["batch", cfg.n_points]} if cfg.spline_params else {}),
             },
         },
     }

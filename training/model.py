@@ -10,7 +10,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from curve_vae.geometry import spline_head
+from curve_vae.geometry import clamped_uniform_knots, spline_head
 from curve_vae.training.config import CONV_VARIANTS, VARIANTS, ModelConfig
 
 __all__ = ["VAE", "Encoder", "Decoder", "Inception", "ModelConfig", "VARIANTS", "count_parameters"]
@@ -162,6 +162,7 @@ class Decoder(nn.Module):
         super().__init__()
         self.cfg = cfg
         self.feat_shape = (feat_channels, feat_len)
+        self.channels = 3 if cfg.spline_params else 2  # x, y (and each point's parameter increment)
         self.dense = nn.Sequential(nn.Linear(cfg.latent_dim, feat_channels * feat_len), nn.ReLU())
         up = nn.Upsample(scale_factor=3, mode="nearest")
         if cfg.variant == "inception":
@@ -177,7 +178,7 @@ class Decoder(nn.Module):
                 conv_block(256, 64, 5, transposed=True),
                 nn.BatchNorm1d(64),
                 up,
-                nn.ConvTranspose1d(64, 2, 3),
+                nn.ConvTranspose1d(64, self.channels, 3),
             )
         else:
             layers: list[nn.Module] = []
@@ -185,7 +186,7 @@ class Decoder(nn.Module):
             for f, k in reversed(CONV_VARIANTS[cfg.variant]):
                 layers += [conv_block(c, f, k, transposed=True), nn.BatchNorm1d(f), up]
                 c = f
-            layers.append(nn.ConvTranspose1d(c, 2, 3))
+            layers.append(nn.ConvTranspose1d(c, self.channels, 3))
             self.features = nn.Sequential(*layers)
         _, out_len = _out_len(self.features, feat_channels, feat_len)
         if out_len < cfg.n_points:
@@ -196,6 +197,9 @@ class Decoder(nn.Module):
             basis, pinv = spline_head(cfg.spline_ctrl, cfg.n_points)
             self.register_buffer("basis", torch.tensor(basis, dtype=torch.float32), persistent=False)
             self.register_buffer("pinv", torch.tensor(pinv, dtype=torch.float32), persistent=False)
+            knots = torch.tensor(clamped_uniform_knots(cfg.spline_ctrl, 3), dtype=torch.float32)
+            self.register_buffer("knots", knots, persistent=False)
+            self.register_buffer("closed", last_span_mask(knots), persistent=False)
 
     def forward(self, z: torch.Tensor, *, full: bool | None = None) -> torch.Tensor:
         """Decode to curves (B, N, 2); full runs every layer over its whole length (default: in training only)."""
@@ -203,15 +207,60 @@ class Decoder(nn.Module):
 
     def decode(self, z: torch.Tensor, *, full: bool | None = None) -> tuple[torch.Tensor, torch.Tensor | None]:
         """Curves (B, N, 2) and, with the spline head, their control points (B, K, 2); else None."""
+        curves, ctrl, _ = self.decode_params(z, full=full)
+        return curves, ctrl
+
+    def decode_params(
+        self, z: torch.Tensor, *, full: bool | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor | None, torch.Tensor | None]:
+        """`decode`, and with learned parameters (cfg.spline_params) each point's spline parameter (B, N); else None."""
         full = self.training if full is None else full
         x = self.dense(z).view(-1, *self.feat_shape)  # (B, C, L)
         for layer, n in zip(self.features, self.crops):
             x = layer(x if full else x[:, :, :n])
-        x = x[:, :, : self.cfg.n_points]  # (B, 2, N), normalised
+        x = x[:, :, : self.cfg.n_points]  # (B, channels, N), normalised
         if not self.cfg.spline_ctrl:
-            return x.transpose(1, 2) * self.cfg.scale + self.cfg.center, None  # (B, N, 2)
-        ctrl = torch.matmul(self.pinv, x.transpose(1, 2)) * self.cfg.scale + self.cfg.center  # (B, K, 2)
-        return torch.matmul(self.basis, ctrl), ctrl  # (B, N, 2), (B, K, 2)
+            return x.transpose(1, 2) * self.cfg.scale + self.cfg.center, None, None  # (B, N, 2)
+        ctrl = torch.matmul(self.pinv, x[:, :2].transpose(1, 2)) * self.cfg.scale + self.cfg.center  # (B, K, 2)
+        if not self.cfg.spline_params:
+            return torch.matmul(self.basis, ctrl), ctrl, None  # (B, N, 2), (B, K, 2)
+        params = increments_to_params(x[:, 2, 1:])
+        return torch.matmul(bspline_basis(params, self.knots, self.closed, 3), ctrl), ctrl, params
+
+
+def increments_to_params(logits: torch.Tensor) -> torch.Tensor:
+    """(B, N-1) logits -> (B, N) increasing parameters from exactly 0 to exactly 1, the steps their softmax.
+
+    Equal logits (zero weights) give the even parameters i/(N-1)."""
+    steps = torch.exp(logits - logits.amax(dim=-1, keepdim=True))
+    cum = torch.cumsum(steps, dim=-1)
+    return torch.cat([torch.zeros_like(cum[:, :1]), cum / cum[:, -1:]], dim=-1)
+
+
+def last_span_mask(knots: torch.Tensor) -> torch.Tensor:
+    """(len(knots) - 1,) bool: True at the last non-empty knot span, which `bspline_basis` closes at its end."""
+    spans = knots[1:] > knots[:-1]
+    last = int(torch.nonzero(spans).max())
+    return torch.arange(len(spans)) == last
+
+
+def bspline_basis(u: torch.Tensor, knots: torch.Tensor, closed: torch.Tensor, degree: int) -> torch.Tensor:
+    """B-spline basis (…, n_ctrl) at parameters u (…) in [knots[0], knots[-1]], by Cox–de Boor's recursion.
+
+    Differentiable in u (the curve's derivative along itself) and exported to ONNX as plain arithmetic; the last
+    non-empty knot span (`closed`, from `last_span_mask`) is closed, so u = knots[-1] gives the last control point,
+    as scipy's design matrix does.
+    """
+    t = knots
+    u = u.unsqueeze(-1)
+    left, right = t[:-1], t[1:]
+    b = ((u >= left) & ((u < right) | (closed & (u <= right)))).to(u.dtype)
+    for k in range(1, degree + 1):
+        d1, d2 = t[k:-1] - t[: -k - 1], t[k + 1 :] - t[1:-k]
+        r1 = torch.where(d1 > 0, 1 / torch.where(d1 > 0, d1, 1), 0)
+        r2 = torch.where(d2 > 0, 1 / torch.where(d2 > 0, d2, 1), 0)
+        b = (u - t[: -k - 1]) * r1 * b[..., :-1] + (t[k + 1 :] - u) * r2 * b[..., 1:]
+    return b
 
 
 class VAE(nn.Module):

@@ -18,7 +18,7 @@ import os
 import random
 import time
 from contextlib import nullcontext
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +34,7 @@ from curve_vae.training.checkpoint import (
     atomic_save,
     load_checkpoint,
     load_weights,
+    widen,
     without_resume_state,
 )
 from curve_vae.training.config import SCHEDULES, ModelConfig, TrainConfig
@@ -321,6 +322,8 @@ def _restore(
         proc.say(f"no checkpoint at {last}: starting a new run")
     if init_from:
         init_cfg, weights = load_weights(init_from)
+        if model.cfg.spline_params and not init_cfg.spline_params and init_cfg.spline_ctrl:
+            init_cfg, weights = replace(init_cfg, spline_params=True), widen(weights, model)
         if not init_cfg.same_weights(model.cfg):
             raise ValueError(f"{init_from} holds a {asdict(init_cfg)} model, not {asdict(model.cfg)}")
         model.load_state_dict(weights)

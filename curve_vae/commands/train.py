@@ -36,6 +36,14 @@ def add_train_options(p: argparse.ArgumentParser) -> None:
         "control points, 7k+3 to keep the data's knots (0: raw points) (default: the --init-from or resumed "
         "checkpoint's head, else 0)",
     )
+    g.add_argument(
+        "--spline-params",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="with the B-spline head: the decoder places each point at a spline parameter of its own (learned; "
+        "a model without them continues with the even parameters it had) (default: the --init-from or resumed "
+        "checkpoint's, else off)",
+    )
     d = TrainConfig()
     g = p.add_argument_group("training")
     helps = {
@@ -80,15 +88,19 @@ def cmd_train(a: argparse.Namespace) -> int:
     from curve_vae.training.figures import plot_training
     from curve_vae.training.train import train
 
-    spline_ctrl = a.spline_ctrl
-    if spline_ctrl is None:  # keep the head of the weights a run continues from: dropping it would go unnoticed
-        start = Path(a.run_dir) / "last.pt" if a.resume and (Path(a.run_dir) / "last.pt").exists() else a.init_from
-        spline_ctrl = 0
-        if start:
-            from curve_vae.training.checkpoint import load_weights
+    # keep the head of the weights a run continues from: dropping it would go unnoticed
+    start = Path(a.run_dir) / "last.pt" if a.resume and (Path(a.run_dir) / "last.pt").exists() else a.init_from
+    started = ModelConfig()
+    if start and (a.spline_ctrl is None or a.spline_params is None):
+        from curve_vae.training.checkpoint import load_weights
 
-            spline_ctrl = load_weights(start)[0].spline_ctrl
-    model_cfg = ModelConfig(variant=a.variant, latent_dim=a.latent_dim, spline_ctrl=spline_ctrl)
+        started = load_weights(start)[0]
+    model_cfg = ModelConfig(
+        variant=a.variant,
+        latent_dim=a.latent_dim,
+        spline_ctrl=started.spline_ctrl if a.spline_ctrl is None else a.spline_ctrl,
+        spline_params=started.spline_params if a.spline_params is None else a.spline_params,
+    )
     cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
     run_dir = Path(a.run_dir)
     state = train(

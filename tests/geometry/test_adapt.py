@@ -166,3 +166,23 @@ def test_spline_params_follow_the_spacing_asked():
     fractions = np.array([-0.1, 0.2, 0.7, 1.3])
     _, _, u = spline_to_caller(ctrl, None, model_size=SIZE, degree=3, model_points=N, fractions=fractions)
     np.testing.assert_array_equal(u, [0.0, 0.2, 0.7, 1.0])  # clipped to the spline's range
+
+
+def test_a_head_with_its_own_parameters_places_the_model_points_there_and_the_rest_between():
+    ctrl = _smooth_ctrl(31)
+    own = np.linspace(0, 1, N) ** 1.7  # a head that crowds its points at the start
+    frame = Frame((3.0, -2.0), 7.0, rotation=0.4, reverse=True)
+    curve, c, u = spline_to_caller(ctrl, frame, model_size=SIZE, degree=3, model_points=N, model_params=own)
+    np.testing.assert_allclose(frame.to_model(curve, SIZE), _scipy_spline(ctrl, own), atol=1e-9)
+    np.testing.assert_allclose(_scipy_spline(c, u), curve, atol=1e-9)
+    _, _, u = spline_to_caller(ctrl, None, model_size=SIZE, degree=3, model_points=N, n_points=81, model_params=own)
+    np.testing.assert_allclose(u, own[::2], atol=1e-15)  # "parameter": the head's spacing, at any count
+    fractions = np.array([0.0, 0.25, 0.5, 1.0])
+    _, _, u = spline_to_caller(
+        ctrl, None, model_size=SIZE, degree=3, model_points=N, fractions=fractions, model_params=own
+    )
+    np.testing.assert_allclose(u, own[[0, 40, 80, 160]], atol=1e-15)  # the input's positions along the model points
+    arc, _, _ = spline_to_caller(
+        ctrl, None, model_size=SIZE, degree=3, model_points=N, n_points=100, spacing="arc_length", model_params=own
+    )
+    assert _steps(arc).max() / _steps(arc).min() < 1.01  # arc-length spacing does not depend on the head's

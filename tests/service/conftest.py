@@ -44,6 +44,13 @@ def raw_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return _copy(FIXTURES / "untrained-raw", tmp_path_factory.mktemp("raw_model"))
 
 
+@pytest.fixture(scope="session")
+def params_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The same untrained VAE whose B-spline head places each point at a parameter of its own (uneven, as its
+    random weights give them), like the shipped model's head."""
+    return _copy(FIXTURES / "untrained-params31", tmp_path_factory.mktemp("params_model"))
+
+
 def _copy(src: Path, out: Path) -> Path:
     """A copy a test may change without changing the committed files."""
     shutil.copytree(src, out, dirs_exist_ok=True)
@@ -58,6 +65,11 @@ def runtime(model_dir: Path) -> CurveRuntime:
 @pytest.fixture(scope="session")
 def raw_runtime(raw_model_dir: Path) -> CurveRuntime:
     return CurveRuntime.load(raw_model_dir, providers="cpu", intra_op_threads=1)
+
+
+@pytest.fixture(scope="session")
+def params_runtime(params_model_dir: Path) -> CurveRuntime:
+    return CurveRuntime.load(params_model_dir, providers="cpu", intra_op_threads=1)
 
 
 @pytest.fixture(scope="session")

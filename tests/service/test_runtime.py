@@ -46,6 +46,15 @@ def test_a_model_plane_centred_elsewhere_is_a_startup_error_not_a_silent_shift(m
         CurveRuntime.load(copy, providers="cpu")
 
 
+def test_a_manifest_promising_learned_parameters_of_a_decoder_without_them_is_a_startup_error(model_dir, tmp_path):
+    copy = _copy(model_dir, tmp_path)
+    manifest = json.loads((copy / "manifest.json").read_text())
+    manifest["spline"]["learned_params"] = True  # the even-parameter decoder has no `params` output
+    (copy / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ModelLoadError, match=r"expected curves, control_points, params"):
+        CurveRuntime.load(copy, providers="cpu")
+
+
 def test_missing_manifest_is_a_startup_error(tmp_path):
     with pytest.raises(ModelLoadError, match=r"manifest\.json is missing"):
         CurveRuntime.load(tmp_path, providers="cpu")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from curve_vae.geometry import clamped_uniform_knots, evaluate_bspline
+from curve_vae.geometry import arc_length_params, clamped_uniform_knots, evaluate_bspline
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
 
@@ -26,8 +26,19 @@ REQUESTS = [
 ]
 
 
+@pytest.fixture(params=["even", "learned"])
+def head_client(request, make_client, params_model_dir, params_runtime):
+    """A client of a model whose head places its points evenly in the parameter, or at parameters of its own."""
+    if request.param == "even":
+        return make_client()
+    client = TestClient(create_app(Settings(model_dir=params_model_dir), runtime=params_runtime))
+    request.addfinalizer(lambda: client.__exit__(None, None, None))
+    return client.__enter__()
+
+
 @pytest.mark.parametrize(("path", "body"), REQUESTS)
-def test_returned_splines_evaluate_back_to_the_returned_points(client, path, body):
+def test_returned_splines_evaluate_back_to_the_returned_points(head_client, path, body):
+    client = head_client
     points = client.post(path, json=body).json()["curves"]
     both = client.post(path, json={**body, "output": "both"}).json()
     only = client.post(path, json={**body, "output": "bspline"}).json()
@@ -67,3 +78,31 @@ def test_npy_augment_is_points_only(client):
 def test_unknown_output_is_a_422(client):
     r = client.post("/decode", json={"latents": Z, "output": "nurbs"})
     assert r.status_code == 422 and "output" in r.json()["detail"]
+
+
+def test_a_learned_head_places_the_points_at_its_own_parameters(params_runtime):
+    """The decoder's `params` output is where its points sit: the model's own 161 points come back at exactly those
+    parameters, other counts between them, arc-length spacing evenly in length, and the input's positions along
+    them; the returned spline at the returned parameters is the returned curve."""
+    rt = params_runtime
+    z = np.random.default_rng(4).normal(size=(1, 32))
+    _, ctrl, params = rt.decode_model_splines(z)
+    assert params.shape == (1, 161) and params[0, 0] == 0 and params[0, -1] == pytest.approx(1)
+    assert np.all(np.diff(params[0]) > 0) and np.ptp(np.diff(params[0])) > 1e-4  # uneven: not i/160
+    for ask in ({}, {"n_points": 161}):
+        splines: list = []
+        rt.decode(z, splines=splines, **ask)
+        np.testing.assert_allclose(splines[0].params, params[0], atol=1e-7)
+    splines = []
+    rt.decode(z, n_points=81, splines=splines)
+    np.testing.assert_allclose(splines[0].params, params[0, ::2], atol=1e-7)  # "parameter": the model's spacing
+    splines = []
+    rt.decode(z, n_points=60, spacing="arc_length", splines=splines)  # evenly in length, whatever the head's params
+    np.testing.assert_allclose(splines[0].params, arc_length_params(ctrl[0].astype(np.float64), 60), atol=1e-12)
+    t = np.linspace(0, 1, 41) ** 1.3
+    drawn = np.stack([10 * t, np.sin(3 * t)], axis=1)
+    splines = []
+    out, _ = rt.reconstruct([drawn], splines=splines, pose="as_is")
+    s = splines[0]
+    assert len(s.params) == 41 and np.all(np.diff(s.params) > 0)
+    np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), out[0], atol=1e-9)

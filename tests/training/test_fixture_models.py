@@ -23,7 +23,7 @@ def _run(model_dir: Path, curves: np.ndarray) -> list[np.ndarray]:
 
 @pytest.mark.parametrize("name", sorted(make_models.MODELS))
 def test_the_committed_fixture_is_what_the_script_makes(name, tmp_path):
-    fresh = make_models.export_untrained(tmp_path, spline_ctrl=make_models.MODELS[name])
+    fresh = make_models.export_untrained(tmp_path, **make_models.MODELS[name])
     committed = FIXTURES / name
     curves = make_models.bspline_curves(8, seed=11).astype(np.float32)
     for a, b in zip(_run(committed, curves), _run(fresh, curves), strict=True):

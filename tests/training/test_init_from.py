@@ -36,3 +36,23 @@ def test_init_from_keeps_the_checkpoints_spline_head(tmp_path, monkeypatch):
     assert json.loads((tmp_path / "kept" / "config.json").read_text())["model"]["spline_ctrl"] == 31
     assert main(["train", "--run-dir", "dropped", "--init-from", str(start), "--spline-ctrl", "0", *tiny]) == 0
     assert json.loads((tmp_path / "dropped" / "config.json").read_text())["model"]["spline_ctrl"] == 0
+
+
+@pytest.mark.slow
+def test_init_from_weights_without_learned_parameters_widens_them_and_keeps_them(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    torch.manual_seed(0)
+    start = tmp_path / "start.pt"
+    torch.save(
+        {"model_config": ModelConfig(spline_ctrl=31).__dict__, "model": VAE(ModelConfig(spline_ctrl=31)).state_dict()},
+        start,
+    )
+    tiny = ["--n-train", "128", "--n-val", "32", "--n-test", "32", "--epochs", "1", "--no-progress"]
+    assert main(["train", "--run-dir", "params", "--init-from", str(start), "--spline-params", *tiny]) == 0
+    assert json.loads((tmp_path / "params" / "config.json").read_text())["model"]["spline_params"] is True
+    again = tmp_path / "params" / "last.pt"
+    assert main(["train", "--run-dir", "kept", "--init-from", str(again), *tiny]) == 0
+    assert json.loads((tmp_path / "kept" / "config.json").read_text())["model"]["spline_params"] is True
+    with pytest.raises(SystemExit):  # the parameter channel is not dropped silently
+        main(["train", "--run-dir", "dropped", "--init-from", str(again), "--no-spline-params", *tiny])
+    assert "'spline_params': True} model, not" in capsys.readouterr().err
