@@ -13,8 +13,9 @@ and measure generalisation in the evaluation suite (training/suite.py).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
@@ -149,9 +150,12 @@ HELD_OUT: dict[str, Family] = {"superellipse": superellipse, "stroke": stroke, "
 class MixSpec:
     """One version of the broad mix: each training family's share, and how the paper's share is drawn."""
 
-    shares: dict[str, float]  # family -> share of the mix; the paper's curves stay the largest single share
+    shares: Mapping[str, float]  # family -> share of the mix; the paper's curves stay the largest single share
     paper_raw: float  # of the paper's share: drawn as the paper draws them (its pose, frame, parameter spacing)
     paper_spacings: tuple[str, ...]  # the rest, posed, each respaced at one of these drawn at random
+
+    def __post_init__(self) -> None:  # a read-only copy: a version, once made, draws the same curves for good
+        object.__setattr__(self, "shares", MappingProxyType(dict(self.shares)))
 
 
 #: Every broad mix still made, by version (part of a data set's configuration, so a cache made by another

@@ -113,6 +113,8 @@ def test_each_mix_version_draws_its_own_shares():
     assert MIX_VERSION in MIXES and 2 in MIXES
     for spec in MIXES.values():
         assert abs(sum(spec.shares.values()) - 1.0) < 1e-9 and 0 <= spec.paper_raw <= 1
+        with pytest.raises(TypeError):  # a made version's shares cannot be changed by accident
+            spec.shares["paper"] = 1.0  # type: ignore[index]
     old = broad_mix(400, 5, version=2)
     np.testing.assert_array_equal(old, broad_mix(400, 5, version=2))
     assert not np.array_equal(old, broad_mix(400, 5, version=MIX_VERSION))
