@@ -514,7 +514,9 @@ class ModelInfo(BaseModel):
     )
     spline: dict[str, Any] | None = Field(
         None,
-        description='The decoder\'s B-spline head (n_ctrl, degree, knots), when it has one: output "bspline" works.',
+        description='The decoder\'s B-spline head (n_ctrl, degree, knots), when it has one: output "bspline" works. '
+        "learned_params: whether the head places its points at parameters of its own (the spacing of the curve it "
+        "decodes) rather than evenly in the spline parameter.",
     )
     files: dict[str, FileInfo] = Field(description="sha256 and size of each exported file, from the manifest.")
     providers: list[str] = Field(description="onnxruntime execution providers the sessions actually run on.")

@@ -66,7 +66,10 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
             else None
         ),
         "spline": (
-            {k: m["spline"][k] for k in ("n_ctrl", "degree", "knots") if k in m["spline"]} if m.get("spline") else None
+            {"n_ctrl": m["spline"]["n_ctrl"], "degree": m["spline"]["degree"], "knots": m["spline"]["knots"]}
+            | {"learned_params": runtime.has_params}
+            if m.get("spline")
+            else None
         ),
         "files": {k: {"sha256": v["sha256"], "bytes": v.get("bytes", 0)} for k, v in m["files"].items()},
         "providers": runtime.providers,
