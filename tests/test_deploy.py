@@ -309,6 +309,14 @@ def test_the_manifests_are_a_deployment_service_autoscaler_and_config(k8s):
     assert sorted(kustomization["resources"]) == sorted(p.name for p in K8S.glob("*.yaml") if p.stem != "kustomization")
 
 
+def test_the_manifests_deploy_the_image_of_this_release(k8s):
+    """The image tag follows the package's version: a release that forgets it would deploy the previous model."""
+    version = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    kustomization = yaml.safe_load((K8S / "kustomization.yaml").read_text())
+    assert [i["newTag"] for i in kustomization["images"] if i["name"] == "curve-vae"] == [version]
+    assert container(k8s)["image"] == f"curve-vae:{version}"
+
+
 def test_probes_ask_routes_the_app_has_on_the_containers_port(k8s, routes):
     c = container(k8s)
     ports = {p["name"]: p["containerPort"] for p in c["ports"]}
