@@ -6,7 +6,8 @@
 #   RUN=/tmp/r2 INIT=/tmp/r/best.pt BUDGET=170 LR=1.2e-4 WARMUP=0.1 bash scripts/gpu_stage.sh   # stage 2
 #
 # Settings (environment): BUDGET seconds of training (400), LR peak (3e-4), WARMUP (0.05), NTRAIN curves (2000000),
-# MIX_VERSION (the latest), DEVICE (cuda), WORKERS drawing the data (16), INIT weights (models/vae.pt), RUN folder
+# MIX_VERSION (the latest), PARAMS (1: --spline-params, a head that learns its points' parameters; default: INIT's
+# head), DEVICE (cuda), WORKERS drawing the data (16), INIT weights (models/vae.pt), RUN folder
 # (/tmp/r), DATA cache (/tmp/d.npz: a second stage on the same curves reads it), WHEELS (a folder of wheels of
 # what the machine lacks, e.g. pydantic, shapely; installed to /tmp/site without an index), OUT (/tmp/out).
 # OUT receives train.log, log.jsonl, config.json and best.pt without its optimiser state (a third of the size).
@@ -28,8 +29,10 @@ export PYTHONPATH=/tmp/site:$SRC
 cd "$SRC"  # not the checkout: python -m would import the checkout's curve_vae/ before the mapped one
 mix_version=()
 if [ -n "${MIX_VERSION:-}" ]; then mix_version=(--mix-version "$MIX_VERSION"); fi
+params=()
+if [ "${PARAMS:-}" = 1 ]; then params=(--spline-params); fi
 python3 -m curve_vae.cli train --run-dir "$RUN" --init-from "${INIT:-$REPO/models/vae.pt}" --mix broad \
-  "${mix_version[@]}" --n-train "${NTRAIN:-2000000}" --data "${DATA:-/tmp/d.npz}" --workers "${WORKERS:-16}" \
+  "${mix_version[@]}" "${params[@]}" --n-train "${NTRAIN:-2000000}" --data "${DATA:-/tmp/d.npz}" --workers "${WORKERS:-16}" \
   --device "${DEVICE:-cuda}" --batch-size 512 --lr "${LR:-3e-4}" --warmup "${WARMUP:-0.05}" --epochs 1000 \
   --time-budget "${BUDGET:-400}" --snapshots 1 --no-progress 2>&1 | tee "$OUT/train.log"
 python3 - <<'PY'

@@ -23,6 +23,7 @@ def test_a_stage_from_a_checkout_leaves_a_slim_best_checkpoint_and_its_log(tmp_p
         "WORKERS": "1",
         "BUDGET": "2",
         "MIX_VERSION": "2",
+        "PARAMS": "1",
         "OUT": str(out),
         "RUN": str(run),
         "DATA": str(tmp_path / "d.npz"),
@@ -36,6 +37,7 @@ def test_a_stage_from_a_checkout_leaves_a_slim_best_checkpoint_and_its_log(tmp_p
     config = json.loads((out / "config.json").read_text())
     assert config["data"]["mix_version"] == 2 and config["data"]["n_train"] == 600
     assert config["train"]["device"] == "cpu" and config["train"]["time_budget"] == 2
+    assert config["model"]["spline_params"] is True  # from models/vae.pt, its head widened
     assert (out / "log.jsonl").read_text().strip() and (out / "train.log").exists()
     slim = torch.load(out / "best.pt", map_location="cpu", weights_only=False)
     assert "optimizer" not in slim and "model" in slim
