@@ -80,6 +80,7 @@ class TrainConfig:
     train_limit: int = 0  # use only the first N training curves (0: all)
     time_budget: float = 0.0  # seconds of training: the schedule follows elapsed time, not steps (0: off)
     snapshots: int = 0  # keep the weights of the latest N epochs as epoch-NNNN.pt, for curve-vae average
+    only_params: bool = False  # train only the head's parameter channel (VAE.learn_only_params)
 
     def __post_init__(self) -> None:
         if self.schedule not in SCHEDULES:

@@ -278,6 +278,31 @@ class VAE(nn.Module):
         self.encoder = Encoder(cfg)
         self.decoder = Decoder(cfg, self.encoder.feat_channels, self.encoder.feat_len)
 
+    def learn_only_params(self) -> list[nn.Parameter]:
+        """Freeze everything but the head's parameter channel (its row of the decoder's last layer), BatchNorm's
+        statistics included: the curves' shapes stay the weights', only where the points sit along them is
+        trained. Returns the parameters left to train."""
+        if not self.cfg.spline_params:
+            raise ValueError("only the parameters can be trained with learned parameters (spline_params)")
+        self.frozen_body = True
+        for p in self.parameters():
+            p.requires_grad_(False)
+        last = self.decoder.features[-1]
+        keep = torch.zeros_like(last.bias)
+        keep[2] = 1.0
+        for p, mask in ((last.weight, keep.view(1, -1, 1)), (last.bias, keep)):
+            p.requires_grad_(True)
+            p.register_hook(lambda g, mask=mask: g * mask)  # the x and y rows stay as they are
+        return [last.weight, last.bias]
+
+    def train(self, mode: bool = True) -> VAE:
+        super().train(mode)
+        if getattr(self, "frozen_body", False):
+            for m in self.modules():
+                if isinstance(m, nn.BatchNorm1d):
+                    m.eval()  # frozen statistics: the shapes must not drift
+        return self
+
     def forward(self, curves: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         mean, log_var = self.encoder(curves)
         z = mean

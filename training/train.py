@@ -273,7 +273,7 @@ class _Parts:
 
 def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_per_epoch: int) -> _Parts:
     model = VAE(model_cfg).to(proc.device)
-    opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
+    opt = torch.optim.Adam(model.learn_only_params() if cfg.only_params else model.parameters(), lr=cfg.lr)
     clock = Clock(cfg.time_budget, 0.0)
     return _Parts(model, opt, _make_schedule(opt, cfg, steps_per_epoch, clock), clock, np.random.default_rng(cfg.seed))
 

@@ -66,6 +66,8 @@ def add_train_options(p: argparse.ArgumentParser) -> None:
         "stops when it is spent, whatever the throughput (0: off; --epochs stays an upper bound)",
         "snapshots": "keep the weights of the latest N epochs as RUN_DIR/epoch-NNNN.pt, to average them "
         "afterwards with curve-vae average (0: off)",
+        "only_params": "with --spline-params: train only where the points sit along the curves (the head's "
+        "parameter channel); every other weight and BatchNorm statistic stays the starting model's",
     }
     for f in fields(TrainConfig):
         flag = "--" + f.name.replace("_", "-")

@@ -58,3 +58,24 @@ def test_learned_parameters_need_the_spline_head():
         ModelConfig(spline_params=True)
     assert not ModelConfig(spline_ctrl=31).same_weights(ModelConfig(spline_ctrl=31, spline_params=True))
     assert ModelConfig(spline_ctrl=31, spline_params=True).same_weights(ModelConfig(spline_ctrl=10, spline_params=True))
+
+
+def test_learning_only_the_parameters_leaves_every_other_weight_and_statistic_as_it_was():
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant="cnn1", spline_ctrl=31, spline_params=True))
+    trained = model.learn_only_params()
+    model.train()
+    before = {k: v.clone() for k, v in model.state_dict().items()}
+    opt = torch.optim.Adam(trained, lr=1e-2)
+    for _ in range(3):
+        loss = (model(torch.rand(8, 161, 2) * 128)[0] - 64).square().mean()
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+    after = model.state_dict()
+    last = f"decoder.features.{len(model.decoder.features) - 1}"
+    assert [k for k in before if not torch.equal(before[k], after[k])] == [f"{last}.weight", f"{last}.bias"]
+    torch.testing.assert_close(after[f"{last}.weight"][:, :2], before[f"{last}.weight"][:, :2], rtol=0, atol=0)
+    assert not torch.equal(after[f"{last}.weight"][:, 2], before[f"{last}.weight"][:, 2])
+    with pytest.raises(ValueError, match="spline_params"):
+        VAE(ModelConfig(variant="cnn1", spline_ctrl=31)).learn_only_params()
