@@ -73,7 +73,9 @@ SpacingMode = Annotated[
             "along their order — the paper's B-spline samples are spaced so, and the default model was also trained "
             "on points spaced by arc length and unevenly; 50, 161 or 500 samples of a curve give the same result. "
             '"arc_length": every curve is resampled evenly by arc length first, and returned curves are spaced so '
-            "(with the default model, better for spirals and sharp-cornered arcs, worse for airfoils)."
+            "(with the default model, better for spirals and sharp-cornered arcs, worse for airfoils). Returned curves "
+            'of `n_points` with "parameter" are at the model\'s own spacing: evenly in its spline parameter, or where '
+            "a head that learns its points' parameters places them (GET /model: spline.learned_params)."
         )
     ),
 ]
