@@ -146,8 +146,9 @@ class Encoder(nn.Module):
 
 
 #: The parameter channel's logits are this times its output: Adam moves each weight by about the learning rate
-#: whatever its gradient, and the channel starts at zero beside weights already trained, so at the shared rate it
-#: barely moved (increments within 0.6% of even after 70,000 curves at lr 1e-4).
+#: whatever its gradient, and the channel starts at zero beside weights already trained; unscaled, it stayed within
+#: 0.6% of even increments after 70,000 curves at lr 1e-4 (×10 did not move it much further on the CPU either:
+#: docs/RESULTS.md, the arc-length gap).
 PARAM_GAIN = 10.0
 
 
