@@ -135,7 +135,7 @@ class ModelGraphs:
     @property
     def has_params(self) -> bool:
         """Whether the decoder places its points at spline parameters of its own (output `params`), not evenly."""
-        return self.has_splines and self.learned_params
+        return self.learned_params  # read from the manifest's spline entry: never without a head
 
     @property
     def providers(self) -> list[str]:
