@@ -101,6 +101,40 @@ def arc_length_params(control_points: np.ndarray, n_points: int, *, degree: int 
     return np.interp(np.linspace(0.0, s[-1], n_points), s[keep], u[keep])
 
 
+def closest_params(
+    control_points: np.ndarray,
+    points: np.ndarray,
+    around: np.ndarray,
+    *,
+    window: float = 0.05,
+    degree: int = 3,
+    dense: int = 2049,
+) -> np.ndarray:
+    """Parameter (n,) of the point of a clamped uniform B-spline (n_ctrl, 2) closest to each of `points` (n, 2),
+    searched within `window` of its parameter `around` (n,): the foot points of curve fitting, kept near a first
+    guess so that a point is never matched to another branch of a curve that comes back near itself.
+
+    The nearest of `dense` samples in the window, then two Newton steps on the squared distance (clipped to the
+    window and to [0, 1]).
+    """
+    ctrl = np.asarray(control_points, np.float64)
+    pts = np.asarray(points, np.float64)
+    a = np.clip(np.asarray(around, np.float64), 0.0, 1.0)
+    grid = np.linspace(0.0, 1.0, dense)
+    d2 = ((pts[:, None, :] - sample_bspline(ctrl, dense, degree)[None]) ** 2).sum(-1)  # (n, dense)
+    d2[np.abs(grid[None, :] - a[:, None]) > window] = np.inf
+    u = grid[d2.argmin(axis=1)]
+    lo, hi = np.clip(a - window, 0.0, 1.0), np.clip(a + window, 0.0, 1.0)
+    spline = BSpline(clamped_uniform_knots(len(ctrl), degree), ctrl, degree)
+    d1, d2s = spline.derivative(1), spline.derivative(2)
+    for _ in range(2):
+        r, t, c = spline(u) - pts, d1(u), d2s(u)
+        grad, curv = (r * t).sum(-1), (t * t).sum(-1) + (r * c).sum(-1)
+        step = np.where(curv > 0, grad / np.where(curv > 0, curv, 1.0), 0.0)
+        u = np.clip(u - step, lo, hi)
+    return u
+
+
 @dataclass(frozen=True)
 class BSplineFit:
     """A least-squares B-spline: control points, knots and how far the curve is from it."""

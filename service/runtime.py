@@ -27,6 +27,7 @@ and length adaptation is `geometry.adapt`; augmentation `service.augmenting` and
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -50,6 +51,7 @@ from curve_vae.geometry import (
 )
 from curve_vae.geometry.adapt import F32_MAX
 from curve_vae.service.augmenting import Augmenting
+from curve_vae.service.fitting import Fitting
 from curve_vae.service.graphs import ModelGraphs
 from curve_vae.service.inputs import InputError
 from curve_vae.service.sampling import Sampling
@@ -82,6 +84,8 @@ class Prepared:
     decoded: np.ndarray | None = None  # (B, n_points, 2) model plane
     ctrl: np.ndarray | None = None  # (B, n_ctrl, 2) with a B-spline head
     params: np.ndarray | None = None  # (B, n_points) spline parameter of each model point, if the head learns them
+    # With refine, the latents are fitted (service.fitting) and each input point is matched to its closest point:
+    feet: list[np.ndarray] | None = None  # per curve, the spline parameter (model order) of each input point
 
 
 @dataclass(frozen=True)
@@ -103,7 +107,7 @@ class Spline:
         }
 
 
-class CurveRuntime(ModelGraphs, Augmenting, Sampling):
+class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
     """An exported model's graphs (`ModelGraphs`) with the frame, length and pose handling that brings any curve to
     them and back.
 
@@ -119,13 +123,19 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
         frame: FrameMode = "auto",
         spacing: Spacing = "parameter",
         pose: PoseMode = "auto",
+        refine: int = 0,
     ) -> Prepared:
         """Bring caller curves (each (n_i, 2), n_i ≥ 4) to the model's frame and point count.
 
         pose "auto" (frame "auto" only): each curve is tried in the poses of `geometry.pose_frames` — so a
         curve, its reversal, mirror image and rotations all get the same candidates — encoded and decoded in
         each, and the pose whose reconstruction is closest to the input is kept, with its latent.
+        refine > 0: that many fitting steps on each kept latent (`_refined`).
         """
+        prep = self._prepare(curves, frame, spacing, pose)
+        return self._refined(prep, refine) if refine > 0 else prep
+
+    def _prepare(self, curves: Sequence[np.ndarray], frame: FrameMode, spacing: Spacing, pose: PoseMode) -> Prepared:
         posing = frame == "auto" and pose == "auto"
         rows, frames, fractions, inputs = [], [], [], []
         with np.errstate(all="ignore"):
@@ -166,6 +176,28 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
             decoded[best],
             None if ctrl is None else ctrl[best],
             None if params is None else params[best],
+        )
+
+    def _refined(self, prep: Prepared, steps: int) -> Prepared:
+        """`prep` with its latents fitted to the caller's own points by `steps` steps (service.fitting): the latent
+        means become the fitted latents (the log-variances stay the encoder's), and each input point is matched to
+        its closest point on the fitted spline (`Prepared.feet`)."""
+        if not self.has_splines:
+            raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
+        mean, log_var = self._encoded(prep)
+        targets, around = [], []
+        for pts, f, fraction in zip(prep.inputs, prep.frames, prep.fractions):
+            targets.append(f.to_model(pts, self.model_size) if f is not None else pts)
+            at = np.linspace(0.0, 1.0, len(pts)) if fraction is None else fraction
+            around.append(at)
+        if prep.params is not None or self.has_params:  # the head's own parameters at those positions
+            params = prep.params if prep.params is not None else self.decode_model_splines(mean)[2]
+            own = np.linspace(0.0, 1.0, self.n_points)
+            around = [np.interp(a, own, p) for a, p in zip(around, params)]
+        with np.errstate(all="ignore"):
+            z, (out, ctrl, params), feet = self.refine_latents(mean, targets, around, steps)
+        return dataclasses.replace(
+            prep, mean=z.astype(np.float32), log_var=log_var, decoded=out, ctrl=ctrl, params=params, feet=feet
         )
 
     def _to_model_points(
@@ -235,9 +267,11 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
         frame: FrameMode = "auto",
         spacing: Spacing = "parameter",
         pose: PoseMode = "auto",
+        refine: int = 0,
     ) -> tuple[np.ndarray, np.ndarray, list[Frame | None]]:
-        """Latent mean and log-variance of each curve, and the frame (with its pose) each was mapped from."""
-        prep = self.prepare(curves, frame, spacing, pose)
+        """Latent mean and log-variance of each curve, and the frame (with its pose) each was mapped from; with
+        `refine`, the means are the fitted latents (see `prepare`)."""
+        prep = self.prepare(curves, frame, spacing, pose, refine)
         mean, log_var = self._encoded(prep)
         return mean, log_var, prep.frames
 
@@ -301,13 +335,15 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
         spacing: Spacing = "parameter",
         splines: list[Spline] | None = None,
         pose: PoseMode = "auto",
+        refine: int = 0,
     ) -> tuple[list[np.ndarray], np.ndarray]:
         """Encode the means, decode them; the curves in the caller's frame and their MSE (paper eq. 4) there.
 
-        The MSE compares each input with its reconstruction at the input's own points,
-        whatever `n_points` asks for the returned curves.
+        The MSE compares each input with its reconstruction at the input's own points, whatever `n_points` asks
+        for the returned curves. With `refine` the latents are fitted first (see `prepare`) and the input's own
+        points are matched to their closest points on the reconstruction.
         """
-        prep = self.prepare(curves, frame, spacing, pose)
+        prep = self.prepare(curves, frame, spacing, pose, refine)
         with np.errstate(all="ignore"):
             if prep.decoded is not None:
                 out, ctrl, params = prep.decoded, prep.ctrl, prep.params
@@ -318,9 +354,14 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling):
             for i, o in enumerate(out):
                 c, u = None if ctrl is None else ctrl[i], None if params is None else params[i]
                 kept = splines if n_points is None else None
-                own = self._to_caller(
-                    o, prep.frames[i], n_points=None, fractions=prep.fractions[i], ctrl=c, params=u, splines=kept
-                )
+                if prep.feet is not None:  # the spline's points closest to the input's: at their parameters
+                    own = self._to_caller(
+                        o, prep.frames[i], n_points=None, fractions=prep.feet[i], ctrl=c, splines=kept
+                    )
+                else:
+                    own = self._to_caller(
+                        o, prep.frames[i], n_points=None, fractions=prep.fractions[i], ctrl=c, params=u, splines=kept
+                    )
                 mse[i] = mse_per_curve(prep.inputs[i][None], own[None])[0]
                 if n_points is not None:
                     own = self._to_caller(

@@ -81,7 +81,9 @@ async def _encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarra
     runtime = runtime_of(request)
 
     def work() -> Response:
-        mean, log_var, frames = runtime.encode(curves, frame=req.frame, spacing=req.spacing, pose=req.pose)
+        mean, log_var, frames = runtime.encode(
+            curves, frame=req.frame, spacing=req.spacing, pose=req.pose, refine=req.refine
+        )
         # float64 as the JSON always carried: orjson would write float32 at float32's shorter precision
         return JSON(
             {"mean": mean.astype(np.float64), "log_var": log_var.astype(np.float64), "frames": frames_json(frames)}
@@ -177,7 +179,13 @@ async def _reconstruct(request: Request, req: s.ReconstructRequest, curves: list
 
     def work() -> Response:
         out, mse = runtime.reconstruct(
-            curves, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines, pose=req.pose
+            curves,
+            frame=req.frame,
+            n_points=req.n_points,
+            spacing=req.spacing,
+            splines=splines,
+            pose=req.pose,
+            refine=req.refine,
         )
         body = with_metrics({"curves": [np.ascontiguousarray(c) for c in out], "mse": mse}, out, req.metrics)
         return JSON(with_output(body, splines, req.output))

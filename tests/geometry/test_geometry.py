@@ -7,6 +7,7 @@ from curve_vae.geometry import (
     arc_length_params,
     blend_frames,
     clamped_uniform_knots,
+    closest_params,
     curve_length,
     evaluate_bspline,
     fit_bspline,
@@ -169,3 +170,35 @@ def test_fit_bspline_auto_takes_the_fewest_control_points():
     seven = np.array([[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]], float)
     fit = fit_bspline_auto(seven)
     assert 4 <= len(fit.control_points) <= 7 and fit.rms_error <= 1e-3 * np.linalg.norm(np.ptp(seven, axis=0))
+
+
+def test_closest_params_find_the_parameters_of_points_on_the_spline():
+    ctrl = random_control_points(np.random.default_rng(3), 1, n_ctrl=12)[0]
+    u = np.sort(np.random.default_rng(4).uniform(0, 1, 40))
+    pts = evaluate_bspline(ctrl, u)
+    guess = np.clip(u + np.random.default_rng(5).uniform(-0.03, 0.03, len(u)), 0, 1)
+    found = closest_params(ctrl, pts, guess, window=0.05)
+    assert np.abs(evaluate_bspline(ctrl, found) - pts).max() < 1e-6
+
+
+def test_closest_params_of_points_off_the_curve_are_their_foot_points():
+    # the upper half of a near-circle, points 5 units outside it: each foot point lies on the line to the centre
+    ctrl = np.array([[100.0, 0.0], [100.0, 60.0], [50.0, 100.0], [-50.0, 100.0], [-100.0, 60.0], [-100.0, 0.0]])
+    u = np.linspace(0.1, 0.9, 9)
+    on = evaluate_bspline(ctrl, u)
+    tangent = evaluate_bspline(ctrl, u + 1e-6) - evaluate_bspline(ctrl, u - 1e-6)
+    normal = np.stack([tangent[:, 1], -tangent[:, 0]], 1)
+    off = on + 5.0 * normal / np.linalg.norm(normal, axis=1, keepdims=True)
+    found = closest_params(ctrl, off, u, window=0.1)
+    np.testing.assert_allclose(found, u, atol=1e-6)
+
+
+def test_closest_params_stay_within_their_window():
+    # a hairpin: the end of the curve passes close to its start; a point near the start, guessed near the start,
+    # must not jump to the end's branch although that is nearer
+    ctrl = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 10.0], [0.0, 10.0], [0.0, 2.0]])
+    target = np.array([[1.0, 1.5]])
+    near_start = closest_params(ctrl, target, np.array([0.02]), window=0.05)
+    anywhere = closest_params(ctrl, target, np.array([0.5]), window=1.0)
+    assert near_start[0] <= 0.07
+    assert anywhere[0] > 0.9

@@ -1,0 +1,98 @@
+"""Fitting a reconstruction to its curve: the encoder's latent refined so that the decoded B-spline passes closer to
+the caller's points.
+
+The encoder maps a curve to a latent in one pass; the decoder's best latent for that curve is usually nearby but not
+there. `Fitting.refine_latents` takes `steps` Levenberg–Marquardt steps on each latent, minimising the squared distance
+from the curve's own points to the decoded spline, each point measured to its closest point on the spline (foot points,
+`geometry.closest_params`, searched near the previous ones). Because the points are matched to the closest point and
+not to a fixed parameter, the fit does not depend on how the caller spaced the points along the curve. The Jacobian of
+the control points with respect to the latent comes from forward differences: one decoder run of
+latent_dim + 1 rows per curve per step, so a step costs about 33 decodes; a step that does not lower the distance is
+undone and the damping raised. Torch-free: the decoder is the ONNX graph.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from curve_vae.geometry import closest_params
+
+#: Forward-difference step in latent units (the latent prior is a unit Gaussian; the decoder runs in float32).
+FD_STEP = 1e-2
+#: How far along the spline (in its parameter) a point's match may move in one step.
+FOOT_WINDOW = 0.05
+
+
+class Fitting:
+    """The latent refinement of CurveRuntime (it needs `decode_model_splines`, `knots`, `spline_degree`)."""
+
+    knots: np.ndarray | None
+    spline_degree: int
+    decode_model_splines: Any
+
+    def refine_latents(
+        self, latents: np.ndarray, targets: Sequence[np.ndarray], around: Sequence[np.ndarray], steps: int
+    ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray | None], list[np.ndarray]]:
+        """`steps` damped Gauss–Newton steps on each latent (B, latent_dim) towards its curve `targets[i]` (n_i, 2),
+        model plane, whose points start matched to spline parameters `around[i]` (n_i,).
+
+        Returns the refined latents (float64), their decoding (curves, control points, learned parameters or None)
+        and each target point's parameter on its refined spline. Never worse than the latents given: a curve whose
+        step raises its distance keeps the previous latent.
+        """
+        assert self.knots is not None, "refinement needs a B-spline head"
+        z = np.array(latents, np.float64)
+        count, dim = z.shape
+        decoded = self.decode_model_splines(z)
+        feet = [
+            closest_params(c, t, a, window=FOOT_WINDOW, degree=self.spline_degree)
+            for c, t, a in zip(decoded[1], targets, around)
+        ]
+        cost = np.array([self._cost(c, t, u) for c, t, u in zip(decoded[1], targets, feet)])
+        damping = np.full(count, 1e-2)
+        for _ in range(steps):
+            if count == 0:
+                break
+            shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
+            jac = (self.decode_model_splines(shifted)[1].reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
+            trial = z.copy()
+            for i in range(count):
+                basis = self._basis(feet[i])
+                residual = (targets[i] - basis @ decoded[1][i]).reshape(-1)
+                j = np.einsum("nk,lkd->ndl", basis, jac[i]).reshape(-1, dim)
+                a = j.T @ j
+                a += damping[i] * np.diag(np.diag(a)) + 1e-9 * (np.trace(a) / dim + 1e-12) * np.eye(dim)
+                trial[i] = z[i] + np.linalg.solve(a, j.T @ residual)
+            with np.errstate(all="ignore"):
+                tried = self.decode_model_splines(trial)
+            tried_feet, tried_cost = [], np.full(count, np.inf)
+            for i in range(count):
+                c = tried[1][i]
+                if np.isfinite(c).all():
+                    u = closest_params(c, targets[i], feet[i], window=FOOT_WINDOW, degree=self.spline_degree)
+                    tried_cost[i] = self._cost(c, targets[i], u)
+                    tried_feet.append(u)
+                else:
+                    tried_feet.append(feet[i])
+            better = tried_cost < cost
+            z[better], cost[better] = trial[better], tried_cost[better]
+            decoded = tuple(None if d is None else np.where(_rows(better, d), t, d) for d, t in zip(decoded, tried))
+            feet = [tf if b else f for b, tf, f in zip(better, tried_feet, feet)]
+            damping = np.where(better, damping / 3, damping * 4)
+        return z, decoded, feet  # type: ignore[return-value]
+
+    def _basis(self, u: np.ndarray) -> np.ndarray:
+        """(n, n_ctrl) B-spline basis of the head at parameters u."""
+        return BSpline.design_matrix(np.clip(u, 0.0, 1.0), self.knots, self.spline_degree).toarray()
+
+    def _cost(self, ctrl: np.ndarray, target: np.ndarray, u: np.ndarray) -> float:
+        return float(((target - self._basis(u) @ np.asarray(ctrl, np.float64)) ** 2).sum())
+
+
+def _rows(mask: np.ndarray, like: np.ndarray) -> np.ndarray:
+    """A row mask (B,) shaped to broadcast against `like` (B, …)."""
+    return mask.reshape((-1,) + (1,) * (like.ndim - 1))
