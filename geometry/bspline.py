@@ -108,14 +108,14 @@ def closest_params(
     *,
     window: float = 0.05,
     degree: int = 3,
-    dense: int = 2049,
+    dense: int = 513,
 ) -> np.ndarray:
     """Parameter (n,) of the point of a clamped uniform B-spline (n_ctrl, 2) closest to each of `points` (n, 2),
     searched within `window` of its parameter `around` (n,): the foot points of curve fitting, kept near a first
     guess so that a point is never matched to another branch of a curve that comes back near itself.
 
-    The nearest of `dense` samples in the window, then two Newton steps on the squared distance (clipped to the
-    window and to [0, 1]).
+    The nearest of `dense` samples in the window, then three Newton steps on the squared distance (clipped to the
+    window and to [0, 1], each kept only where it brings the point closer).
     """
     ctrl = np.asarray(control_points, np.float64)
     pts = np.asarray(points, np.float64)
@@ -127,11 +127,13 @@ def closest_params(
     lo, hi = np.clip(a - window, 0.0, 1.0), np.clip(a + window, 0.0, 1.0)
     spline = BSpline(clamped_uniform_knots(len(ctrl), degree), ctrl, degree)
     d1, d2s = spline.derivative(1), spline.derivative(2)
-    for _ in range(2):
+    for _ in range(3):
         r, t, c = spline(u) - pts, d1(u), d2s(u)
         grad, curv = (r * t).sum(-1), (t * t).sum(-1) + (r * c).sum(-1)
         step = np.where(curv > 0, grad / np.where(curv > 0, curv, 1.0), 0.0)
-        u = np.clip(u - step, lo, hi)
+        moved = np.clip(u - step, lo, hi)
+        closer = ((spline(moved) - pts) ** 2).sum(-1) < (r**2).sum(-1)  # a step never takes a point further
+        u = np.where(closer, moved, u)
     return u
 
 

@@ -4,11 +4,12 @@ the caller's points.
 The encoder maps a curve to a latent in one pass; the decoder's best latent for that curve is usually nearby but not
 there. `Fitting.refine_latents` takes `steps` Levenberg–Marquardt steps on each latent, minimising the squared distance
 from the curve's own points to the decoded spline, each point measured to its closest point on the spline (foot points,
-`geometry.closest_params`, searched near the previous ones). Because the points are matched to the closest point and
-not to a fixed parameter, the fit does not depend on how the caller spaced the points along the curve. The Jacobian of
-the control points with respect to the latent comes from forward differences: one decoder run of
-latent_dim + 1 rows per curve per step, so a step costs about 33 decodes; a step that does not lower the distance is
-undone and the damping raised. Torch-free: the decoder is the ONNX graph.
+`geometry.closest_params`, searched near the previous ones). Because the points are matched to their closest points and
+not to fixed parameters, the distance minimised does not depend on how the caller spaced the points along the curve
+(the encoder's latent it starts from does: see docs/RESULTS.md). The Jacobian of
+the control points with respect to the latent comes from forward differences (latent_dim decoder runs per curve)
+every JACOBIAN_EVERY steps and from Broyden's rank-one update in between (one run per curve per step); a step that
+does not lower the distance is undone and the damping raised. Torch-free: the decoder is the ONNX graph.
 """
 
 from __future__ import annotations
@@ -25,6 +26,10 @@ from curve_vae.geometry import closest_params
 FD_STEP = 1e-2
 #: How far along the spline (in its parameter) a point's match may move in one step.
 FOOT_WINDOW = 0.05
+#: Steps between forward-difference Jacobians; the steps in between update it by Broyden's rule from the step just
+#: tried (one decoder run per curve). Every 5th step: 10 steps cost about a third of a fresh Jacobian at every step,
+#: for nearly the same fit (scripts/refine_tradeoff.py --jacobian-every).
+JACOBIAN_EVERY = 5
 
 
 class Fitting:
@@ -35,16 +40,24 @@ class Fitting:
     decode_model_splines: Any
 
     def refine_latents(
-        self, latents: np.ndarray, targets: Sequence[np.ndarray], around: Sequence[np.ndarray], steps: int
+        self,
+        latents: np.ndarray,
+        targets: Sequence[np.ndarray],
+        around: Sequence[np.ndarray],
+        steps: int,
+        *,
+        jacobian_every: int | None = None,
     ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray | None], list[np.ndarray]]:
         """`steps` damped Gauss–Newton steps on each latent (B, latent_dim) towards its curve `targets[i]` (n_i, 2),
         model plane, whose points start matched to spline parameters `around[i]` (n_i,).
 
         Returns the refined latents (float64), their decoding (curves, control points, learned parameters or None)
         and each target point's parameter on its refined spline. Never worse than the latents given: a curve whose
-        step raises its distance keeps the previous latent.
+        step raises its distance keeps the previous latent. A fresh Jacobian every `jacobian_every` steps (default
+        JACOBIAN_EVERY).
         """
         assert self.knots is not None, "refinement needs a B-spline head"
+        every = jacobian_every or JACOBIAN_EVERY
         z = np.array(latents, np.float64)
         count, dim = z.shape
         decoded = self.decode_model_splines(z)
@@ -54,11 +67,13 @@ class Fitting:
         ]
         cost = np.array([self._cost(c, t, u) for c, t, u in zip(decoded[1], targets, feet)])
         damping = np.full(count, 1e-2)
-        for _ in range(steps):
+        jac = np.zeros(0)
+        for step in range(steps):
             if count == 0:
                 break
-            shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
-            jac = (self.decode_model_splines(shifted)[1].reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
+            if step % every == 0:
+                shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
+                jac = (self.decode_model_splines(shifted)[1].reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
             trial = z.copy()
             for i in range(count):
                 basis = self._basis(feet[i])
@@ -78,6 +93,12 @@ class Fitting:
                     tried_feet.append(u)
                 else:
                     tried_feet.append(feet[i])
+            # Broyden's update of each curve's Jacobian by the step just tried (accepted or not)
+            dz, dc = trial - z, tried[1].astype(np.float64) - decoded[1]
+            norm = (dz**2).sum(1)
+            ok = (norm > 0) & np.isfinite(dc).reshape(count, -1).all(1)
+            miss = dc - np.einsum("bl,blkd->bkd", dz, jac)
+            jac[ok] += dz[ok, :, None, None] * miss[ok, None] / norm[ok, None, None, None]
             better = tried_cost < cost
             z[better], cost[better] = trial[better], tried_cost[better]
             decoded = tuple(None if d is None else np.where(_rows(better, d), t, d) for d, t in zip(decoded, tried))

@@ -202,17 +202,21 @@ def _interpolation_figures(encode: Encoder, decode: Decoder, first: np.ndarray, 
     plot_latent_tsne(encode, first, out / "latent_tsne.png")
 
 
-def _family_suite(runtime: Any, suite_count: int, out: Path, figures: bool) -> dict[str, Any]:
-    """The family suite's report (training/suite.py) on the paper's test split, with its figure if asked."""
+def _family_suite(
+    runtime: Any, suite_count: int, out: Path, figures: bool, refine: int = 0
+) -> tuple[dict[str, Any], dict[str, Any] | None]:
+    """The family suite's report (training/suite.py) on the paper's test split, with its figure if asked; with
+    `refine`, also the same sets reconstructed with that many fitting steps (the request option)."""
     from curve_vae.training.figures import plot_suite
     from curve_vae.training.suite import paper_test_split, run_suite, suite_sets
 
     paper = paper_test_split()  # whatever the model was trained on: the suite's paper sets are the paper's
     sets = suite_sets(paper, suite_count)
     report = run_suite(runtime, sets)
+    refined = {"refine": refine, "sets": run_suite(runtime, sets, refine=refine)} if refine > 0 else None
     if figures:
         plot_suite(runtime, sets, out / "families.png")
-    return report
+    return report, refined
 
 
 def run_evaluation(
@@ -225,12 +229,15 @@ def run_evaluation(
     figures: bool = True,
     runtime: Any = None,
     suite_count: int = 0,
+    suite_refine: int = 0,
 ) -> dict[str, Any]:
     """Evaluate on each named test set; write report.json (and figures) into out_dir.
 
     runtime: the exported model as the service runs it (service.runtime.CurveRuntime): adds the
     generation report of its priors, the first test set held out and the second as the real reference,
-    and with suite_count > 0 the family suite (training/suite.py) of that many curves per set.
+    and with suite_count > 0 the family suite (training/suite.py) of that many curves per set (with
+    suite_refine > 0 also refined by that many fitting steps, as report["families_refined"] = {"refine": steps,
+    "sets": …}).
     """
     from curve_vae.training.figures import plot_samples, plot_training
 
@@ -246,7 +253,9 @@ def run_evaluation(
     if figures and len(first) >= MIN_FIGURE_CURVES:
         _interpolation_figures(encode, decode, first, out)
     if runtime is not None and suite_count > 0:
-        report["families"] = _family_suite(runtime, suite_count, out, figures)
+        report["families"], refined = _family_suite(runtime, suite_count, out, figures, suite_refine)
+        if refined is not None:
+            report["families_refined"] = refined
     if figures and log_path is not None and log_path.exists():
         plot_training(log_path, out / "training.png")
     atomic_write_text(out / "report.json", json.dumps(report, indent=2) + "\n")

@@ -74,7 +74,15 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
         )[0]
     log = Path(a.checkpoint).parent / "log.jsonl" if a.checkpoint else None
     report = run_evaluation(
-        enc, dec, sets, a.out, log_path=log, figures=not a.no_figures, runtime=runtime, suite_count=a.suite_count
+        enc,
+        dec,
+        sets,
+        a.out,
+        log_path=log,
+        figures=not a.no_figures,
+        runtime=runtime,
+        suite_count=a.suite_count,
+        suite_refine=a.suite_refine,
     )
     for name, r in report["test_sets"].items():
         s_in, s_out = r["smoothness_input"]["roughness"], r["smoothness_output"]["roughness"]
@@ -104,6 +112,9 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
 
         print("curve families (relative RMSE: RMSE ÷ bounding-box diagonal, through the service's runtime):")
         print(format_suite(report["families"]))
+        if "families_refined" in report:
+            print(f"the same, refined (request option refine: {report['families_refined']['refine']}):")
+            print(format_suite(report["families_refined"]["sets"]))
     print(f"report: {Path(a.out) / 'report.json'}")
     return 0
 
@@ -179,6 +190,13 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         help=f"exported model to evaluate with onnxruntime (default: {DEFAULT_MODELS})",
     )
     src.add_argument("--checkpoint", default="", help="evaluate a torch checkpoint instead")
+    s.add_argument(
+        "--suite-refine",
+        type=int,
+        default=0,
+        help="also measure the family suite with this many fitting steps (the request option refine; about 30× "
+        "the time at 10 steps); needs --model-dir (default: 0, not measured)",
+    )
     s.add_argument("--data", default=None, help=f"data set cache (default: {DATA_HELP})")
     s.add_argument(
         "--fresh-seed",

@@ -8,6 +8,7 @@ const W = 1000, H = 700;  // the board's viewBox; API coordinates are the board'
 const COLORS = ["#1f77b4", "#2ca02c", "#9467bd"];
 const NAMES = ["A", "B", "C"];
 const N_POINTS = 100;
+const FIT_STEPS = 10;  // "fit closely": the reconstructions' `refine`
 
 // Everything the page shows, in API coordinates; window.curveVae for tests and the console.
 const state = {
@@ -184,9 +185,10 @@ function finishStroke() {
 
 async function reconstructAll() {
   if (!state.curves.length) return;
-  const body = { curves: state.curves, spacing: "arc_length", n_points: N_POINTS, output: "both" };
+  const body = { curves: state.curves, spacing: "arc_length", n_points: N_POINTS, output: "both",
+    refine: $("fit-closely").checked ? FIT_STEPS : 0 };
   const r = await api("/reconstruct", body, $("board-error"));
-  state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i] }));
+  state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i], body }));
 }
 
 function needed() { return state.mode === "triplet" ? 3 : 2; }
@@ -249,6 +251,9 @@ for (const mode of ["pair", "triplet"]) {
 }
 
 $("show-ctrl").addEventListener("change", render);
+$("fit-closely").addEventListener("change", () => {
+  busy = busy.then(async () => { try { await reconstructAll(); } catch (e) { /* shown by api() */ } render(); });
+});
 $("clear").addEventListener("click", () => {
   Object.assign(state, { curves: [], recon: [], result: null, strip: [] });
   curvesChanged();

@@ -110,3 +110,15 @@ def test_refine_over_http_lowers_the_mse_and_works_with_npy_bodies(client, curve
     assert r.status_code == 200 and r.json()["mse"] == pytest.approx(fitted, rel=1e-9)
     r = client.post(f"/reconstruct?refine={MAX_REFINE_STEPS + 1}", content=buf.getvalue(), headers=headers)
     assert r.status_code == 422 and "refine" in r.text
+
+
+def test_evaluate_measures_the_family_suite_refined_too(runtime, curves, tmp_path):
+    from curve_vae.training.evaluate import run_evaluation, runtime_codec
+
+    enc, dec, _ = runtime_codec(runtime)
+    sets = {"test": curves(8), "fresh": curves(8, seed=1)}
+    report = run_evaluation(enc, dec, sets, tmp_path, figures=False, runtime=runtime, suite_count=2, suite_refine=1)
+    plain, refined = report["families"], report["families_refined"]
+    assert refined["refine"] == 1 and refined["sets"].keys() == plain.keys()
+    for name, row in plain.items():
+        assert refined["sets"][name]["rel_rmse_mean"] <= row["rel_rmse_mean"] * (1 + 1e-9), name

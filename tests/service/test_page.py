@@ -201,6 +201,22 @@ def test_page_on_another_origin_with_cors(browser, server, server_factory, model
     assert errors == []
 
 
+def test_fit_closely_refines_the_reconstructions(browser, server):
+    page, errors = open_page(browser, server.url + "/")
+    t = np.linspace(0, 1, 40)
+    draw(page, list(zip(200 + 600 * t, 350 + 120 * np.sin(2 * np.pi * t) * (1 - 0.5 * t))))  # an S-stroke
+    page.wait_for_function("document.querySelectorAll('path.reconstruction').length === 1")
+    plain = state(page)["recon"][0]
+    assert plain["body"]["refine"] == 0
+    page.check("#fit-closely")
+    page.wait_for_function("window.curveVae.recon[0] && window.curveVae.recon[0].body.refine === 10")
+    fitted = state(page)["recon"][0]
+    assert fitted["mse"] < plain["mse"] / 2, (plain["mse"], fitted["mse"])
+    answer = httpx.post(server.url + "/reconstruct", json=fitted["body"], timeout=30).json()
+    np.testing.assert_allclose(drawn(page, "path.reconstruction"), answer["curves"][0], atol=2e-3)
+    assert errors == []
+
+
 def test_phone_sized_screen(browser, server):
     page, errors = open_page(browser, server.url + "/", width=390, height=844)
     assert page.evaluate("document.documentElement.scrollWidth") <= 390  # no sideways scrolling
