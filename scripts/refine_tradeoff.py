@@ -7,13 +7,18 @@ For sets of the family suite (training/suite.py) — the paper's test curves at 
 rotated, the held-out families, real airfoils where data/ has them — it prints the mean relative RMSE (RMSE over the
 input's own points ÷ its bounding-box diagonal) at each number of steps, the ratio of the arc-length-spaced paper
 curves' error to the parameter-spaced ones', and the time per curve as a multiple of a plain reconstruction's
-(all sets, one run, one thread: these machines are noisy, so compare ratios, not seconds).
+(all sets, one run, one thread: these machines are noisy, so compare ratios, not seconds). With --figure, a PNG:
+the error per set against the steps, and the leading edge of the first real airfoil, plain and refined.
 """
 
 from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from curve_vae.service import fitting
 from curve_vae.service.runtime import CurveRuntime
@@ -33,6 +38,7 @@ def main() -> None:
         default=fitting.JACOBIAN_EVERY,
         help=f"steps between forward-difference Jacobians (default: {fitting.JACOBIAN_EVERY}, the service's)",
     )
+    p.add_argument("--figure", type=Path, default=None, help="also write the figure here (PNG)")
     a = p.parse_args()
     fitting.JACOBIAN_EVERY = a.jacobian_every
     rt = CurveRuntime.load(a.model_dir, providers="cpu", intra_op_threads=1)
@@ -57,6 +63,39 @@ def main() -> None:
     print(f"{'time per curve (× the first)':28s}" + "".join(f"{seconds[s] / base:10.1f}×" for s in a.steps))
     print(f"({n} curves per column; the first column: {1000 * base / n:.1f} ms per curve on this machine)")
     print("mean relative RMSE per set (RMSE ÷ bounding-box diagonal, at the input's own points)")
+    if a.figure:
+        plot(rt, sets, errors, a.steps, a.figure)
+
+
+def plot(rt: Any, sets: dict[str, list], errors: dict[int, dict[str, float]], steps: list[int], path: Path) -> None:
+    from curve_vae.training.figures import pyplot, save_figure
+
+    plt = pyplot()
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
+    for name in sets:
+        left.plot(steps, [100 * errors[s][name] for s in steps], "o-", ms=3, label=name)
+    left.set(yscale="log", xlabel="refine (fitting steps)", ylabel="mean relative RMSE (of the diagonal)")
+    left.grid(alpha=0.3, which="both")
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    left.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}%"))
+    left.yaxis.set_minor_formatter(NullFormatter())
+    left.set_yticks([0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0])
+    left.legend(fontsize=7)
+    real = [n for n in sets if n.startswith("airfoils")]
+    curve = sets[real[0] if real else "superellipse"][0]
+    edge = curve[np.argmin(curve[:, 0])]
+    span = 0.04 * np.ptp(curve[:, 0])
+    near = np.abs(curve - edge).max(axis=1) < span
+    right.plot(*curve[near].T, "o", color="0.5", ms=3, label="input points")
+    for n, colour in ((0, "tab:red"), (max(steps), "tab:blue")):
+        out, _ = rt.reconstruct([curve], refine=n, n_points=2000)
+        o = out[0][np.abs(out[0] - edge).max(axis=1) < span]
+        right.plot(*o.T, "-", color=colour, lw=1.2, label=f"refine {n}")
+    right.set(aspect="equal", title="leading edge of a real airfoil (UIUC)" if real else "a superellipse")
+    right.legend(fontsize=7)
+    fig.tight_layout()
+    save_figure(fig, path)
 
 
 if __name__ == "__main__":

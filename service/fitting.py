@@ -81,7 +81,10 @@ class Fitting:
                 j = np.einsum("nk,lkd->ndl", basis, jac[i]).reshape(-1, dim)
                 a = j.T @ j
                 a += damping[i] * np.diag(np.diag(a)) + 1e-9 * (np.trace(a) / dim + 1e-12) * np.eye(dim)
-                trial[i] = z[i] + np.linalg.solve(a, j.T @ residual)
+                try:
+                    trial[i] = z[i] + np.linalg.solve(a, j.T @ residual)
+                except np.linalg.LinAlgError:  # a Jacobian of non-finite numbers: this curve stays where it is
+                    trial[i] = z[i]
             with np.errstate(all="ignore"):
                 tried = self.decode_model_splines(trial)
             tried_feet, tried_cost = [], np.full(count, np.inf)

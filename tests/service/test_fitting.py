@@ -122,3 +122,18 @@ def test_evaluate_measures_the_family_suite_refined_too(runtime, curves, tmp_pat
     assert refined["refine"] == 1 and refined["sets"].keys() == plain.keys()
     for name, row in plain.items():
         assert refined["sets"][name]["rel_rmse_mean"] <= row["rel_rmse_mean"] * (1 + 1e-9), name
+
+
+@pytest.mark.parametrize("magnitude", [1e-290, 1e140])
+def test_refining_works_at_extreme_but_representable_magnitudes(runtime, curves, magnitude):
+    c = curves(1, seed=8)[0]
+    base, _ = runtime.reconstruct([c], refine=2)
+    out, mse = runtime.reconstruct([c * magnitude], refine=2)
+    np.testing.assert_allclose(out[0], base[0] * magnitude, rtol=1e-5, atol=0)
+    assert np.isfinite(mse).all()
+
+
+@pytest.mark.parametrize("magnitude", [1e-320, 1e200])
+def test_refining_beyond_float64_is_an_input_error(runtime, curves, magnitude):
+    with pytest.raises(InputError):
+        runtime.reconstruct([curves(1)[0], curves(1)[0] * magnitude], refine=2)
