@@ -8,7 +8,9 @@ rotated, the held-out families, real airfoils where data/ has them — it prints
 input's own points ÷ its bounding-box diagonal) at each number of steps, the ratio of the arc-length-spaced paper
 curves' error to the parameter-spaced ones', and the time per curve as a multiple of a plain reconstruction's
 (all sets, one run, one thread: these machines are noisy, so compare ratios, not seconds). With --figure, a PNG:
-the error per set against the steps, and the leading edge of the first real airfoil, plain and refined.
+the error per set against the steps, and the leading edge of the first real airfoil, plain and refined. With
+--basins, how much the start of the fit matters: the arc-length-spaced paper curves fitted from encodings of the same
+curves respaced part of the way towards the B-spline parameter they were drawn at.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from curve_vae.geometry import arc_fractions, closest_params, evaluate_bspline
 from curve_vae.service import fitting
 from curve_vae.service.runtime import CurveRuntime
 from curve_vae.training.suite import paper_test_split, relative_rmse, suite_sets
@@ -39,6 +42,7 @@ def main() -> None:
         help=f"steps between forward-difference Jacobians (default: {fitting.JACOBIAN_EVERY}, the service's)",
     )
     p.add_argument("--figure", type=Path, default=None, help="also write the figure here (PNG)")
+    p.add_argument("--basins", action="store_true", help="also measure where the arc-length fit starts (see above)")
     a = p.parse_args()
     fitting.JACOBIAN_EVERY = a.jacobian_every
     rt = CurveRuntime.load(a.model_dir, providers="cpu", intra_op_threads=1)
@@ -65,6 +69,29 @@ def main() -> None:
     print("mean relative RMSE per set (RMSE ÷ bounding-box diagonal, at the input's own points)")
     if a.figure:
         plot(rt, sets, errors, a.steps, a.figure)
+    if a.basins:
+        basins(rt, sets["paper"], sets["paper, arc-length spacing"], max(a.steps))
+
+
+def basins(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps: int) -> None:
+    """The arc-length-spaced paper curves' points, fitted from encodings of the same curves respaced part of the way
+    from arc length (alpha 0) to the B-spline parameter they were drawn at (alpha 1); each fit measured from the
+    arc-length-spaced points to their closest points on it."""
+    print(f"arc-length-spaced paper curves, refine {steps}, the fit started from the curve respaced towards its")
+    print("B-spline parameter (alpha 0: arc length, as posted; 1: the parameter):")
+    even = np.linspace(0.0, 1.0, len(param[0]))
+    for alpha in (0.0, 0.25, 0.5, 0.75, 1.0):
+        starts = []
+        for c in param:  # c: the curve at even parameters; its arc-length samples sit at these parameters
+            u = (1 - alpha) * np.interp(even, arc_fractions(c), even) + alpha * even
+            starts.append(np.stack([np.interp(u, even, c[:, 0]), np.interp(u, even, c[:, 1])], 1))
+        splines: list = []
+        rt.reconstruct(starts, refine=steps, splines=splines)
+        fits = []
+        for sp, points in zip(splines, arc):
+            u = closest_params(sp.control_points, points, np.full(len(points), 0.5), window=1.0)
+            fits.append(evaluate_bspline(sp.control_points, u))
+        print(f"  alpha {alpha:4.2f}: {100 * relative_rmse(arc, fits).mean():.3f}%")
 
 
 def plot(rt: Any, sets: dict[str, list], errors: dict[int, dict[str, float]], steps: list[int], path: Path) -> None:
@@ -80,7 +107,10 @@ def plot(rt: Any, sets: dict[str, list], errors: dict[int, dict[str, float]], st
 
     left.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}%"))
     left.yaxis.set_minor_formatter(NullFormatter())
-    left.set_yticks([0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0])
+    shown = [100 * e for row in errors.values() for e in row.values()]
+    left.set_yticks(
+        [t for t in (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0) if min(shown) / 1.3 <= t <= max(shown) * 1.3]
+    )
     left.legend(fontsize=7)
     real = [n for n in sets if n.startswith("airfoils")]
     curve = sets[real[0] if real else "superellipse"][0]
