@@ -30,6 +30,21 @@ class BeyondFloat32(ValueError):
     its own coordinates are that large)."""
 
 
+def is_closed(points: np.ndarray) -> bool:
+    """Whether a curve (n, 2) ends where it starts (to 1e-9 of its extent): a loop listed with its first point
+    repeated at the end, as closed airfoil coordinate files are."""
+    pts = np.asarray(points, np.float64)
+    return bool(np.abs(pts[-1] - pts[0]).max() <= 1e-9 * np.ptp(pts, axis=0).max())
+
+
+def joined_ends(points: np.ndarray) -> np.ndarray:
+    """A copy of (n, 2) points or control points whose first and last rows are both their mean: the reconstruction
+    of a closed curve closed again (for a clamped B-spline, its end control points are its end points)."""
+    out = np.array(points, np.float64)
+    out[0] = out[-1] = (out[0] + out[-1]) / 2
+    return out
+
+
 def to_model_plane(
     points: np.ndarray, frame: Frame | None, *, model_size: float, n_points: int, spacing: str = "parameter"
 ) -> tuple[np.ndarray, np.ndarray | None]:

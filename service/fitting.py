@@ -61,10 +61,7 @@ class Fitting:
         z = np.array(latents, np.float64)
         count, dim = z.shape
         decoded = self.decode_model_splines(z)
-        feet = [
-            closest_params(c, t, a, window=FOOT_WINDOW, degree=self.spline_degree)
-            for c, t, a in zip(decoded[1], targets, around)
-        ]
+        feet = [self._feet(c, t, a) for c, t, a in zip(decoded[1], targets, around)]
         cost = np.array([self._cost(c, t, u) for c, t, u in zip(decoded[1], targets, feet)])
         damping = np.full(count, 1e-2)
         jac = np.zeros(0)
@@ -91,7 +88,7 @@ class Fitting:
             for i in range(count):
                 c = tried[1][i]
                 if np.isfinite(c).all():
-                    u = closest_params(c, targets[i], feet[i], window=FOOT_WINDOW, degree=self.spline_degree)
+                    u = self._feet(c, targets[i], feet[i])
                     tried_cost[i] = self._cost(c, targets[i], u)
                     tried_feet.append(u)
                 else:
@@ -108,6 +105,13 @@ class Fitting:
             feet = [tf if b else f for b, tf, f in zip(better, tried_feet, feet)]
             damping = np.where(better, damping / 3, damping * 4)
         return z, decoded, feet  # type: ignore[return-value]
+
+    def _feet(self, ctrl: np.ndarray, target: np.ndarray, around: np.ndarray) -> np.ndarray:
+        """Each target point's closest point on the spline near `around`; the curve's ends stay its ends (the
+        first and last points are matched to parameters 0 and 1, as without refinement)."""
+        u = closest_params(ctrl, target, around, window=FOOT_WINDOW, degree=self.spline_degree)
+        u[0], u[-1] = 0.0, 1.0
+        return u
 
     def _basis(self, u: np.ndarray) -> np.ndarray:
         """(n, n_ctrl) B-spline basis of the head at parameters u."""

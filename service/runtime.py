@@ -49,7 +49,7 @@ from curve_vae.geometry import (
     spline_to_caller,
     to_model_plane,
 )
-from curve_vae.geometry.adapt import F32_MAX
+from curve_vae.geometry.adapt import F32_MAX, is_closed, joined_ends
 from curve_vae.service.augmenting import Augmenting
 from curve_vae.service.fitting import Fitting
 from curve_vae.service.graphs import ModelGraphs
@@ -340,8 +340,9 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         """Encode the means, decode them; the curves in the caller's frame and their MSE (paper eq. 4) there.
 
         The MSE compares each input with its reconstruction at the input's own points, whatever `n_points` asks
-        for the returned curves. With `refine` the latents are fitted first (see `prepare`) and the input's own
-        points are matched to their closest points on the reconstruction.
+        for the returned curves. A closed input (its last point its first) comes back closed: the reconstruction's
+        ends are joined at their midpoint. With `refine` the latents are fitted first (see `prepare`) and the
+        input's own points are matched to their closest points on the reconstruction.
         """
         prep = self.prepare(curves, frame, spacing, pose, refine)
         with np.errstate(all="ignore"):
@@ -353,6 +354,8 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
             results, mse = [], np.empty(len(out))
             for i, o in enumerate(out):
                 c, u = None if ctrl is None else ctrl[i], None if params is None else params[i]
+                if is_closed(prep.inputs[i]):  # a loop comes back a loop
+                    o, c = (joined_ends(o), c) if c is None else (o, joined_ends(c))
                 kept = splines if n_points is None else None
                 if prep.feet is not None:  # the spline's points closest to the input's: at their parameters
                     own = self._to_caller(

@@ -15,6 +15,7 @@ from curve_vae.geometry import (
     spline_to_caller,
     to_model_plane,
 )
+from curve_vae.geometry.adapt import is_closed, joined_ends
 
 SIZE = 92.6  # the shipped model's frame size
 N = 161  # the model's point count
@@ -186,3 +187,21 @@ def test_a_head_with_its_own_parameters_places_the_model_points_there_and_the_re
         ctrl, None, model_size=SIZE, degree=3, model_points=N, n_points=100, spacing="arc_length", model_params=own
     )
     assert _steps(arc).max() / _steps(arc).min() < 1.01  # arc-length spacing does not depend on the head's
+
+
+def test_is_closed_takes_a_repeated_first_point_at_any_scale():
+    loop = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 0.0]])
+    assert is_closed(loop) and is_closed(loop * 1e-12 + 5.0) and is_closed(loop * 1e12)
+    assert not is_closed(loop[:-1])
+    nearly = loop.copy()
+    nearly[-1] = [1e-6, 0.0]
+    assert not is_closed(nearly)
+
+
+def test_joined_ends_meet_at_their_midpoint_and_leave_the_rest():
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.2, 0.4]])
+    out = joined_ends(pts)
+    np.testing.assert_array_equal(out[0], [0.1, 0.2])
+    np.testing.assert_array_equal(out[-1], [0.1, 0.2])
+    np.testing.assert_array_equal(out[1:-1], pts[1:-1])
+    assert pts[0, 0] == 0.0  # a copy

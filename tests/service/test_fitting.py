@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from curve_vae.geometry import evaluate_bspline, resample
+from curve_vae.geometry import evaluate_bspline, resample, self_intersects
 from curve_vae.service.app import create_app
 from curve_vae.service.inputs import InputError
 from curve_vae.service.schemas import MAX_REFINE_STEPS
@@ -137,3 +137,20 @@ def test_refining_works_at_extreme_but_representable_magnitudes(runtime, curves,
 def test_refining_beyond_float64_is_an_input_error(runtime, curves, magnitude):
     with pytest.raises(InputError):
         runtime.reconstruct([curves(1)[0], curves(1)[0] * magnitude], refine=2)
+
+
+@pytest.mark.parametrize("refine", [0, 3])
+def test_a_closed_curve_comes_back_closed(shipped_runtime, refine):
+    # NACA 0012 with a closed trailing edge, listed as closed coordinate files list it: from the trailing edge over
+    # the upper surface to the leading edge and back under the lower one, the first point repeated at the end
+    theta = np.linspace(0, 2 * np.pi, 81)
+    x = (1 + np.cos(theta)) / 2
+    half = 0.6 * (0.2969 * np.sqrt(x) - 0.126 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
+    loop = np.stack([x, np.where(theta <= np.pi, half, -half)], 1)
+    loop[-1] = loop[0]
+    splines: list = []
+    out, _ = shipped_runtime.reconstruct([loop, loop[:-5]], refine=refine, splines=splines)
+    np.testing.assert_array_equal(out[0][0], out[0][-1])
+    np.testing.assert_array_equal(splines[0].control_points[0], splines[0].control_points[-1])
+    assert np.abs(out[1][0] - out[1][-1]).max() > 1e-3  # an open curve stays open
+    assert not self_intersects(out[0])
