@@ -14,13 +14,18 @@ does not lower the distance is undone and the damping raised. Torch-free: the de
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.interpolate import BSpline
 
 from curve_vae.geometry import closest_params
+from curve_vae.service.inputs import InputError
+
+if TYPE_CHECKING:
+    from curve_vae.service.runtime import Prepared
 
 #: Forward-difference step in latent units (the latent prior is a unit Gaussian; the decoder runs in float32).
 FD_STEP = 1e-2
@@ -33,11 +38,38 @@ JACOBIAN_EVERY = 5
 
 
 class Fitting:
-    """The latent refinement of CurveRuntime (it needs `decode_model_splines`, `knots`, `spline_degree`)."""
+    """The latent refinement of CurveRuntime (it needs its graphs' `decode_model_splines`, `knots`,
+    `spline_degree`, `has_splines`, `has_params`, `model_size`, `n_points`, and `_encoded`)."""
 
     knots: np.ndarray | None
     spline_degree: int
+    has_splines: bool
+    has_params: bool
+    model_size: float
+    n_points: int
     decode_model_splines: Any
+    _encoded: Any
+
+    def _refined(self, prep: Prepared, steps: int) -> Prepared:
+        """`prep` with its latents fitted to the caller's own points by `steps` steps: the latent means become the
+        fitted latents (the log-variances stay the encoder's), and each input point is matched to its closest
+        point on the fitted spline (`Prepared.feet`), starting from where the model's spacing put it."""
+        if not self.has_splines:
+            raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
+        mean, log_var = self._encoded(prep)
+        targets, around = [], []
+        for pts, f, fraction in zip(prep.inputs, prep.frames, prep.fractions):
+            targets.append(f.to_model(pts, self.model_size) if f is not None else pts)
+            around.append(np.linspace(0.0, 1.0, len(pts)) if fraction is None else fraction)
+        if prep.params is not None or self.has_params:  # the head's own parameters at those positions
+            params = prep.params if prep.params is not None else self.decode_model_splines(mean)[2]
+            own = np.linspace(0.0, 1.0, self.n_points)
+            around = [np.interp(a, own, p) for a, p in zip(around, params)]
+        with np.errstate(all="ignore"):
+            z, (out, ctrl, params), feet = self.refine_latents(mean, targets, around, steps)
+        return dataclasses.replace(
+            prep, mean=z.astype(np.float32), log_var=log_var, decoded=out, ctrl=ctrl, params=params, feet=feet
+        )
 
     def refine_latents(
         self,

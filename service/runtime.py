@@ -17,17 +17,16 @@ model input. "arc_length" resamples evenly by arc length instead (geometry.adapt
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 
-Length (~430 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a
+Length (~460 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a
 batch's frames, input positions and splines from `prepare` through the graphs to the result, turning geometry's
 errors into the service's InputError with the field and curve they concern. Its parts live beside it: the
 sessions, signature checks and raw graph runs are `service.graphs` (the base class `ModelGraphs`); the pure frame
-and length adaptation is `geometry.adapt`; augmentation `service.augmenting` and sampling `service.sampling`
-(base classes too); the input error `service.inputs`; the mixing weights `geometry.mixing`.
+and length adaptation is `geometry.adapt`; augmentation `service.augmenting`, sampling `service.sampling` and the
+fitting of `refine` `service.fitting` (base classes too); the input error `service.inputs`; the mixing weights `geometry.mixing`.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -176,28 +175,6 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
             decoded[best],
             None if ctrl is None else ctrl[best],
             None if params is None else params[best],
-        )
-
-    def _refined(self, prep: Prepared, steps: int) -> Prepared:
-        """`prep` with its latents fitted to the caller's own points by `steps` steps (service.fitting): the latent
-        means become the fitted latents (the log-variances stay the encoder's), and each input point is matched to
-        its closest point on the fitted spline (`Prepared.feet`)."""
-        if not self.has_splines:
-            raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
-        mean, log_var = self._encoded(prep)
-        targets, around = [], []
-        for pts, f, fraction in zip(prep.inputs, prep.frames, prep.fractions):
-            targets.append(f.to_model(pts, self.model_size) if f is not None else pts)
-            at = np.linspace(0.0, 1.0, len(pts)) if fraction is None else fraction
-            around.append(at)
-        if prep.params is not None or self.has_params:  # the head's own parameters at those positions
-            params = prep.params if prep.params is not None else self.decode_model_splines(mean)[2]
-            own = np.linspace(0.0, 1.0, self.n_points)
-            around = [np.interp(a, own, p) for a, p in zip(around, params)]
-        with np.errstate(all="ignore"):
-            z, (out, ctrl, params), feet = self.refine_latents(mean, targets, around, steps)
-        return dataclasses.replace(
-            prep, mean=z.astype(np.float32), log_var=log_var, decoded=out, ctrl=ctrl, params=params, feet=feet
         )
 
     def _to_model_points(
