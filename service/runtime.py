@@ -22,7 +22,8 @@ batch's frames, input positions and splines from `prepare` through the graphs to
 errors into the service's InputError with the field and curve they concern. Its parts live beside it: the
 sessions, signature checks and raw graph runs are `service.graphs` (the base class `ModelGraphs`); the pure frame
 and length adaptation is `geometry.adapt`; augmentation `service.augmenting`, sampling `service.sampling` and the
-fitting of `refine` `service.fitting` (base classes too); the input error `service.inputs`; the mixing weights `geometry.mixing`.
+fitting of `refine` `service.fitting` (base classes too); the input error `service.inputs`; the mixing weights
+`geometry.mixing`.
 """
 
 from __future__ import annotations
