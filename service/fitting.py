@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.interpolate import BSpline
+from scipy.optimize import isotonic_regression
 
 from curve_vae.geometry import closest_params
 from curve_vae.service.inputs import InputError
@@ -139,11 +140,14 @@ class Fitting:
         return z, decoded, feet  # type: ignore[return-value]
 
     def _feet(self, ctrl: np.ndarray, target: np.ndarray, around: np.ndarray) -> np.ndarray:
-        """Each target point's closest point on the spline near `around`; the curve's ends stay its ends (the
-        first and last points are matched to parameters 0 and 1, as without refinement)."""
+        """Each target point's closest point on the spline near `around`, kept in the points' order: the curve's
+        ends stay its ends (the first and last points at parameters 0 and 1, as without refinement), and where
+        closest points come out of order (points around a corner sharper than the spline's, all closest to its
+        rounded tip) they are pooled to the least-squares non-decreasing sequence (isotonic regression), so the
+        returned points never step back along the curve."""
         u = closest_params(ctrl, target, around, window=FOOT_WINDOW, degree=self.spline_degree)
         u[0], u[-1] = 0.0, 1.0
-        return u
+        return np.asarray(isotonic_regression(u).x, np.float64)
 
     def _basis(self, u: np.ndarray) -> np.ndarray:
         """(n, n_ctrl) B-spline basis of the head at parameters u."""
