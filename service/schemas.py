@@ -93,9 +93,9 @@ RefineSteps = Annotated[
             "Fitting steps (default 0: none). After encoding, each curve's latent is refined by this many "
             "Levenberg–Marquardt steps that bring the decoded curve closer to the input's own points, each point "
             "measured to its closest point on the curve, and the returned points are those closest points. With "
-            "the default model, 10 steps bring the paper's test curves from 0.17% to 0.025% of their bounding-box "
-            "diagonal, the same curves spaced by arc length from 0.28% to 0.09% and real airfoils from 0.41% to "
-            "0.04%, at about 8× the compute of a plain reconstruction (3 steps: 4×; scripts/refine_tradeoff.py). "
+            "the default model, 10 steps bring the paper's test curves from 0.17% to 0.026% of their bounding-box "
+            "diagonal, the same curves spaced by arc length from 0.28% to 0.10% and real airfoils from 0.40% to "
+            "0.04%, at about 8× the compute of a plain reconstruction (3 steps: 4×; docs/RESULTS.md). "
             "Needs a model with a B-spline head. In /encode, the returned means are the refined latents."
         ),
     ),
