@@ -10,7 +10,9 @@ curves' error to the parameter-spaced ones', and the time per curve as a multipl
 (all sets, one run, one thread: these machines are noisy, so compare ratios, not seconds). With --figure, a PNG:
 the error per set against the steps, and the leading edge of the first real airfoil, plain and refined. With
 --basins, how much the start of the fit matters: the arc-length-spaced paper curves fitted from encodings of the same
-curves respaced part of the way towards the B-spline parameter they were drawn at.
+curves respaced part of the way towards the B-spline parameter they were drawn at. With --interpolation, sweeps of
+7 curves between pairs of paper curves (the second of each pair spaced by arc length), plain and refined: the interior
+curves' roughness and self-intersection, and how far the first end is from its input.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from curve_vae.geometry import arc_fractions, closest_params, evaluate_bspline
+from curve_vae.geometry import arc_fractions, closest_params, evaluate_bspline, self_intersects, smoothness
 from curve_vae.service import fitting
 from curve_vae.service.runtime import CurveRuntime
 from curve_vae.training.suite import paper_test_split, relative_rmse, suite_sets
@@ -43,6 +45,7 @@ def main() -> None:
     )
     p.add_argument("--figure", type=Path, default=None, help="also write the figure here (PNG)")
     p.add_argument("--basins", action="store_true", help="also measure where the arc-length fit starts (see above)")
+    p.add_argument("--interpolation", action="store_true", help="also measure sweeps between refined curves")
     a = p.parse_args()
     fitting.JACOBIAN_EVERY = a.jacobian_every
     rt = CurveRuntime.load(a.model_dir, providers="cpu", intra_op_threads=1)
@@ -71,6 +74,26 @@ def main() -> None:
         plot(rt, sets, errors, a.steps, a.figure)
     if a.basins:
         basins(rt, sets["paper"], sets["paper, arc-length spacing"], max(a.steps))
+    if a.interpolation:
+        interpolation(rt, sets["paper"], sets["paper, arc-length spacing"], a.steps)
+
+
+def interpolation(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps: list[int]) -> None:
+    """Sweeps from paper curve 2k to the arc-length-spaced paper curve 2k+1, 7 curves each, at each number of steps."""
+    w = np.stack([np.linspace(1, 0, 7), np.linspace(0, 1, 7)], 1)
+    pairs = [(param[2 * k], arc[2 * k + 1]) for k in range(len(param) // 2)]
+    print(f"sweeps between {len(pairs)} pairs (7 curves each; interior: the 5 between the ends):")
+    for n in steps:
+        rough, cross, first = [], [], []
+        for a, b in pairs:
+            out, _ = rt.interpolate([a, b], w, refine=n)
+            rough += [smoothness(c)["roughness"] for c in out[1:-1]]
+            cross += [bool(self_intersects(c)) for c in out[1:-1]]
+            first.append(relative_rmse([a], [out[0]])[0])
+        print(
+            f"  refine {n:2d}: interior roughness {np.mean(rough):.3f}°, crossing {100 * np.mean(cross):.1f}%; "
+            f"first end {100 * np.mean(first):.3f}% from its input"
+        )
 
 
 def basins(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps: int) -> None:

@@ -363,14 +363,18 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         spacing: Spacing = "parameter",
         splines: list[Spline] | None = None,
         pose: PoseMode = "auto",
+        refine: int = 0,
     ) -> tuple[np.ndarray, list[Frame | None]]:
         """Decode affine combinations of the curves' latent means (paper eqs. 9, 10), one per weight row.
 
         weights: (rows, len(curves)), rows summing to 1. With frame "auto" each interpolant
         comes back in the same blend of the inputs' frames. Length: n_points; else the
         inputs' common length, at the blend of their points' positions; else the model's.
+        With `refine` the means are the fitted latents (see `prepare`), and the positions blended are the input
+        points' closest points on their fitted splines, so a row of weights [1, 0, …] gives the refined
+        reconstruction of the first curve.
         """
-        prep = self.prepare(curves, frame, spacing, pose)
+        prep = self.prepare(curves, frame, spacing, pose, refine)
         mean, _ = self._encoded(prep)
         return self._mix(prep, mean.astype(np.float64), np.asarray(weights, np.float64), n_points, spacing, splines)
 
@@ -397,13 +401,19 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
                 [blend_frames(given, w[r : r + 1])[0] for r in range(len(w))] if auto else [None] * len(w)
             )
             common = self._common_length(prep)
-            blend = n_points is None and common is not None and all(f is not None for f in prep.fractions)
+            placed = prep.feet is not None or all(f is not None for f in prep.fractions)
+            blend = n_points is None and common is not None and placed
             if n_points is None and common is None:
                 n_points = self.n_points
             results = []
             for r, o in enumerate(out):
                 c, u = None if ctrl is None else ctrl[r], None if params is None else params[r]
-                if blend:
+                if blend and prep.feet is not None:  # refined: blend the spline parameters of the input points
+                    positions = np.maximum.accumulate(np.clip(w[r] @ np.stack(prep.feet), 0.0, 1.0))
+                    results.append(
+                        self._to_caller(o, frames[r], n_points=None, fractions=positions, ctrl=c, splines=splines)
+                    )
+                elif blend:
                     positions = w[r] @ np.stack(prep.fractions)  # type: ignore[arg-type]
                     positions = np.maximum.accumulate(np.clip(positions, 0.0, 1.0))  # extrapolating rows stay ordered
                     results.append(

@@ -245,7 +245,14 @@ async def _interpolate(request: Request, req: s.InterpolateRequest, curves: list
 
     def work() -> Response:
         out, frames = runtime.interpolate(
-            curves, weights, frame=req.frame, n_points=req.n_points, spacing=req.spacing, splines=splines, pose=req.pose
+            curves,
+            weights,
+            frame=req.frame,
+            n_points=req.n_points,
+            spacing=req.spacing,
+            splines=splines,
+            pose=req.pose,
+            refine=req.refine,
         )
         body = {"weights": weights, "curves": np.ascontiguousarray(out), "frames": frames_json(frames)}
         return JSON(with_output(with_metrics(body, out, req.metrics), splines, req.output))

@@ -168,3 +168,22 @@ def test_refined_points_never_step_back_along_the_curve_at_a_sharp_corner(shippe
     for o, s in zip(out, splines):
         assert (np.diff(s.params) >= 0).all()
         assert not self_intersects(o)
+
+
+def test_refined_interpolation_ends_are_the_refined_reconstructions(runtime, curves):
+    c = [curves(1, seed=9)[0], resample(curves(1, seed=10)[0], 161)]
+    ends, _ = runtime.interpolate(c, np.array([[1.0, 0.0], [0.0, 1.0], [0.5, 0.5]]), refine=3)
+    fitted, _ = runtime.reconstruct(c, refine=3)
+    plain, _ = runtime.reconstruct(c)
+    for end, f, p in zip(ends[:2], fitted, plain):
+        np.testing.assert_allclose(end, f, rtol=0, atol=1e-9 * np.abs(f).max())
+        assert np.abs(f - p).max() > 1e-6  # refined, not the plain reconstruction
+    assert np.isfinite(ends[2]).all()
+
+
+def test_refine_over_http_on_interpolate(client, curves):
+    c = curves(2, seed=11).tolist()
+    r = client.post("/interpolate", json={"curves": c, "steps": 3, "refine": 2})
+    assert r.status_code == 200 and len(r.json()["curves"]) == 3
+    fitted = client.post("/reconstruct", json={"curves": c, "refine": 2}).json()["curves"]
+    np.testing.assert_allclose(r.json()["curves"][0], fitted[0], atol=1e-9)
