@@ -93,7 +93,7 @@ class Fitting:
         every = jacobian_every or JACOBIAN_EVERY
         z = np.array(latents, np.float64)
         count, dim = z.shape
-        decoded = self.decode_model_splines(z)
+        decoded = _float64(self.decode_model_splines(z))
         feet = [self._feet(c, t, a) for c, t, a in zip(decoded[1], targets, around)]
         cost = np.array([self._cost(c, t, u) for c, t, u in zip(decoded[1], targets, feet)])
         damping = np.full(count, 1e-2)
@@ -103,7 +103,8 @@ class Fitting:
                 break
             if step % every == 0:
                 shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
-                jac = (self.decode_model_splines(shifted)[1].reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
+                moved = self.decode_model_splines(shifted)[1].astype(np.float64)
+                jac = (moved.reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
             trial = z.copy()
             for i in range(count):
                 basis = self._basis(feet[i])
@@ -116,7 +117,7 @@ class Fitting:
                 except np.linalg.LinAlgError:  # a Jacobian of non-finite numbers: this curve stays where it is
                     trial[i] = z[i]
             with np.errstate(all="ignore"):
-                tried = self.decode_model_splines(trial)
+                tried = _float64(self.decode_model_splines(trial))
             tried_feet, tried_cost = [], np.full(count, np.inf)
             for i in range(count):
                 c = tried[1][i]
@@ -127,7 +128,7 @@ class Fitting:
                 else:
                     tried_feet.append(feet[i])
             # Broyden's update of each curve's Jacobian by the step just tried (accepted or not)
-            dz, dc = trial - z, tried[1].astype(np.float64) - decoded[1]
+            dz, dc = trial - z, tried[1] - decoded[1]
             norm = (dz**2).sum(1)
             ok = (norm > 0) & np.isfinite(dc).reshape(count, -1).all(1)
             miss = dc - np.einsum("bl,blkd->bkd", dz, jac)
@@ -155,6 +156,11 @@ class Fitting:
 
     def _cost(self, ctrl: np.ndarray, target: np.ndarray, u: np.ndarray) -> float:
         return float(((target - self._basis(u) @ np.asarray(ctrl, np.float64)) ** 2).sum())
+
+
+def _float64(decoded: tuple[np.ndarray | None, ...]) -> tuple[np.ndarray | None, ...]:
+    """A decoding (curves, control points, parameters or None) in float64, for the differences of the fit."""
+    return tuple(None if d is None else d.astype(np.float64) for d in decoded)
 
 
 def _rows(mask: np.ndarray, like: np.ndarray) -> np.ndarray:
