@@ -66,6 +66,17 @@ def check_n_points(n_points: int | None, settings: Settings) -> None:
         raise InputError(("n_points",), f"at most {settings.max_points}, got {n_points}")
 
 
+def check_refine(steps: int, curves: list[np.ndarray], settings: Settings) -> None:
+    """The fitting work a request asks for (input points × steps) within CURVE_VAE_MAX_REFINE_WORK."""
+    work = steps * sum(len(c) for c in curves)
+    if work > settings.max_refine_work:
+        raise InputError(
+            ("refine",),
+            f"{steps} steps on {sum(len(c) for c in curves)} input points are {work} point-steps; at most "
+            f"{settings.max_refine_work} (CURVE_VAE_MAX_REFINE_WORK): send fewer curves or steps",
+        )
+
+
 def check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
     n = len(req.curves)
     if req.weights is None:

@@ -23,6 +23,7 @@ from curve_vae.service.deps import (
     SettingsDep,
     check_curves,
     check_n_points,
+    check_refine,
     check_weights,
     in_executor,
     run_inference,
@@ -79,6 +80,7 @@ async def encode(
 @npy_route("/encode", s.EncodeRequest)
 async def _encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray]) -> Response:
     runtime = runtime_of(request)
+    check_refine(req.refine, curves, settings_of(request))
 
     def work() -> Response:
         mean, log_var, frames = runtime.encode(
@@ -175,6 +177,7 @@ async def reconstruct(
 async def _reconstruct(request: Request, req: s.ReconstructRequest, curves: list[np.ndarray]) -> Response:
     runtime, settings = runtime_of(request), settings_of(request)
     check_n_points(req.n_points, settings)
+    check_refine(req.refine, curves, settings)
     splines = splines_wanted(req.output, runtime)
 
     def work() -> Response:
@@ -240,6 +243,7 @@ async def interpolate(
 async def _interpolate(request: Request, req: s.InterpolateRequest, curves: list[np.ndarray]) -> Response:
     runtime, settings = runtime_of(request), settings_of(request)
     check_n_points(req.n_points, settings)
+    check_refine(req.refine, curves, settings)
     weights = check_weights(req, settings)
     splines = splines_wanted(req.output, runtime)
 

@@ -82,6 +82,7 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
             "max_body_bytes": settings.max_body_bytes,
             "max_stream_curves": settings.max_stream_curves,
             "max_mesh_triangles": settings.max_mesh_triangles,
+            "max_refine_work": settings.max_refine_work,
         },
         "execution": execution_of(request, runtime),
     }

@@ -187,3 +187,17 @@ def test_refine_over_http_on_interpolate(client, curves):
     assert r.status_code == 200 and len(r.json()["curves"]) == 3
     fitted = client.post("/reconstruct", json={"curves": c, "refine": 2}).json()["curves"]
     np.testing.assert_allclose(r.json()["curves"][0], fitted[0], atol=1e-9)
+
+
+def test_a_request_asking_for_too_much_fitting_work_is_refused_before_any(make_client, curves):
+    client = make_client(max_refine_work=1000)
+    c = curves(2, seed=12).tolist()  # 2 × 161 points
+    for path, extra in (("/reconstruct", {}), ("/encode", {}), ("/interpolate", {"steps": 3})):
+        r = client.post(path, json={"curves": c, "refine": 4, **extra})
+        assert r.status_code == 422, (path, r.text)
+        assert r.json()["detail"] == (
+            "refine: 4 steps on 322 input points are 1288 point-steps; at most 1000 (CURVE_VAE_MAX_REFINE_WORK): "
+            "send fewer curves or steps"
+        )
+        assert client.post(path, json={"curves": c, "refine": 3, **extra}).status_code == 200
+    assert client.get("/model").json()["limits"]["max_refine_work"] == 1000

@@ -18,6 +18,7 @@ from tests.service.conftest import SHIPPED, LiveServer
 CROSS_FIELD_RULES = {
     "coincident points": r"all \d+ points coincide: a curve needs at least 2 distinct points",
     "segments × profile points ≤ CURVE_VAE_MAX_MESH_TRIANGLES": r"segments of a \d+-point profile make up to",
+    "refine steps × input points ≤ CURVE_VAE_MAX_REFINE_WORK": r"point-steps; at most \d+ \(CURVE_VAE_MAX_REFINE_WORK",
     "neighbours ≥ the sources per mode - 1": r"neighbours: mode \w+ mixes each curve with \d others",
     "neighbours ≤ the number of other curves": r"neighbours: at most \d+ \(each curve has",
     "one frame per latent": r"frames: expected one frame per latent",
