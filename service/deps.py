@@ -66,14 +66,22 @@ def check_n_points(n_points: int | None, settings: Settings) -> None:
         raise InputError(("n_points",), f"at most {settings.max_points}, got {n_points}")
 
 
+#: What one curve costs a fitting step beyond its points, in points: its decoder runs (service/fitting.py) take
+#: about as long as matching 300 points (10 steps: ~86 ms for a 4-point curve, ~130 ms for a 161-point one).
+REFINE_POINTS_PER_CURVE = 300
+
+
 def check_refine(steps: int, curves: list[np.ndarray], settings: Settings) -> None:
-    """The fitting work a request asks for (input points × steps) within CURVE_VAE_MAX_REFINE_WORK."""
-    work = steps * sum(len(c) for c in curves)
+    """The fitting work a request asks for — steps × (input points + REFINE_POINTS_PER_CURVE per curve) — within
+    CURVE_VAE_MAX_REFINE_WORK."""
+    points = sum(len(c) for c in curves)
+    work = steps * (points + REFINE_POINTS_PER_CURVE * len(curves))
     if work > settings.max_refine_work:
         raise InputError(
             ("refine",),
-            f"{steps} steps on {sum(len(c) for c in curves)} input points are {work} point-steps; at most "
-            f"{settings.max_refine_work} (CURVE_VAE_MAX_REFINE_WORK): send fewer curves or steps",
+            f"{steps} steps on {len(curves)} curves of {points} points in all are {work} units of work (steps × "
+            f"(points + {REFINE_POINTS_PER_CURVE} per curve)); at most {settings.max_refine_work} "
+            "(CURVE_VAE_MAX_REFINE_WORK): send fewer curves or steps",
         )
 
 

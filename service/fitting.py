@@ -85,22 +85,26 @@ class Fitting:
         model plane, whose points start matched to spline parameters `around[i]` (n_i,).
 
         Returns the refined latents (float64), their decoding (curves, control points, learned parameters or None)
-        and each target point's parameter on its refined spline. Never worse than the latents given: a curve whose
-        step raises its distance keeps the previous latent. A fresh Jacobian every `jacobian_every` steps (default
-        JACOBIAN_EVERY).
+        and each target point's parameter on its refined spline. Never further from the targets than the latents
+        given at `around`: a curve whose step raises its distance keeps the previous latent. A fresh Jacobian every
+        `jacobian_every` steps (default JACOBIAN_EVERY).
         """
         assert self.knots is not None, "refinement needs a B-spline head"
         every = jacobian_every or JACOBIAN_EVERY
         z = np.array(latents, np.float64)
         count, dim = z.shape
         decoded = _float64(self.decode_model_splines(z))
-        feet = [self._feet(c, t, a) for c, t, a in zip(decoded[1], targets, around)]
-        cost = np.array([self._cost(c, t, u) for c, t, u in zip(decoded[1], targets, feet)])
+        # the start: each curve's closest points, or its positions as given where those are closer (pooling points
+        # into order can cost more than it gains), so that the fit is never further than the plain reconstruction
+        feet, cost = [], np.empty(count)
+        for i, (c, t, a) in enumerate(zip(decoded[1], targets, around)):
+            closest = self._feet(c, t, a)
+            starts = [(self._cost(c, t, closest), closest), (self._cost(c, t, a), np.asarray(a, np.float64))]
+            cost[i], u = min(starts, key=lambda start: start[0])
+            feet.append(u)
         damping = np.full(count, 1e-2)
         jac = np.zeros(0)
-        for step in range(steps):
-            if count == 0:
-                break
+        for step in range(steps if count else 0):
             if step % every == 0:
                 shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
                 moved = self.decode_model_splines(shifted)[1].astype(np.float64)

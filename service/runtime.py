@@ -333,16 +333,11 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
             for i, o in enumerate(out):
                 c, u = None if ctrl is None else ctrl[i], None if params is None else params[i]
                 if is_closed(prep.inputs[i]):  # a loop comes back a loop
-                    o, c = (joined_ends(o), c) if c is None else (o, joined_ends(c))
+                    o, c = _joined(o, c)
                 kept = splines if n_points is None else None
-                if prep.feet is not None:  # the spline's points closest to the input's: at their parameters
-                    own = self._to_caller(
-                        o, prep.frames[i], n_points=None, fractions=prep.feet[i], ctrl=c, splines=kept
-                    )
-                else:
-                    own = self._to_caller(
-                        o, prep.frames[i], n_points=None, fractions=prep.fractions[i], ctrl=c, params=u, splines=kept
-                    )
+                # refined: the spline's points closest to the input's, at their parameters (not the head's)
+                at, head = (prep.fractions[i], u) if prep.feet is None else (prep.feet[i], None)
+                own = self._to_caller(o, prep.frames[i], n_points=None, fractions=at, ctrl=c, params=head, splines=kept)
                 mse[i] = mse_per_curve(prep.inputs[i][None], own[None])[0]
                 if n_points is not None:
                     own = self._to_caller(
@@ -372,7 +367,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         inputs' common length, at the blend of their points' positions; else the model's.
         With `refine` the means are the fitted latents (see `prepare`), and the positions blended are the input
         points' closest points on their fitted splines, so a row of weights [1, 0, …] gives the refined
-        reconstruction of the first curve.
+        reconstruction of the first curve. When every input is closed (`reconstruct`), so is every interpolant.
         """
         prep = self.prepare(curves, frame, spacing, pose, refine)
         mean, _ = self._encoded(prep)
@@ -405,20 +400,19 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
             blend = n_points is None and common is not None and placed
             if n_points is None and common is None:
                 n_points = self.n_points
+            closed = bool(prep.inputs) and all(is_closed(c) for c in prep.inputs)  # loops mix into loops
             results = []
             for r, o in enumerate(out):
                 c, u = None if ctrl is None else ctrl[r], None if params is None else params[r]
-                if blend and prep.feet is not None:  # refined: blend the spline parameters of the input points
-                    positions = np.maximum.accumulate(np.clip(w[r] @ np.stack(prep.feet), 0.0, 1.0))
-                    results.append(
-                        self._to_caller(o, frames[r], n_points=None, fractions=positions, ctrl=c, splines=splines)
-                    )
-                elif blend:
-                    positions = w[r] @ np.stack(prep.fractions)  # type: ignore[arg-type]
+                if closed:
+                    o, c = _joined(o, c)
+                if blend:  # refined: blend the spline parameters of the input points (not the head's)
+                    at, head = (prep.fractions, u) if prep.feet is None else (prep.feet, None)
+                    positions = w[r] @ np.stack(at)  # type: ignore[arg-type]
                     positions = np.maximum.accumulate(np.clip(positions, 0.0, 1.0))  # extrapolating rows stay ordered
                     results.append(
                         self._to_caller(
-                            o, frames[r], n_points=None, fractions=positions, ctrl=c, params=u, splines=splines
+                            o, frames[r], n_points=None, fractions=positions, ctrl=c, params=head, splines=splines
                         )
                     )
                 else:
@@ -450,6 +444,12 @@ def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:
             length = _number(curve_length(c))
         out.append({"smoothness": smooth, "self_intersects": bool(self_intersects(c)), "length": length})
     return out
+
+
+def _joined(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """A decoded curve (and its control points) closed: the ends joined at their midpoint (geometry.joined_ends), on
+    the control points where there are some (a clamped B-spline's end points are its end control points)."""
+    return (joined_ends(out), None) if ctrl is None else (out, joined_ends(ctrl))
 
 
 def _number(value: Any) -> float | None:

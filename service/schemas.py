@@ -80,7 +80,8 @@ SpacingMode = Annotated[
     ),
 ]
 
-#: Most fitting steps a request may ask for (each costs about 33 decoder runs per curve).
+#: Most fitting steps a request may ask for (each costs about 7 decoder runs per curve: a Jacobian of 32 runs every
+#: 5th step, one run per step; service/fitting.py).
 MAX_REFINE_STEPS = 30
 
 RefineSteps = Annotated[
@@ -96,8 +97,9 @@ RefineSteps = Annotated[
             "the default model, 10 steps bring the paper's test curves from 0.17% to 0.026% of their bounding-box "
             "diagonal, the same curves spaced by arc length from 0.28% to 0.10% and real airfoils from 0.40% to "
             "0.04%, at about 8× the compute of a plain reconstruction (3 steps: 4×; docs/RESULTS.md). "
-            "Needs a model with a B-spline head; a request's input points × steps are limited by the server "
-            "(GET /model: limits.max_refine_work). In /encode, the returned means are the refined latents; in "
+            "Needs a model with a B-spline head; a request's work, steps × (input points + 300 per curve), is "
+            "limited by the server (GET /model: limits.max_refine_work). In /encode, the returned means are the "
+            "refined latents; in "
             "/interpolate the refined latents are mixed, so the ends of a sweep are the refined reconstructions "
             "(60 pairs of paper curves, the second of each spaced by arc length, 10 steps: the first end 0.026% from "
             "its input instead of 0.17%; the curves between the ends 15% rougher, as often crossing themselves)."

@@ -54,9 +54,9 @@ class Settings(BaseSettings):
     max_body_bytes: int = Field(8 << 20, ge=1024)  # larger request bodies get 413
     max_stream_curves: int = Field(100_000, ge=1)  # curves of one streamed .npy (/augment format npy): ~13 MB per 10k
     max_mesh_triangles: int = Field(1_000_000, ge=1)  # triangles of one /revolve mesh: 50 MB of STL
-    # Input points × refine steps of one request: about 30 s of one CPU core here (docs/RESULTS.md: 10 steps on
-    # 161 points cost ~0.1 s), so under request_timeout; 256 curves of 161 points may take 12 steps.
-    max_refine_work: int = Field(500_000, ge=0)
+    # Fitting work of one request, steps × (input points + 300 per curve) (service/deps.py check_refine): about 35 s
+    # of one CPU core here, under request_timeout; 256 curves of 161 points may take 10 steps.
+    max_refine_work: int = Field(1_200_000, ge=0)
     # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
     cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)
     # API keys (service/access.py), comma-separated or a JSON list; empty = open. Set by environment only,

@@ -194,8 +194,8 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         "--suite-refine",
         type=int,
         default=0,
-        help="also measure the family suite with this many fitting steps (the request option refine; about 30× "
-        "the time at 10 steps); needs --model-dir (default: 0, not measured)",
+        help="also measure the family suite with this many fitting steps (the request option refine; about 8× "
+        "the time at 10 steps); needs --model-dir and --suite-count > 0 (default: 0, not measured)",
     )
     s.add_argument("--data", default=None, help=f"data set cache (default: {DATA_HELP})")
     s.add_argument(

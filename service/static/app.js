@@ -8,7 +8,8 @@ const W = 1000, H = 700;  // the board's viewBox; API coordinates are the board'
 const COLORS = ["#1f77b4", "#2ca02c", "#9467bd"];
 const NAMES = ["A", "B", "C"];
 const N_POINTS = 100;
-const FIT_STEPS = 10;  // "fit closely": the reconstructions' `refine`
+const FIT_STEPS = 10;  // "fit closely": the `refine` of every call that encodes the drawn curves
+const refine = () => ($("fit-closely").checked ? FIT_STEPS : 0);
 
 // Everything the page shows, in API coordinates; window.curveVae for tests and the console.
 const state = {
@@ -185,10 +186,9 @@ function finishStroke() {
 
 async function reconstructAll() {
   if (!state.curves.length) return;
-  const body = { curves: state.curves, spacing: "arc_length", n_points: N_POINTS, output: "both",
-    refine: $("fit-closely").checked ? FIT_STEPS : 0 };
+  const body = { curves: state.curves, spacing: "arc_length", n_points: N_POINTS, output: "both", refine: refine() };
   const r = await api("/reconstruct", body, $("board-error"));
-  state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i], body }));
+  state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i], refine: body.refine }));
 }
 
 function needed() { return state.mode === "triplet" ? 3 : 2; }
@@ -200,7 +200,7 @@ function mixWeights() {
 async function updateMix() {
   if (state.curves.length < needed()) { state.result = null; render(); return; }
   const body = { curves: state.curves.slice(0, needed()), weights: mixWeights(), spacing: "arc_length",
-    n_points: N_POINTS, output: "both", metrics: true };
+    n_points: N_POINTS, output: "both", metrics: true, refine: refine() };
   const r = await api("/interpolate", body, $("mix-error"));
   state.result = { points: r.curves[0], spline: r.splines[0], metrics: r.metrics[0], weights: r.weights[0], body };
   render();
@@ -209,7 +209,7 @@ async function updateMix() {
 async function updateStrip() {
   if (state.curves.length < needed()) { state.strip = []; return; }
   const steps = state.mode === "triplet" ? 4 : 5;  // pair: 5 evenly spaced; triplet: the grid of paper Fig. 8
-  const body = { curves: state.curves.slice(0, needed()), steps, spacing: "arc_length", n_points: 60 };
+  const body = { curves: state.curves.slice(0, needed()), steps, spacing: "arc_length", n_points: 60, refine: refine() };
   const r = await api("/interpolate", body, $("strip-error"));
   state.strip = r.curves;
 }
@@ -251,9 +251,7 @@ for (const mode of ["pair", "triplet"]) {
 }
 
 $("show-ctrl").addEventListener("change", render);
-$("fit-closely").addEventListener("change", () => {
-  busy = busy.then(async () => { try { await reconstructAll(); } catch (e) { /* shown by api() */ } render(); });
-});
+$("fit-closely").addEventListener("change", curvesChanged);
 $("clear").addEventListener("click", () => {
   Object.assign(state, { curves: [], recon: [], result: null, strip: [] });
   curvesChanged();

@@ -201,19 +201,25 @@ def test_page_on_another_origin_with_cors(browser, server, server_factory, model
     assert errors == []
 
 
-def test_fit_closely_refines_the_reconstructions(browser, server):
+def test_fit_closely_refines_the_reconstructions_and_the_mix(browser, server):
     page, errors = open_page(browser, server.url + "/")
     t = np.linspace(0, 1, 40)
     draw(page, list(zip(200 + 600 * t, 350 + 120 * np.sin(2 * np.pi * t) * (1 - 0.5 * t))))  # an S-stroke
-    page.wait_for_function("document.querySelectorAll('path.reconstruction').length === 1")
-    plain = state(page)["recon"][0]
-    assert plain["body"]["refine"] == 0
+    draw(page, arc(500, 420, 250, np.pi, 2 * np.pi))  # a bowl
+    page.wait_for_function("window.curveVae.result !== null && window.curveVae.recon.length === 2")
+    plain = state(page)
+    assert plain["recon"][0]["refine"] == 0 and plain["result"]["body"]["refine"] == 0
     page.check("#fit-closely")
-    page.wait_for_function("window.curveVae.recon[0] && window.curveVae.recon[0].body.refine === 10")
-    fitted = state(page)["recon"][0]
-    assert fitted["mse"] < plain["mse"] / 2, (plain["mse"], fitted["mse"])
-    answer = httpx.post(server.url + "/reconstruct", json=fitted["body"], timeout=30).json()
-    np.testing.assert_allclose(drawn(page, "path.reconstruction"), answer["curves"][0], atol=2e-3)
+    page.wait_for_function(
+        "window.curveVae.recon[0].refine === 10 && window.curveVae.result && window.curveVae.result.body.refine === 10"
+    )
+    fitted = state(page)
+    assert fitted["recon"][0]["mse"] < plain["recon"][0]["mse"] / 2, (plain["recon"][0], fitted["recon"][0])
+    body = {"curves": fitted["curves"], "spacing": "arc_length", "n_points": 100, "output": "both", "refine": 10}
+    answer = httpx.post(server.url + "/reconstruct", json=body, timeout=30).json()
+    np.testing.assert_allclose(drawn(page, "path.reconstruction >> nth=0"), answer["curves"][0], atol=2e-3)
+    mix = httpx.post(server.url + "/interpolate", json=fitted["result"]["body"], timeout=30).json()
+    np.testing.assert_allclose(drawn(page, "#interpolant"), mix["curves"][0], atol=2e-3)
     assert errors == []
 
 
