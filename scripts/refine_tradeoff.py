@@ -70,6 +70,9 @@ def main() -> None:
     print(f"{'time per curve (× the first)':28s}" + "".join(f"{seconds[s] / base:10.1f}×" for s in a.steps))
     print(f"({n} curves per column; the first column: {1000 * base / n:.1f} ms per curve on this machine)")
     print("mean relative RMSE per set (RMSE ÷ bounding-box diagonal, at the input's own points)")
+    print("of which the matching alone (each input point to its closest point on the plain reconstruction, 0 steps):")
+    for name, curves in sets.items():
+        print(f"  {name:28s}{100 * matched_only(rt, curves):8.3f}%")
     if a.figure:
         plot(rt, sets, errors, a.steps, a.figure)
     if a.basins:
@@ -94,6 +97,15 @@ def interpolation(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps
             f"  refine {n:2d}: interior roughness {np.mean(rough):.3f}°, crossing {100 * np.mean(cross):.1f}%; "
             f"first end {100 * np.mean(first):.3f}% from its input"
         )
+
+
+def matched_only(rt: Any, curves: list[np.ndarray]) -> float:
+    """Mean relative RMSE of the plain reconstructions with each input point at its closest point on them: what
+    refine's matching gives before any step (model plane: the frames are similarities, the ratio is the same)."""
+    prep = rt._refined(rt.prepare(curves), 0)
+    targets = [f.to_model(c, rt.model_size) for f, c in zip(prep.frames, curves)]
+    fits = [evaluate_bspline(c, u) for c, u in zip(prep.ctrl, prep.feet)]
+    return float(relative_rmse(targets, fits).mean())
 
 
 def basins(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps: int) -> None:
