@@ -35,7 +35,12 @@ def _distinct(curve: list[tuple[float, float]]) -> list[tuple[float, float]]:
 
 Curve = Annotated[
     list[Point],
-    Field(min_length=4, description="Ordered [x, y] points of an open curve: ≥ 4 points, ≥ 2 of them distinct."),
+    Field(
+        min_length=4,
+        description="Ordered [x, y] points of a curve: ≥ 4 points, ≥ 2 of them distinct. A curve whose last point "
+        "repeats its first is closed (a loop, as closed airfoil files list it): its reconstruction, and every "
+        "interpolant between closed curves, comes back closed.",
+    ),
     AfterValidator(_distinct),
 ]
 
