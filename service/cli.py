@@ -32,7 +32,12 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--max-body-bytes", "max_body_bytes", int, "larger request bodies are answered 413"),
     ("--max-stream-curves", "max_stream_curves", int, "most curves in one streamed .npy (POST /augment format npy)"),
     ("--max-mesh-triangles", "max_mesh_triangles", int, "most triangles in one POST /revolve mesh"),
-    ("--max-refine-work", "max_refine_work", int, "most input points × refine steps in one request"),
+    (
+        "--max-refine-work",
+        "max_refine_work",
+        int,
+        "most refine work in one request: steps × (input points + 300 per curve)",
+    ),
     ("--batch-size", "batch_size", int, "curves per ONNX run"),
     ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0: the CPU quota shared out"),
     ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),

@@ -78,8 +78,6 @@ class Fitting:
         targets: Sequence[np.ndarray],
         around: Sequence[np.ndarray],
         steps: int,
-        *,
-        jacobian_every: int | None = None,
     ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray | None], list[np.ndarray]]:
         """`steps` damped Gauss–Newton steps on each latent (B, latent_dim) towards its curve `targets[i]` (n_i, 2),
         model plane, whose points start matched to spline parameters `around[i]` (n_i,).
@@ -87,10 +85,9 @@ class Fitting:
         Returns the refined latents (float64), their decoding (curves, control points, learned parameters or None)
         and each target point's parameter on its refined spline. Never further from the targets than the latents
         given at `around`: a curve whose step raises its distance keeps the previous latent. A fresh Jacobian every
-        `jacobian_every` steps (default JACOBIAN_EVERY).
+        JACOBIAN_EVERY steps (read at each call, so a measurement can set it).
         """
         assert self.knots is not None, "refinement needs a B-spline head"
-        every = jacobian_every or JACOBIAN_EVERY
         z = np.array(latents, np.float64)
         count, dim = z.shape
         decoded = _float64(self.decode_model_splines(z))
@@ -105,7 +102,7 @@ class Fitting:
         damping = np.full(count, 1e-2)
         jac = np.zeros(0)
         for step in range(steps if count else 0):
-            if step % every == 0:
+            if step % JACOBIAN_EVERY == 0:
                 shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
                 moved = self.decode_model_splines(shifted)[1].astype(np.float64)
                 jac = (moved.reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP

@@ -6,7 +6,7 @@ settings or the loaded model (curves per request, points per curve, latent size,
 row length) are checked in `service.deps`, with the same error format, and stated in the
 published schema by `service.openapi.state_bounds`.
 
-Length (~520 lines): every request and response body in one place, as the OpenAPI page groups
+Length (~570 lines): every request and response body in one place, as the OpenAPI page groups
 them; the field docs are most of it.
 """
 
@@ -104,8 +104,8 @@ RefineSteps = Annotated[
             "0.04%, at about 8× the compute of a plain reconstruction (3 steps: 4×; docs/RESULTS.md). "
             "Needs a model with a B-spline head; a request's work, steps × (input points + 300 per curve), is "
             "limited by the server (GET /model: limits.max_refine_work). In /encode, the returned means are the "
-            "refined latents; in "
-            "/interpolate the refined latents are mixed, so the ends of a sweep are the refined reconstructions "
+            "refined latents; in /interpolate the refined latents are mixed, so the ends of a sweep are the refined "
+            "reconstructions "
             "(60 pairs of paper curves, the second of each spaced by arc length, 10 steps: the first end 0.026% from "
             "its input instead of 0.17%; the curves between the ends 15% rougher, as often crossing themselves)."
         ),

@@ -77,15 +77,18 @@ async def encode(
     return await _encode(request, req, check_curves(req.curves, settings))
 
 
+def _taken(req: s.EncodeRequest | s.ReconstructRequest | s.InterpolateRequest) -> dict[str, Any]:
+    """How a request's curves are brought to the model: the runtime's frame, spacing, pose and refine options."""
+    return {"frame": req.frame, "spacing": req.spacing, "pose": req.pose, "refine": req.refine}
+
+
 @npy_route("/encode", s.EncodeRequest)
 async def _encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray]) -> Response:
     runtime = runtime_of(request)
     check_refine(req.refine, curves, settings_of(request))
 
     def work() -> Response:
-        mean, log_var, frames = runtime.encode(
-            curves, frame=req.frame, spacing=req.spacing, pose=req.pose, refine=req.refine
-        )
+        mean, log_var, frames = runtime.encode(curves, **_taken(req))
         # float64 as the JSON always carried: orjson would write float32 at float32's shorter precision
         return JSON(
             {"mean": mean.astype(np.float64), "log_var": log_var.astype(np.float64), "frames": frames_json(frames)}
@@ -181,15 +184,7 @@ async def _reconstruct(request: Request, req: s.ReconstructRequest, curves: list
     splines = splines_wanted(req.output, runtime)
 
     def work() -> Response:
-        out, mse = runtime.reconstruct(
-            curves,
-            frame=req.frame,
-            n_points=req.n_points,
-            spacing=req.spacing,
-            splines=splines,
-            pose=req.pose,
-            refine=req.refine,
-        )
+        out, mse = runtime.reconstruct(curves, n_points=req.n_points, splines=splines, **_taken(req))
         body = with_metrics({"curves": [np.ascontiguousarray(c) for c in out], "mse": mse}, out, req.metrics)
         return JSON(with_output(body, splines, req.output))
 
@@ -248,16 +243,7 @@ async def _interpolate(request: Request, req: s.InterpolateRequest, curves: list
     splines = splines_wanted(req.output, runtime)
 
     def work() -> Response:
-        out, frames = runtime.interpolate(
-            curves,
-            weights,
-            frame=req.frame,
-            n_points=req.n_points,
-            spacing=req.spacing,
-            splines=splines,
-            pose=req.pose,
-            refine=req.refine,
-        )
+        out, frames = runtime.interpolate(curves, weights, n_points=req.n_points, splines=splines, **_taken(req))
         body = {"weights": weights, "curves": np.ascontiguousarray(out), "frames": frames_json(frames)}
         return JSON(with_output(with_metrics(body, out, req.metrics), splines, req.output))
 

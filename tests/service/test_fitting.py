@@ -14,14 +14,20 @@ from curve_vae.service.app import create_app
 from curve_vae.service.inputs import InputError
 from curve_vae.service.schemas import MAX_REFINE_STEPS
 from curve_vae.service.settings import Settings
+from curve_vae.training.suite import relative_rmse
 
 from .conftest import bspline_curves
 
 
-def _relative_rmse(inputs: list[np.ndarray], outputs: list[np.ndarray]) -> np.ndarray:
-    return np.array(
-        [np.sqrt(((a - b) ** 2).sum(-1).mean()) / np.hypot(*np.ptp(a, axis=0)) for a, b in zip(inputs, outputs)]
-    )
+def _naca_loop(thickness: float = 0.12) -> np.ndarray:
+    """A closed-trailing-edge NACA 00xx section listed as closed coordinate files list it: from the trailing edge over
+    the upper surface to the leading edge and back under the lower one, the first point repeated at the end."""
+    theta = np.linspace(0, 2 * np.pi, 81)
+    x = (1 + np.cos(theta)) / 2
+    half = 5 * thickness * (0.2969 * np.sqrt(x) - 0.126 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
+    loop = np.stack([x, np.where(theta <= np.pi, half, -half)], 1)
+    loop[-1] = loop[0]
+    return loop
 
 
 def _in_a_user_frame(curves: np.ndarray) -> list[np.ndarray]:
@@ -39,7 +45,7 @@ def test_refining_brings_the_shipped_models_reconstructions_much_closer(shipped_
         splines: list = []
         fitted, fitted_mse = shipped_runtime.reconstruct(curves, refine=6, splines=splines)
         assert (fitted_mse <= plain_mse * (1 + 1e-9)).all(), name
-        before, after = _relative_rmse(curves, plain).mean(), _relative_rmse(curves, fitted).mean()
+        before, after = relative_rmse(curves, plain).mean(), relative_rmse(curves, fitted).mean()
         assert after < before / 2, (name, before, after)
         for c, s in zip(fitted, splines):  # the returned points lie on the returned spline, at its params
             np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), c, atol=1e-9 * np.abs(c).max())
@@ -52,7 +58,7 @@ def test_a_refined_curve_does_not_depend_on_how_its_points_are_spaced(shipped_ru
     arc = [resample(c, 161) for c in curves]
     for name, cs in {"parameter": curves, "arc": arc}.items():
         out, _ = shipped_runtime.reconstruct(cs, refine=10)
-        err = _relative_rmse(cs, out).mean()
+        err = relative_rmse(cs, out).mean()
         assert err < 0.0015, (name, err)
 
 
@@ -143,13 +149,7 @@ def test_refining_beyond_float64_is_an_input_error(runtime, curves, magnitude):
 
 @pytest.mark.parametrize("refine", [0, 3])
 def test_a_closed_curve_comes_back_closed(shipped_runtime, refine):
-    # NACA 0012 with a closed trailing edge, listed as closed coordinate files list it: from the trailing edge over
-    # the upper surface to the leading edge and back under the lower one, the first point repeated at the end
-    theta = np.linspace(0, 2 * np.pi, 81)
-    x = (1 + np.cos(theta)) / 2
-    half = 0.6 * (0.2969 * np.sqrt(x) - 0.126 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
-    loop = np.stack([x, np.where(theta <= np.pi, half, -half)], 1)
-    loop[-1] = loop[0]
+    loop = _naca_loop()
     splines: list = []
     out, _ = shipped_runtime.reconstruct([loop, loop[:-5]], refine=refine, splines=splines)
     np.testing.assert_array_equal(out[0][0], out[0][-1])
@@ -206,14 +206,7 @@ def test_a_request_asking_for_too_much_fitting_work_is_refused_before_any(make_c
 
 
 def test_closed_curves_interpolate_into_closed_curves_whose_ends_are_their_reconstructions(shipped_runtime):
-    theta = np.linspace(0, 2 * np.pi, 81)
-    x = (1 + np.cos(theta)) / 2
-    loops = []
-    for thickness in (0.6, 1.0):
-        half = thickness * (0.2969 * np.sqrt(x) - 0.126 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
-        loop = np.stack([x, np.where(theta <= np.pi, half, -half)], 1)
-        loop[-1] = loop[0]
-        loops.append(loop)
+    loops = [_naca_loop(0.12), _naca_loop(0.2)]
     for refine in (0, 3):
         sweep, _ = shipped_runtime.interpolate(loops, np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]]), refine=refine)
         ends, _ = shipped_runtime.reconstruct(loops, refine=refine)
