@@ -15,6 +15,7 @@ from curve_vae.geometry.bspline import (
     evaluate_bspline,
     fit_bspline,
     fit_bspline_auto,
+    params_at_arc_fractions,
     random_control_points,
     sample_bspline,
     spline_head,
@@ -32,6 +33,7 @@ from curve_vae.geometry.frame import (
 )
 from curve_vae.geometry.mesh import Mesh, revolve
 from curve_vae.geometry.metrics import (
+    closest_squared_distances,
     curve_length,
     mse_per_curve,
     self_intersects,
@@ -51,12 +53,14 @@ __all__ = [
     "blend_frames",
     "clamped_uniform_knots",
     "closest_params",
+    "closest_squared_distances",
     "curve_length",
     "evaluate_bspline",
     "fit_bspline",
     "fit_bspline_auto",
     "fit_frame",
     "mse_per_curve",
+    "params_at_arc_fractions",
     "polyline_to_caller",
     "pose_frames",
     "posed_frame",

@@ -87,18 +87,26 @@ def evaluate_bspline(control_points: np.ndarray, params: np.ndarray, degree: int
 
 
 def arc_length_params(control_points: np.ndarray, n_points: int, *, degree: int = 3, dense: int = 4096) -> np.ndarray:
-    """n_points parameters in [0, 1] of a clamped uniform B-spline (n_ctrl, 2), evenly spaced in its arc length.
+    """n_points parameters in [0, 1] of a clamped uniform B-spline (n_ctrl, 2), evenly spaced in its arc length."""
+    return params_at_arc_fractions(control_points, np.linspace(0.0, 1.0, n_points), degree=degree, dense=dense)
+
+
+def params_at_arc_fractions(
+    control_points: np.ndarray, fractions: np.ndarray, *, degree: int = 3, dense: int = 4096
+) -> np.ndarray:
+    """The parameters (n,) of a clamped uniform B-spline (n_ctrl, 2) at `fractions` (n,) of its arc length.
 
     The length is that of the spline sampled at `dense` parameters; the parameters in between are
-    interpolated linearly, which places points within ~1e-6 of the curve's length of even spacing.
+    interpolated linearly, which places points within ~1e-6 of the curve's length of where they belong.
     """
+    at = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
     u = np.linspace(0.0, 1.0, dense)
     pts = sample_bspline(control_points, dense, degree)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-    if not s[-1] > 0:
-        return np.linspace(0.0, 1.0, n_points)  # a spline collapsed to a point: any spacing is even
+    if not s[-1] > 1e-9 * (1.0 + np.abs(pts).max()):
+        return at  # a spline collapsed to a point (up to rounding): any spacing is even
     keep = np.concatenate([[True], np.diff(s) > 0])
-    return np.interp(np.linspace(0.0, s[-1], n_points), s[keep], u[keep])
+    return np.interp(at * s[-1], s[keep], u[keep])
 
 
 def closest_params(

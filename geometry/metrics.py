@@ -15,6 +15,16 @@ def mse_per_curve(target: np.ndarray, pred: np.ndarray) -> np.ndarray:
     return np.mean(d * d, axis=(-2, -1))
 
 
+def closest_squared_distances(points: np.ndarray, curve: np.ndarray) -> np.ndarray:
+    """Each of `points` (n, 2)'s squared distance to its closest point on the polyline `curve` (m, 2), the first and
+    last points to the curve's first and last points (a reconstruction's ends are the input's): (n,). What a model
+    trained with match "closest" is trained on, and how the service picks its pose for one."""
+    pts, line = np.asarray(points, np.float64), np.asarray(curve, np.float64)
+    d = shapely.distance(shapely.points(pts[1:-1]), shapely.linestrings(line)) ** 2
+    ends = ((pts[[0, -1]] - line[[0, -1]]) ** 2).sum(-1)
+    return np.concatenate([ends[:1], d, ends[1:]])
+
+
 def turning_angles(curves: np.ndarray) -> np.ndarray:
     """Angle (radians) between consecutive unit tangents t_i = (p_{i+1}-p_i)/|·| (paper eq. 8).
 

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.interpolate import BSpline
 from scipy.optimize import isotonic_regression
 
-from curve_vae.geometry import closest_params
+from curve_vae.geometry import arc_fractions, closest_params, params_at_arc_fractions
 from curve_vae.service.inputs import InputError
 
 if TYPE_CHECKING:
@@ -91,12 +91,13 @@ class Fitting:
         z = np.array(latents, np.float64)
         count, dim = z.shape
         decoded = _float64(self.decode_model_splines(z))
-        # the start: each curve's closest points, or its positions as given where those are closer (pooling points
-        # into order can cost more than it gains), so that the fit is never further than the plain reconstruction
+        # the start: each curve's closest points searched near its positions as given and near the same fractions of
+        # the spline's length as of the target's, or those guesses themselves where closer (pooling points into
+        # order can cost more than it gains), so that the fit is never further than the plain reconstruction
         feet, cost = [], np.empty(count)
         for i, (c, t, a) in enumerate(zip(decoded[1], targets, around)):
-            closest = self._feet(c, t, a)
-            starts = [(self._cost(c, t, closest), closest), (self._cost(c, t, a), np.asarray(a, np.float64))]
+            guesses = [np.asarray(a, np.float64), *_along(c, t)]
+            starts = [(self._cost(c, t, u), u) for g in guesses for u in (self._feet(c, t, g), g)]
             cost[i], u = min(starts, key=lambda start: start[0])
             feet.append(u)
         damping = np.full(count, 1e-2)
@@ -157,6 +158,16 @@ class Fitting:
 
     def _cost(self, ctrl: np.ndarray, target: np.ndarray, u: np.ndarray) -> float:
         return float(((target - self._basis(u) @ np.asarray(ctrl, np.float64)) ** 2).sum())
+
+
+def _along(ctrl: np.ndarray, target: np.ndarray) -> list[np.ndarray]:
+    """A second first guess of where the target's points sit on the spline: at the same fractions of its length as
+    along the target (a guess whatever the target's spacing, for a spline of the target's shape); none for a target
+    whose points all coincide."""
+    try:
+        return [params_at_arc_fractions(ctrl, arc_fractions(target), dense=1024)]
+    except ValueError:
+        return []
 
 
 def _float64(decoded: tuple[np.ndarray | None, ...]) -> tuple[np.ndarray | None, ...]:

@@ -39,11 +39,13 @@ from curve_vae.geometry import (
     BeyondFloat32,
     Frame,
     blend_frames,
+    closest_squared_distances,
     curve_length,
     fit_frame,
     mse_per_curve,
     polyline_to_caller,
     pose_frames,
+    sample_bspline,
     self_intersects,
     smoothness,
     spline_to_caller,
@@ -62,6 +64,9 @@ PoseMode = Literal["auto", "as_is"]
 #: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
 POSE_CHORD_COUNT = 3
+#: Samples of a decoded spline its pose candidates are measured against, for a model trained on closest points
+#: (twice the model's points, as training measures it: training.model.DENSE).
+MATCH_SAMPLES = 321
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
 
 
@@ -124,16 +129,20 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         spacing: Spacing = "parameter",
         pose: PoseMode = "auto",
         refine: int = 0,
+        *,
+        placed: bool = True,
     ) -> Prepared:
         """Bring caller curves (each (n_i, 2), n_i ≥ 4) to the model's frame and point count.
 
         pose "auto" (frame "auto" only): each curve is tried in the poses of `geometry.pose_frames` — so a
         curve, its reversal, mirror image and rotations all get the same candidates — encoded and decoded in
         each, and the pose whose reconstruction is closest to the input is kept, with its latent.
-        refine > 0: that many fitting steps on each kept latent (`_refined`).
+        refine > 0: that many fitting steps on each kept latent (`_refined`). A model trained on closest points
+        (`closest_match`) has each input point matched to its closest point on its reconstruction even without
+        steps, unless `placed` is False (encoding only).
         """
         prep = self._prepare(curves, frame, spacing, pose)
-        return self._refined(prep, refine) if refine > 0 else prep
+        return self._refined(prep, refine) if refine > 0 or (placed and self.closest_match) else prep
 
     def _prepare(self, curves: Sequence[np.ndarray], frame: FrameMode, spacing: Spacing, pose: PoseMode) -> Prepared:
         posing = frame == "auto" and pose == "auto"
@@ -163,7 +172,11 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
             _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
             decoded, ctrl, params = self.decode_model_splines(mean)
-            err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
+            if self.closest_match:  # trained on closest points: measured so (assert: such a model has a spline head)
+                dense = [sample_bspline(c, MATCH_SAMPLES, self.spline_degree) for c in ctrl.astype(np.float64)]
+                err = np.array([closest_squared_distances(b, d).sum() for b, d in zip(batch, dense)])
+            else:
+                err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
         k = len(batch) // max(len(inputs), 1)  # every curve has the same number of candidates, in a row
         best = list(np.arange(len(inputs)) * k + err.reshape(len(inputs), k).argmin(axis=1))
         return Prepared(
@@ -249,7 +262,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
     ) -> tuple[np.ndarray, np.ndarray, list[Frame | None]]:
         """Latent mean and log-variance of each curve, and the frame (with its pose) each was mapped from; with
         `refine`, the means are the fitted latents (see `prepare`)."""
-        prep = self.prepare(curves, frame, spacing, pose, refine)
+        prep = self.prepare(curves, frame, spacing, pose, refine, placed=False)
         mean, log_var = self._encoded(prep)
         return mean, log_var, prep.frames
 

@@ -37,6 +37,10 @@ class ModelConfig:
     # spline, such as arc length; off: point i sits at i/(n_points-1). Zero weights in that channel give the
     # even parameters exactly, so a model without it continues with the channel added (checkpoint.widen).
     spline_params: bool = False
+    # Trained with match "closest" (TrainConfig.match): each point was measured to its closest point on the decoded
+    # spline, so the spline's shape is the model's answer and not where its even parameters fall; the service then
+    # places each input point at its closest point on it. No weights of its own.
+    spline_match: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "variant", ALIASES.get(self.variant.lower(), self.variant.lower()))
@@ -48,17 +52,20 @@ class ModelConfig:
             raise ValueError(f"spline_ctrl must be 0 (off) or 4 … {self.n_points}, got {self.spline_ctrl}")
         if self.spline_params and not self.spline_ctrl:
             raise ValueError("spline_params needs the B-spline head (spline_ctrl > 0)")
+        if self.spline_match and not self.spline_ctrl:
+            raise ValueError("spline_match needs the B-spline head (spline_ctrl > 0)")
 
     def same_weights(self, other: ModelConfig) -> bool:
-        """Whether the two configs have the same trainable weights (the spline head has none of its own)."""
+        """Whether the two configs have the same trainable weights (the spline head and its match have none)."""
 
         def key(c: ModelConfig) -> tuple[ModelConfig, bool]:  # learned parameters add a channel; the head none
-            return replace(c, spline_ctrl=0, spline_params=False), c.spline_params
+            return replace(c, spline_ctrl=0, spline_params=False, spline_match=False), c.spline_params
 
         return key(self) == key(other)
 
 
 SCHEDULES = ("onecycle", "cosine", "constant", "plateau")
+MATCHES = ("index", "closest", "twin")
 
 
 @dataclass(frozen=True)
@@ -81,6 +88,11 @@ class TrainConfig:
     time_budget: float = 0.0  # seconds of training: the schedule follows elapsed time, not steps (0: off)
     snapshots: int = 0  # keep the weights of the latest N epochs as epoch-NNNN.pt, for curve-vae average
     only_params: bool = False  # train only the head's parameter channel (VAE.learn_only_params)
+    # index: eq. 4, point i to point i; closest: each point to its closest point (spacing-free); twin: eq. 4 against
+    # the curve's twin, the same curve evenly in its own parameter (data twins): whatever the input's spacing, the
+    # decoder's even parameters fall where the curve's own do
+    match: str = "index"
+    only_encoder: bool = False  # train only the encoder; decoder, BatchNorm statistics frozen (VAE.learn_only_encoder)
 
     def __post_init__(self) -> None:
         if self.schedule not in SCHEDULES:
@@ -89,5 +101,9 @@ class TrainConfig:
             raise ValueError("a time budget needs a onecycle, cosine or constant schedule, not plateau")
         if self.snapshots < 0:
             raise ValueError(f"snapshots must be ≥ 0, got {self.snapshots}")
+        if self.match not in MATCHES:
+            raise ValueError(f"match must be one of {', '.join(MATCHES)}, got {self.match!r}")
+        if self.only_params and self.only_encoder:
+            raise ValueError("only_params and only_encoder exclude each other: pick one part to train")
         if self.epochs < 1 or self.batch_size < 1 or self.lr <= 0:
             raise ValueError("epochs and batch_size must be ≥ 1 and lr > 0")

@@ -34,6 +34,9 @@ class DataConfig:
     source: str = ""  # mix "files": a curve file, or a directory of .npy/.csv/.json/.dat files
     # mix "broad": the version of its definition (training.families.MIX_VERSION), set by default; 0 otherwise
     mix_version: int = 0
+    # mix "broad": also keep each training and validation curve evenly in its own parameter, in the same pose
+    # (its "twin", training.families.draw_family), for training with match "twin"
+    twins: bool = False
 
     def __post_init__(self) -> None:
         if self.mix not in MIXES:
@@ -44,6 +47,8 @@ class DataConfig:
             object.__setattr__(self, "mix_version", MIX_VERSION)
         elif self.mix != "broad" and self.mix_version:
             raise ValueError('mix_version belongs to mix "broad" only')
+        if self.twins and self.mix != "broad":
+            raise ValueError('twins belong to mix "broad" only: its families know their own parameter')
         if (self.mix == "files") != bool(self.source):
             raise ValueError('a data source (--curves PATH) goes with mix "files", and only with it')
 
@@ -99,6 +104,8 @@ class CurveDataset:
     val: np.ndarray
     test: np.ndarray
     test_ctrl: np.ndarray  # control points of the test curves, for B-spline comparisons
+    train_twins: np.ndarray | None = None  # with config.twins: each training curve evenly in its own parameter
+    val_twins: np.ndarray | None = None
 
     @classmethod
     def generate(cls, config: DataConfig, *, workers: int = 1) -> CurveDataset:
@@ -113,7 +120,17 @@ class CurveDataset:
             from curve_vae.training.families import broad_mix
 
             curves, ctrl = paper_test_curves(config)
-            mixed = broad_mix(b, config.seed + 1, n_points=config.n_points, workers=workers, version=config.mix_version)
+            mixed = broad_mix(
+                b,
+                config.seed + 1,
+                n_points=config.n_points,
+                workers=workers,
+                version=config.mix_version,
+                twins=config.twins,
+            )
+            if config.twins:
+                (drawn, even) = mixed
+                return cls(config, drawn[:a], drawn[a:b], curves, ctrl, even[:a], even[a:b])
             return cls(config, mixed[:a], mixed[a:b], curves, ctrl)
         curves, ctrl = _paper_curves(config, config.n_train + config.n_val + config.n_test)
         return cls(config, curves[:a], curves[a:b], curves[b:], ctrl[b:])
@@ -122,7 +139,16 @@ class CurveDataset:
         """Write atomically: a crash never leaves a half-written cache behind."""
         meta = json.dumps({"format_version": FORMAT_VERSION, "config": asdict(self.config)})
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
-            np.savez(f, meta=np.array(meta), train=self.train, val=self.val, test=self.test, test_ctrl=self.test_ctrl)
+            twins = {} if self.train_twins is None else {"train_twins": self.train_twins, "val_twins": self.val_twins}
+            np.savez(
+                f,
+                meta=np.array(meta),
+                train=self.train,
+                val=self.val,
+                test=self.test,
+                test_ctrl=self.test_ctrl,
+                **twins,
+            )
 
     @classmethod
     def load(cls, path: str | Path) -> CurveDataset:
@@ -136,13 +162,17 @@ class CurveDataset:
             cfg = meta["config"]
             cfg["center"] = tuple(cfg["center"])
             cfg.setdefault("mix_version", 1 if cfg.get("mix") == "broad" else 0)  # written before versions
-            return cls(DataConfig(**cfg), z["train"], z["val"], z["test"], z["test_ctrl"])
+            twins = (z["train_twins"], z["val_twins"]) if "train_twins" in z else (None, None)
+            return cls(DataConfig(**cfg), z["train"], z["val"], z["test"], z["test_ctrl"], *twins)
 
 
 def default_cache(config: DataConfig) -> Path:
     """Where a configuration's data set is cached by default: one file per configuration (data/curves-<digest>.npz),
     so that a cache is never regenerated over, whatever the parameters asked for."""
-    digest = hashlib.sha256(json.dumps(asdict(config), sort_keys=True).encode()).hexdigest()[:10]
+    described = asdict(config)
+    if not config.twins:
+        del described["twins"]  # the caches of data sets without twins keep the names they had before twins
+    digest = hashlib.sha256(json.dumps(described, sort_keys=True).encode()).hexdigest()[:10]
     return Path("data") / f"curves-{digest}.npz"
 
 

@@ -70,6 +70,9 @@ def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
         else f"curve point i is the clamped uniform cubic B-spline at u = i/{cfg.n_points - 1}",
         "output": "control_points",
         **({"learned_params": True} if cfg.spline_params else {}),
+        # trained on each point's distance to its closest point on the spline: a consumer places each input
+        # point at its closest point on the decoded spline, not at the parameters above
+        **({"match": "closest"} if cfg.spline_match else {}),
     }
 
 

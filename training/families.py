@@ -218,15 +218,21 @@ def respace(dense: np.ndarray, n_points: int, spacings: list[str], rng: np.rando
     return out
 
 
-def to_pose(curves: np.ndarray, rng: np.random.Generator, model_size: float) -> np.ndarray:
+def to_pose(
+    curves: np.ndarray, rng: np.random.Generator, model_size: float, *, also: np.ndarray | None = None
+) -> np.ndarray:
     """Each curve mirrored to turn counter-clockwise, its chord turned to a random direction between −135° and
     −45° (where the service's pose candidates put it), then shifted and scaled so its bounding box is centred
-    in the model plane with its larger side `model_size` — exactly as the service maps a posted curve."""
+    in the model plane with its larger side `model_size` — exactly as the service maps a posted curve. `also`
+    (same shape): other samples of the same curves, moved in place by each curve's move."""
     out = np.empty_like(curves, dtype=np.float64)
     for i, c in enumerate(np.asarray(curves, np.float64)):
         mirror = signed_turning(c) < 0
         turn = rng.uniform(-0.75 * np.pi, -0.25 * np.pi) - chord_heading(c * [-1.0, 1.0] if mirror else c)
-        out[i] = posed_frame(c, turn, mirror=mirror).to_model(c, model_size)
+        frame = posed_frame(c, turn, mirror=mirror)
+        out[i] = frame.to_model(c, model_size)
+        if also is not None:
+            also[i] = frame.to_model(np.asarray(also[i], np.float64), model_size)
     return out
 
 
@@ -239,19 +245,26 @@ def draw_family(
     model_size: float | None = MODEL_SIZE,
     spacings: tuple[str, ...] = SPACINGS,
     chunk: int = 1024,
+    twins: bool = False,
 ) -> np.ndarray:
     """`count` curves (count, n_points, 2) float32 of one family without self-intersections, each at a spacing
-    drawn from `spacings`; in the model's pose and frame, or as drawn for model_size None."""
-    out, have = [], 0
+    drawn from `spacings`; in the model's pose and frame, or as drawn for model_size None. twins: (2, count,
+    n_points, 2), the curves and the same curves evenly in their own parameter, in the same pose ("twins")."""
+    out, pairs, have = [], [], 0
     while have < count:
         dense = family(rng, chunk)
         ok = ~self_intersects(dense[:, ::4])  # 161 of the dense points: the model's resolution
         dense = dense[ok & np.isfinite(dense).all(axis=(1, 2))]
         pts = respace(dense, n_points, list(rng.choice(spacings, len(dense))), rng)
+        even = respace(dense, n_points, ["parameter"] * len(dense), rng) if twins else None
         if model_size is not None:
-            pts = to_pose(pts, rng, model_size)
+            pts = to_pose(pts, rng, model_size, also=even)
         out.append(pts.astype(np.float32))
+        if even is not None:
+            pairs.append(even.astype(np.float32))
         have += len(pts)
+    if twins:
+        return np.stack([np.concatenate(out)[:count], np.concatenate(pairs)[:count]])
     return np.concatenate(out)[:count]
 
 
@@ -286,10 +299,10 @@ def own_curves(
     return tuple(to_pose(s, rng, model_size).astype(np.float32) for s in (drawn, val, test))  # type: ignore[return-value]
 
 
-def _mix_chunk(args: tuple[int, int, int, int, float, int]) -> np.ndarray:
+def _mix_chunk(args: tuple[int, int, int, int, float, int, bool]) -> np.ndarray:
     """Chunk `index` of the broad mix of `version`: `count` curves in its shares, drawn with its own seed
-    (seed, index)."""
-    seed, index, count, n_points, model_size, version = args
+    (seed, index); with twins (2, count, n_points, 2), each curve and its twin (`draw_family`)."""
+    seed, index, count, n_points, model_size, version, twins = args
     spec = MIXES[version]
     rng = np.random.default_rng([seed, index])
     sizes = {name: int(count * share) for name, share in spec.shares.items()}
@@ -298,13 +311,24 @@ def _mix_chunk(args: tuple[int, int, int, int, float, int]) -> np.ndarray:
     for name, k in sizes.items():
         if name == "paper":
             raw = int(round(k * spec.paper_raw))
-            parts.append(draw_family(paper, raw, rng, n_points=n_points, model_size=None, spacings=("parameter",)))
+            drawn = draw_family(paper, raw, rng, n_points=n_points, model_size=None, spacings=("parameter",))
+            parts.append(np.stack([drawn, drawn]) if twins else drawn)  # evenly in their parameter: their own twins
             parts.append(
-                draw_family(paper, k - raw, rng, n_points=n_points, model_size=model_size, spacings=spec.paper_spacings)
+                draw_family(
+                    paper,
+                    k - raw,
+                    rng,
+                    n_points=n_points,
+                    model_size=model_size,
+                    spacings=spec.paper_spacings,
+                    twins=twins,
+                )
             )
         else:
-            parts.append(draw_family(TRAIN_FAMILIES[name], k, rng, n_points=n_points, model_size=model_size))
-    return np.concatenate(parts)
+            parts.append(
+                draw_family(TRAIN_FAMILIES[name], k, rng, n_points=n_points, model_size=model_size, twins=twins)
+            )
+    return np.concatenate(parts, axis=1 if twins else 0)
 
 
 def broad_mix(
@@ -315,15 +339,17 @@ def broad_mix(
     model_size: float = MODEL_SIZE,
     workers: int = 1,
     version: int = MIX_VERSION,
+    twins: bool = False,
 ) -> np.ndarray:
     """`count` curves of the training mix of `version` (MIXES: its shares, shuffled), seeded. Part of the
     paper's share keeps its own pose, frame and parameter spacing (paper_raw), so the model stays as good on
     the paper's curves. Drawn in CHUNK-curve chunks by `workers` processes; the result does not depend on
-    `workers`."""
+    `workers`. twins: (2, count, n_points, 2), the curves and their twins (`draw_family`), in the same order; the
+    curves are not those drawn without twins (the twins are drawn too)."""
     if version not in MIXES:
         raise ValueError(f"the broad mix of version {version} is no longer made (made: {sorted(MIXES)})")
     jobs = [
-        (seed, i, min(CHUNK, count - start), n_points, model_size, version)
+        (seed, i, min(CHUNK, count - start), n_points, model_size, version, twins)
         for i, start in enumerate(range(0, count, CHUNK))
     ]
     if workers > 1 and len(jobs) > 1:
@@ -335,5 +361,8 @@ def broad_mix(
             chunks = list(pool.map(_mix_chunk, jobs))
     else:
         chunks = [_mix_chunk(job) for job in jobs]
+    if twins:
+        pairs = np.concatenate(chunks, axis=1)[:, :count] if chunks else np.empty((2, 0, n_points, 2), np.float32)
+        return pairs[:, np.random.default_rng(seed).permutation(pairs.shape[1])]
     curves = np.concatenate(chunks)[:count] if chunks else np.empty((0, n_points, 2), np.float32)
     return curves[np.random.default_rng(seed).permutation(len(curves))]

@@ -40,3 +40,46 @@ def vae_loss(
     kl = kl_divergence(mean.float(), log_var.float())
     lap = torch.mean(torch.abs(laplacian(target) - laplacian(pred)))
     return {"loss": mse + beta * kl + lap_weight * lap, "mse": mse, "kl": kl, "lap": lap}
+
+
+def squared_distance_to_polyline(points: torch.Tensor, line: torch.Tensor) -> torch.Tensor:
+    """(B, P, 2) points, (B, L, 2) polyline → (B, P): each point's squared distance to the polyline, measured to the
+    two segments on either side of its nearest vertex (the foot clamped to the segment). The nearest vertex is
+    searched without gradient (a distance matrix); the distance to the segments carries it."""
+    n_seg = line.shape[1] - 1
+    with torch.no_grad():
+        nearest = torch.cdist(points, line).argmin(dim=-1)  # (B, P)
+    seg = torch.stack([nearest - 1, nearest], dim=-1).clamp(0, n_seg - 1).flatten(1)  # (B, 2P)
+    index = seg.unsqueeze(-1).expand(-1, -1, 2)
+    a = torch.gather(line, 1, index).view(*points.shape[:2], 2, 2)  # (B, P, 2 segments, 2)
+    d = torch.gather(line, 1, index + 1).view(*points.shape[:2], 2, 2) - a
+    p = points.unsqueeze(2)
+    t = ((p - a) * d).sum(-1) / (d.square().sum(-1) + 1e-12)
+    foot = a + t.clamp(0.0, 1.0).unsqueeze(-1) * d
+    return (foot - p).square().sum(-1).amin(dim=-1)
+
+
+def closest_point_terms(target: torch.Tensor, curve: torch.Tensor) -> dict[str, torch.Tensor]:
+    """How far a decoded curve is from the target's points, whatever their spacing along it. `curve` (B, M, 2) is the
+    decoded spline sampled densely from its start to its end; target (B, N, 2).
+
+    mse: each target point's squared distance to its closest point on the curve (the two end points to the curve's
+    ends, which the service pins there), as eq. 4 averages it (over points and both coordinates); back: the same from
+    the curve's samples to the target's polyline, which keeps the curve from straying where no point is."""
+    target, curve = target.float(), curve.float()
+    inner = squared_distance_to_polyline(target[:, 1:-1], curve)
+    ends = torch.stack([(target[:, 0] - curve[:, 0]).square().sum(-1), (target[:, -1] - curve[:, -1]).square().sum(-1)])
+    mse = (inner.sum(1) + ends.sum(0)).mean() / (2 * target.shape[1])
+    back = squared_distance_to_polyline(curve, target).mean() / 2
+    return {"mse": mse, "back": back}
+
+
+def closest_loss(
+    target: torch.Tensor, curve: torch.Tensor, mean: torch.Tensor, log_var: torch.Tensor, *, beta: float = 1e-3
+) -> dict[str, torch.Tensor]:
+    """The objective of match "closest": `closest_point_terms` both ways + β·KL; `curve` the dense decoding. Its
+    "mse" is the one-way distance the service returns (each point to its closest point on the curve)."""
+    terms = closest_point_terms(target, curve)
+    kl = kl_divergence(mean.float(), log_var.float())
+    lap = torch.zeros((), device=kl.device)  # the spline head is smooth; a Laplacian of unmatched points means nothing
+    return {"loss": terms["mse"] + terms["back"] + beta * kl, **terms, "kl": kl, "lap": lap}

@@ -207,6 +207,9 @@ class Decoder(nn.Module):
             knots = torch.tensor(clamped_uniform_knots(cfg.spline_ctrl, 3), dtype=torch.float32)
             self.register_buffer("knots", knots, persistent=False)
             self.register_buffer("closed", last_span_mask(knots), persistent=False)
+            # the spline at twice the points' density, for losses that measure the whole curve (match "closest")
+            fine = spline_head(cfg.spline_ctrl, DENSE * (cfg.n_points - 1) + 1)[0]
+            self.register_buffer("dense_basis", torch.tensor(fine, dtype=torch.float32), persistent=False)
 
     def forward(self, z: torch.Tensor, *, full: bool | None = None) -> torch.Tensor:
         """Decode to curves (B, N, 2); full runs every layer over its whole length (default: in training only)."""
@@ -270,6 +273,10 @@ def bspline_basis(u: torch.Tensor, knots: torch.Tensor, closed: torch.Tensor, de
     return b
 
 
+#: Samples of the decoded spline per point interval in a dense decoding (VAE.forward(dense=True)).
+DENSE = 2
+
+
 class VAE(nn.Module):
     """Encoder + decoder. forward samples z = μ + σ·ε in training and decodes μ in eval."""
 
@@ -296,6 +303,15 @@ class VAE(nn.Module):
             p.register_hook(lambda g, mask=mask: g * mask)  # the x and y rows stay as they are
         return [last.weight, last.bias]
 
+    def learn_only_encoder(self) -> list[nn.Parameter]:
+        """Freeze the decoder and every BatchNorm statistic; train the encoder's weights alone. The decoded curves
+        of any latent stay the starting model's (so do /sample's and /decode's answers): only which latent a curve
+        is given changes. Returns the parameters left to train."""
+        self.frozen_body = True
+        for p in self.decoder.parameters():
+            p.requires_grad_(False)
+        return [p for p in self.encoder.parameters() if p.requires_grad]
+
     def train(self, mode: bool = True) -> VAE:
         super().train(mode)
         if getattr(self, "frozen_body", False):
@@ -304,12 +320,19 @@ class VAE(nn.Module):
                     m.eval()  # frozen statistics: the shapes must not drift
         return self
 
-    def forward(self, curves: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    def forward(self, curves: torch.Tensor, *, dense: bool = False) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Decoded curves (B, N, 2), latent mean and log-variance; dense: the decoded splines sampled from start to end
+        at DENSE times the points' density instead (B, DENSE·(N-1)+1, 2), shapes whatever the spacing (spline head)."""
         mean, log_var = self.encoder(curves)
         z = mean
         if self.training:
             z = mean + torch.randn_like(mean) * torch.exp(0.5 * log_var)  # paper eq. 1
-        return self.decoder(z), mean, log_var
+        if not dense:
+            return self.decoder(z), mean, log_var
+        if not self.cfg.spline_ctrl:
+            raise ValueError("a dense decoding needs the B-spline head (spline_ctrl)")
+        _, ctrl = self.decoder.decode(z)
+        return torch.matmul(self.decoder.dense_basis, ctrl), mean, log_var
 
 
 def count_parameters(model: nn.Module) -> int:

@@ -39,7 +39,7 @@ from curve_vae.training.checkpoint import (
 )
 from curve_vae.training.config import SCHEDULES, ModelConfig, TrainConfig
 from curve_vae.training.data import DataConfig, load_or_generate
-from curve_vae.training.losses import vae_loss
+from curve_vae.training.losses import closest_loss, closest_point_terms, vae_loss
 from curve_vae.training.model import VAE
 
 __all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch"]
@@ -117,12 +117,13 @@ def train_one_epoch(
     bar: tqdm | None = None,
     clock: Clock | None = None,
 ) -> dict[str, float]:
-    """One pass over `data[order]` in batches; returns the mean of each loss term.
+    """One pass over `data[order]` in batches; returns the mean of each loss term. Match "twin": data (n, 2, N, 2),
+    each curve and its twin, the target of its reconstruction.
 
     With a clock on a time budget, the pass ends early once the budget is spent (on every
     DDP process at the same step: rank 0's clock decides).
     """
-    model.train()
+    model.train(not cfg.only_encoder)  # encoder alone: decode the mean, as the service does; no sampling noise
     sums: dict[str, torch.Tensor] = {}  # summed on the device: no host sync per step
     n_batches = 0
     per_step = cfg.batch_size // max(1, dist.get_world_size() if dist.is_initialized() else 1)
@@ -130,9 +131,7 @@ def train_one_epoch(
         if clock is not None and clock.budget > 0 and _agree(clock.over()):
             break
         x = data[order[i : i + per_step]].to(device, non_blocking=True)
-        with autocast(device, cfg.bf16):
-            pred, mean, log_var = model(x)
-        terms = vae_loss(x, pred, mean, log_var, beta=cfg.beta, lap_weight=cfg.lap_weight)
+        terms = _batch_terms(model, x, cfg, device)
         opt.zero_grad(set_to_none=True)
         terms["loss"].backward()
         if cfg.grad_clip > 0:
@@ -148,6 +147,19 @@ def train_one_epoch(
             if n_batches % 10 == 0:
                 bar.set_postfix({k: f"{float(sums[k]) / n_batches:.4g}" for k in ("loss", "mse", "kl", "lap")})
     return {**{k: float(v) / max(1, n_batches) for k, v in sums.items()}, "steps": n_batches}
+
+
+def _batch_terms(model: nn.Module, x: torch.Tensor, cfg: TrainConfig, device: torch.device) -> dict[str, torch.Tensor]:
+    """The loss terms of one batch under cfg.match."""
+    if cfg.match == "twin":  # the curve in, its twin (evenly in its own parameter) the target, point by point
+        with autocast(device, cfg.bf16):
+            pred, mean, log_var = model(x[:, 0])
+        return vae_loss(x[:, 1], pred, mean, log_var, beta=cfg.beta, lap_weight=cfg.lap_weight)
+    with autocast(device, cfg.bf16):
+        pred, mean, log_var = model(x, dense=cfg.match == "closest")
+    if cfg.match == "closest":
+        return closest_loss(x, pred, mean, log_var, beta=cfg.beta)
+    return vae_loss(x, pred, mean, log_var, beta=cfg.beta, lap_weight=cfg.lap_weight)
 
 
 def _agree(flag: bool) -> bool:
@@ -175,6 +187,22 @@ def validation_mse(model: nn.Module, curves: np.ndarray | torch.Tensor, *, devic
     """Paper eq. 4 averaged over `curves`, reconstructing from the latent mean (model selection's number)."""
     target = curves.numpy() if isinstance(curves, torch.Tensor) else np.asarray(curves)
     return float(mse_per_curve(target, reconstruct(model, target, device=device)).mean())
+
+
+@torch.no_grad()
+def validation_closest(
+    model: nn.Module, curves: np.ndarray | torch.Tensor, *, batch: int = 250, device: torch.device | None = None
+) -> float:
+    """Match "closest"'s model-selection number: each point's squared distance to its closest point on the spline
+    decoded from the curve's latent mean, averaged as eq. 4 (`closest_point_terms`' mse)."""
+    device = device or next(model.parameters()).device
+    model.eval()
+    x = torch.as_tensor(curves, dtype=torch.float32)
+    total = 0.0
+    for i in range(0, len(x), batch):
+        part = x[i : i + batch].to(device)
+        total += float(closest_point_terms(part, model(part, dense=True)[0])["mse"]) * len(part)
+    return total / max(1, len(x))
 
 
 def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch: int, clock: Clock):
@@ -256,6 +284,10 @@ def _load_splits(
             ds = load_or_generate(data_cfg, cache)
     assert ds is not None
     train_np = ds.train[: cfg.train_limit] if cfg.train_limit else ds.train
+    if cfg.match == "twin":  # each curve with its twin: (n, 2, N, 2)
+        if ds.train_twins is None:
+            raise ValueError('match "twin" needs a data set with twins (mix "broad", DataConfig.twins)')
+        train_np = np.stack([train_np, ds.train_twins[: len(train_np)]], axis=1)
     return torch.from_numpy(np.ascontiguousarray(train_np)), torch.from_numpy(np.ascontiguousarray(ds.val))
 
 
@@ -273,7 +305,14 @@ class _Parts:
 
 def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_per_epoch: int) -> _Parts:
     model = VAE(model_cfg).to(proc.device)
-    opt = torch.optim.Adam(model.learn_only_params() if cfg.only_params else model.parameters(), lr=cfg.lr)
+    trained = (
+        model.learn_only_params()
+        if cfg.only_params
+        else model.learn_only_encoder()
+        if cfg.only_encoder
+        else model.parameters()
+    )
+    opt = torch.optim.Adam(trained, lr=cfg.lr)
     clock = Clock(cfg.time_budget, 0.0)
     return _Parts(model, opt, _make_schedule(opt, cfg, steps_per_epoch, clock), clock, np.random.default_rng(cfg.seed))
 
@@ -359,7 +398,8 @@ def _budget_bar(cfg: TrainConfig, state: RunState, shown: bool) -> tqdm | None:
 
 def _validate(proc: _Process, parts: _Parts, val: torch.Tensor, cfg: TrainConfig) -> float:
     """The validation MSE, rank 0's on every process, so that all stop together; a plateau schedule steps on it."""
-    val_mse = validation_mse(parts.model, val, device=proc.device)
+    measure = validation_mse if cfg.match == "index" else validation_closest
+    val_mse = measure(parts.model, val, device=proc.device)
     if proc.distributed:
         v = torch.tensor([val_mse], dtype=torch.float64)
         dist.broadcast(v, 0)
@@ -489,6 +529,8 @@ def train(
     fresh optimiser and schedule: fine-tuning, or continuing the shipped model on a new machine.
     """
     run_dir = Path(run_dir)
+    if cfg.match != "index" and not model_cfg.spline_ctrl:
+        raise ValueError(f"match {cfg.match!r} measures the decoded spline: it needs the B-spline head (--spline-ctrl)")
     proc = _start_process(cfg)
     try:
         torch.manual_seed(cfg.seed)

@@ -68,6 +68,11 @@ def add_train_options(p: argparse.ArgumentParser) -> None:
         "afterwards with curve-vae average (0: off)",
         "only_params": "with --spline-params: train only where the points sit along the curves (the head's "
         "parameter channel); every other weight and BatchNorm statistic stays the starting model's",
+        "match": "what the reconstruction error measures: index (eq. 4, point i to point i) or closest (each "
+        "point to its closest point on the decoded spline and back, whatever the points' spacing; needs the "
+        "B-spline head; validation and model selection measure it too)",
+        "only_encoder": "train only the encoder: the decoder's weights and every BatchNorm statistic stay the "
+        "starting model's, so every latent decodes as before and only which latent a curve gets changes",
     }
     for f in fields(TrainConfig):
         flag = "--" + f.name.replace("_", "-")
@@ -102,6 +107,7 @@ def cmd_train(a: argparse.Namespace) -> int:
         latent_dim=a.latent_dim,
         spline_ctrl=started.spline_ctrl if a.spline_ctrl is None else a.spline_ctrl,
         spline_params=started.spline_params if a.spline_params is None else a.spline_params,
+        spline_match=a.match in ("closest", "twin"),  # shapes, not where the even parameters fall: placed closest
     )
     cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
     run_dir = Path(a.run_dir)

@@ -8,12 +8,14 @@ from curve_vae.geometry import (
     blend_frames,
     clamped_uniform_knots,
     closest_params,
+    closest_squared_distances,
     curve_length,
     evaluate_bspline,
     fit_bspline,
     fit_bspline_auto,
     fit_frame,
     mse_per_curve,
+    params_at_arc_fractions,
     random_control_points,
     resample,
     sample_bspline,
@@ -161,6 +163,32 @@ def test_arc_length_params_space_points_evenly():
     step = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     assert u[0] == 0 and u[-1] == 1 and np.all(np.diff(u) > 0)
     assert step.max() / step.min() < 1.01  # chords of a fine sampling: even up to curvature
+
+
+def test_params_at_arc_fractions_reach_those_fractions_of_the_length():
+    ctrl = random_control_points(np.random.default_rng(6), 1)[0]
+    fractions = np.array([0.0, 0.1, 0.25, 0.5, 0.9, 1.0])
+    u = params_at_arc_fractions(ctrl, fractions)
+    dense = np.linspace(0, 1, 20001)
+    pts = evaluate_bspline(ctrl, dense)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    np.testing.assert_allclose(np.interp(u, dense, s) / s[-1], fractions, atol=1e-5)
+    np.testing.assert_array_equal(arc_length_params(ctrl, 7), params_at_arc_fractions(ctrl, np.linspace(0, 1, 7)))
+    # a spline collapsed to a point: the fractions themselves
+    np.testing.assert_array_equal(params_at_arc_fractions(np.ones((6, 2)), fractions), fractions)
+
+
+def test_closest_squared_distances_measure_to_the_polyline_with_the_ends_pinned():
+    line = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
+    points = np.array([[1.0, 1.0], [5.0, -2.0], [12.0, 5.0], [10.5, 10.0], [9.0, 9.0]])
+    # inner points to their nearest segment; the first and last to the line's first and last vertex
+    want = [1.0**2 + 1.0**2, 2.0**2, 2.0**2, 0.5**2, 1.0**2 + 1.0**2]
+    np.testing.assert_allclose(closest_squared_distances(points, line), want)
+    # the same points in any spacing along a curve are at distance 0 (up to the polyline's chords)
+    ctrl = random_control_points(np.random.default_rng(7), 1)[0]
+    fine = evaluate_bspline(ctrl, np.linspace(0, 1, 4001))
+    anywhere = evaluate_bspline(ctrl, np.sort(np.r_[0.0, np.random.default_rng(8).uniform(0, 1, 50), 1.0]))
+    assert closest_squared_distances(anywhere, fine).max() < 1e-6
 
 
 def test_fit_bspline_auto_takes_the_fewest_control_points():

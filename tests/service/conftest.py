@@ -7,6 +7,7 @@ model that actually reconstructs use `shipped_runtime` (models/).
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import socket
@@ -51,6 +52,17 @@ def params_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return _copy(FIXTURES / "untrained-params31", tmp_path_factory.mktemp("params_model"))
 
 
+@pytest.fixture(scope="session")
+def closest_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The untrained B-spline VAE marked as trained on closest points (its manifest's spline "match"), as
+    `curve-vae train --match closest` exports one: the service places the input's points at their closest points."""
+    out = _copy(FIXTURES / "untrained-spline31", tmp_path_factory.mktemp("closest_model"))
+    manifest = json.loads((out / "manifest.json").read_text())
+    manifest["spline"]["match"] = "closest"
+    (out / "manifest.json").write_text(json.dumps(manifest, indent=2))
+    return out
+
+
 def _copy(src: Path, out: Path) -> Path:
     """A copy a test may change without changing the committed files."""
     shutil.copytree(src, out, dirs_exist_ok=True)
@@ -70,6 +82,11 @@ def raw_runtime(raw_model_dir: Path) -> CurveRuntime:
 @pytest.fixture(scope="session")
 def params_runtime(params_model_dir: Path) -> CurveRuntime:
     return CurveRuntime.load(params_model_dir, providers="cpu", intra_op_threads=1)
+
+
+@pytest.fixture(scope="session")
+def closest_runtime(closest_model_dir: Path) -> CurveRuntime:
+    return CurveRuntime.load(closest_model_dir, providers="cpu", intra_op_threads=1)
 
 
 @pytest.fixture(scope="session")

@@ -126,3 +126,18 @@ def test_the_test_split_of_a_broad_mix_is_read_without_drawing_its_training_curv
     cfg = DataConfig(n_train=10_000_000, n_val=20, n_test=10, mix="broad")  # far too many to draw in this test
     np.testing.assert_array_equal(load_test_split(cfg, tmp_path / "never.npz"), generate_curves(70_030, 0)[0][-10:])
     assert not (tmp_path / "never.npz").exists()
+
+
+def test_a_broad_data_set_with_twins_keeps_them_through_its_cache(tmp_path):
+    cfg = DataConfig(n_train=300, n_val=40, n_test=10, mix="broad", twins=True)
+    ds = load_or_generate(cfg, tmp_path / "t.npz", say=False)
+    assert ds.train_twins.shape == ds.train.shape and ds.val_twins.shape == ds.val.shape
+    back = CurveDataset.load(tmp_path / "t.npz")
+    np.testing.assert_array_equal(back.train_twins, ds.train_twins)
+    np.testing.assert_array_equal(back.val_twins, ds.val_twins)
+    assert back.config == cfg
+    # caches without twins keep the names they had before twins existed
+    assert default_cache(DataConfig(mix="broad", mix_version=3)).name == "curves-797c386517.npz"
+    assert default_cache(cfg) != default_cache(DataConfig(n_train=300, n_val=40, n_test=10, mix="broad"))
+    with pytest.raises(ValueError, match="twins belong to mix"):
+        DataConfig(twins=True)

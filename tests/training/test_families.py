@@ -108,3 +108,20 @@ def test_own_curves_name_the_bad_file_and_line(tmp_path):
         F.own_curves(str(tmp_path), 10, seed=0)
     with pytest.raises(ValueError, match="no such file"):
         F.own_curves(str(tmp_path / "missing"), 10, seed=0)
+
+
+def test_twins_are_the_same_curves_evenly_in_their_own_parameter_in_the_same_pose():
+    from curve_vae.geometry import closest_squared_distances
+
+    drawn, even = F.broad_mix(600, 8, twins=True)
+    assert drawn.shape == even.shape == (600, 161, 2)
+    for c, t in zip(drawn.astype(np.float64), even.astype(np.float64)):
+        diag = np.hypot(*np.ptp(c, axis=0))
+        # the same curve: the points of one on the other's polyline, up to the chords of the sparser of the two
+        # (a drawn spacing may leave a stretch sparse, its chords cutting a bend), in the same pose and size
+        off = min(np.sqrt(closest_squared_distances(t, c)).mean(), np.sqrt(closest_squared_distances(c, t)).mean())
+        assert off < 2e-4 * diag
+        np.testing.assert_allclose(t[[0, -1]], c[[0, -1]], atol=1e-4)
+    respaced = ~np.all(drawn == even, axis=(1, 2))
+    assert 0.3 < respaced.mean() < 0.9  # the rest were drawn evenly in their parameter: their own twins
+    assert np.array_equal(F.broad_mix(600, 8, twins=True), np.stack([drawn, even]))  # seeded

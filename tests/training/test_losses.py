@@ -2,6 +2,8 @@
 
 import math
 
+import numpy as np
+
 import pytest
 import torch
 
@@ -42,3 +44,37 @@ def test_vae_loss_terms_and_weights():
     # |Lap| of pred's y over points 0..4 = 2 (copied), 2, 4, 2, 2 (copied) → 12 over 20 entries
     assert t["lap"].item() == pytest.approx(12 / 20)
     assert t["loss"].item() == pytest.approx(0.2 + 0.1 * 0.5 + 2.0 * 0.6)
+
+
+def test_distance_to_a_polyline_is_the_foot_points_and_ignores_spacing():
+    import shapely
+
+    from curve_vae.geometry import random_control_points, sample_bspline
+    from curve_vae.training.losses import closest_point_terms, squared_distance_to_polyline
+
+    rng = np.random.default_rng(0)
+    line = torch.tensor(sample_bspline(random_control_points(rng, 3), 321))
+    points = line[:, ::7] + torch.tensor(rng.normal(0, 2.0, (3, 46, 2)))
+    got = squared_distance_to_polyline(points, line).numpy()
+    for p, ln, g in zip(points.numpy(), line.numpy(), got):
+        want = shapely.distance(shapely.points(p), shapely.linestrings(ln)) ** 2
+        np.testing.assert_allclose(g, want, rtol=1e-9, atol=1e-9)
+    # the same curve at another spacing is at distance ~0 both ways; point i to point i it is far
+    ctrl = random_control_points(rng, 2)
+    even = torch.tensor(sample_bspline(ctrl, 161))
+    fine = torch.tensor(sample_bspline(ctrl, 321))
+    uneven = torch.tensor(
+        np.stack(
+            [
+                np.stack([np.interp(np.linspace(0, 1, 161) ** 2, np.linspace(0, 1, 321), f[:, k]) for k in (0, 1)], 1)
+                for f in fine.numpy()
+            ]
+        )
+    )
+    terms = closest_point_terms(uneven, fine)
+    assert float(terms["mse"]) < 1e-3 and float(terms["back"]) < 1e-3
+    assert float((uneven - even).square().mean()) > 10
+    # gradients reach the curve
+    fine.requires_grad_(True)
+    closest_point_terms(uneven + 1.0, fine)["mse"].backward()
+    assert fine.grad.abs().sum() > 0

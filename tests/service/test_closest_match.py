@@ -1,0 +1,79 @@
+"""A model trained on closest points (`curve-vae train --match closest`, the manifest's spline "match"): the service
+returns each input point's closest point on the decoded spline, and picks the pose whose spline passes closest."""
+
+from __future__ import annotations
+
+import numpy as np
+from fastapi.testclient import TestClient
+
+from curve_vae.geometry import closest_squared_distances, evaluate_bspline, pose_frames, resample, sample_bspline
+from curve_vae.geometry.adapt import to_model_plane
+from curve_vae.service.app import create_app
+from curve_vae.service.settings import Settings
+
+from .conftest import bspline_curves
+
+
+def _user_curves() -> list[np.ndarray]:
+    paper = [0.05 * c + [300.0, -20.0] for c in bspline_curves(6, seed=21)]
+    return paper[:3] + [resample(c, 90) for c in paper[3:]]
+
+
+def test_the_manifest_says_how_points_are_placed(closest_runtime, runtime):
+    assert closest_runtime.closest_match and not runtime.closest_match
+
+
+def test_each_returned_point_is_on_the_spline_and_no_further_than_the_models_own_point(closest_runtime, runtime):
+    curves = _user_curves()
+    for pose in ("as_is", "auto"):
+        splines: list = []
+        placed, placed_mse = closest_runtime.reconstruct(curves, pose=pose, splines=splines)
+        for c, s in zip(placed, splines):
+            np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), c, atol=1e-9 * np.abs(c).max())
+            assert s.params[0] == 0.0 and s.params[-1] == 1.0 and np.all(np.diff(s.params) >= 0)
+        if pose == "as_is":  # the same latents and splines: only where the points sit differs
+            own, own_mse = runtime.reconstruct(curves, pose=pose)
+            assert np.all(placed_mse <= own_mse * (1 + 1e-9))
+            assert np.all(placed_mse < 0.99 * own_mse), (placed_mse, own_mse)  # closer points, not the same ones
+
+
+def test_the_pose_kept_is_the_one_whose_spline_passes_closest(closest_runtime):
+    c = _user_curves()[4]
+    prep = closest_runtime.prepare([c], placed=False)
+    costs = []
+    for f in pose_frames(c, chords=3):
+        m, _ = to_model_plane(c, f, model_size=closest_runtime.model_size, n_points=closest_runtime.n_points)
+        mean, _ = closest_runtime.encode_model(m[None].astype(np.float32))
+        ctrl = closest_runtime.decode_model_splines(mean)[1][0].astype(np.float64)
+        costs.append((closest_squared_distances(m, sample_bspline(ctrl, 321)).sum(), f))
+    best = min(costs, key=lambda cost: cost[0])[1]
+    assert prep.frames[0] == best
+
+
+def test_encoding_is_not_changed_by_the_placement(closest_runtime, runtime):
+    curves = _user_curves()
+    mean, log_var, _ = closest_runtime.encode(curves, pose="as_is")
+    want_mean, want_log_var, _ = runtime.encode(curves, pose="as_is")
+    np.testing.assert_array_equal(mean, want_mean)
+    np.testing.assert_array_equal(log_var, want_log_var)
+
+
+def test_an_interpolation_row_of_one_curve_is_its_reconstruction(closest_runtime):
+    a, b = _user_curves()[:2]
+    (ra, rb), _ = closest_runtime.reconstruct([a, b])
+    out, _ = closest_runtime.interpolate([a, b], np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]]))
+    np.testing.assert_allclose(out[0], ra, atol=1e-6 * np.abs(ra).max())
+    np.testing.assert_allclose(out[-1], rb, atol=1e-6 * np.abs(rb).max())
+
+
+def test_over_http_the_reconstruction_is_the_runtimes(closest_model_dir, closest_runtime):
+    c = _user_curves()[3]
+    with TestClient(create_app(Settings(model_dir=closest_model_dir))) as client:
+        r = client.post("/reconstruct", json={"curves": [c.tolist()], "output": "both"})
+        assert r.status_code == 200, r.text
+        body = r.json()
+    splines: list = []
+    (want,), mse = closest_runtime.reconstruct([c], splines=splines)
+    np.testing.assert_allclose(np.array(body["curves"][0]), want, atol=1e-6 * np.abs(want).max())
+    np.testing.assert_allclose(body["splines"][0]["params"], splines[0].params, atol=1e-12)
+    assert body["mse"][0] == mse[0] or abs(body["mse"][0] - mse[0]) <= 1e-9 * mse[0]

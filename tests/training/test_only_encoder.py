@@ -1,0 +1,93 @@
+"""Training the encoder alone: every latent decodes as before; only which latent a curve gets changes."""
+
+import pytest
+import torch
+
+from curve_vae.cli import main
+from curve_vae.training.checkpoint import load_checkpoint
+from curve_vae.training.config import ModelConfig, TrainConfig
+from curve_vae.training.losses import vae_loss
+from curve_vae.training.model import VAE
+from curve_vae.training.train import train_one_epoch
+
+
+def _curves(n: int, seed: int = 0) -> torch.Tensor:
+    g = torch.Generator().manual_seed(seed)
+    t = torch.linspace(0, 1, 161)
+    a = torch.rand(n, 1, 2, generator=g) * 40 + 10
+    return torch.stack([64 + a[..., 0] * torch.cos(3 * t), 64 + a[..., 1] * torch.sin(2 * t)], dim=-1)
+
+
+def test_only_the_encoders_weights_move_and_every_batchnorm_statistic_stays():
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant="cnn1", spline_ctrl=31))
+    trained = model.learn_only_encoder()
+    before = {k: v.clone() for k, v in model.state_dict().items()}
+    opt = torch.optim.Adam(trained, lr=1e-2)
+    cfg = TrainConfig(only_encoder=True, batch_size=16, beta=0.0)
+    train_one_epoch(model, _curves(64), torch.arange(64), opt, None, cfg, torch.device("cpu"))
+    after = model.state_dict()
+    changed = {k for k in before if not torch.equal(before[k], after[k])}
+    assert changed, "the encoder did not learn"
+    assert all(k.startswith("encoder.") for k in changed), sorted(changed)
+    assert not any(k.endswith(("running_mean", "running_var", "num_batches_tracked")) for k in changed)
+
+
+def test_the_encoder_is_trained_on_the_mean_decoded_as_the_service_decodes_it():
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant="cnn1", spline_ctrl=31))
+    model.learn_only_encoder()
+    x = _curves(32, seed=1)
+    with torch.no_grad():
+        pred, mean, log_var = model.eval()(x)
+        want = vae_loss(x, pred, mean, log_var, beta=0.0)["mse"]
+    opt = torch.optim.SGD([p for p in model.parameters() if p.requires_grad], lr=0.0)  # measure, do not move
+    got = train_one_epoch(model, x, torch.arange(32), opt, None, TrainConfig(only_encoder=True, batch_size=32), "cpu")
+    assert got["mse"] == pytest.approx(float(want), rel=1e-5)  # sampling z = μ + σ·ε would not match it
+    # trained as a whole VAE, the same weights decode a sample z = μ + σ·ε instead
+    sampled = train_one_epoch(model, x, torch.arange(32), opt, None, TrainConfig(batch_size=32), "cpu")
+    assert sampled["mse"] != pytest.approx(float(want), rel=1e-5)
+
+
+def test_only_params_and_only_encoder_exclude_each_other():
+    with pytest.raises(ValueError, match="exclude each other"):
+        TrainConfig(only_params=True, only_encoder=True)
+
+
+@pytest.mark.slow
+def test_a_run_with_only_encoder_keeps_the_starting_decoder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    torch.manual_seed(0)
+    cfg = ModelConfig(spline_ctrl=31)
+    start = tmp_path / "start.pt"
+    torch.save({"model_config": cfg.__dict__, "model": VAE(cfg).state_dict()}, start)
+    tiny = ["--n-train", "128", "--n-val", "32", "--n-test", "32", "--epochs", "1", "--batch-size", "64"]
+    assert main(["train", "--run-dir", "enc", "--init-from", str(start), "--only-encoder", *tiny, "--no-progress"]) == 0
+    was, now = torch.load(start)["model"], load_checkpoint(tmp_path / "enc" / "last.pt")["model"]
+    assert all(torch.equal(was[k], now[k]) for k in was if not k.startswith("encoder."))
+    assert any(not torch.equal(was[k], now[k]) for k in was if k.startswith("encoder."))
+
+
+def test_match_twin_reconstructs_each_curve_as_its_twin_and_closest_measures_shapes():
+    from curve_vae.training.losses import closest_point_terms
+
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant="cnn1", spline_ctrl=31)).eval()
+    model.learn_only_encoder()  # decoded from the mean: the terms are exactly those of the model as it is
+    x, twin = _curves(16, seed=2), _curves(16, seed=3)
+    opt = torch.optim.SGD([p for p in model.parameters() if p.requires_grad], lr=0.0)
+    with torch.no_grad():
+        pred, mean, log_var = model(x)
+        want_twin = vae_loss(twin, pred, mean, log_var, beta=0.0)["mse"]
+        dense = model(x, dense=True)[0]
+        want_closest = closest_point_terms(x, dense)["mse"]
+    pairs = torch.stack([x, twin], dim=1)
+    cfg = TrainConfig(match="twin", only_encoder=True, batch_size=16)
+    got = train_one_epoch(model, pairs, torch.arange(16), opt, None, cfg, "cpu")
+    assert got["mse"] == pytest.approx(float(want_twin), rel=1e-5)  # the twin is the target, not the input
+    cfg = TrainConfig(match="closest", only_encoder=True, batch_size=16)
+    got = train_one_epoch(model, x, torch.arange(16), opt, None, cfg, "cpu")
+    assert got["mse"] == pytest.approx(float(want_closest), rel=1e-5)
+    assert dense.shape == (16, 321, 2)
+    with pytest.raises(ValueError, match="match must be one of"):
+        TrainConfig(match="nearest")
