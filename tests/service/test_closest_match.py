@@ -69,6 +69,7 @@ def test_an_interpolation_row_of_one_curve_is_its_reconstruction(closest_runtime
 def test_over_http_the_reconstruction_is_the_runtimes(closest_model_dir, closest_runtime):
     c = _user_curves()[3]
     with TestClient(create_app(Settings(model_dir=closest_model_dir))) as client:
+        assert client.get("/model").json()["spline"]["match"] == "closest"
         r = client.post("/reconstruct", json={"curves": [c.tolist()], "output": "both"})
         assert r.status_code == 200, r.text
         body = r.json()
