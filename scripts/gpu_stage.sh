@@ -7,7 +7,9 @@
 #
 # Settings (environment): BUDGET seconds of training (400), LR peak (3e-4), WARMUP (0.05), NTRAIN curves (2000000),
 # MIX_VERSION (the latest), PARAMS (1: --spline-params, a head that learns its points' parameters; default: INIT's
-# head), DEVICE (cuda), WORKERS drawing the data (16), INIT weights (models/vae.pt), RUN folder
+# head), MATCH (index, closest or twin: what the reconstruction error measures, `curve-vae train --match`; a
+# twin stage — each curve against the same curve evenly in its own parameter — is the next step towards a model that
+# does not care how points are spaced: docs/RESULTS.md), ONLY_ENCODER (1: --only-encoder), DEVICE (cuda), WORKERS drawing the data (16), INIT weights (models/vae.pt), RUN folder
 # (/tmp/r), DATA cache (/tmp/d.npz: a second stage on the same curves reads it), WHEELS (a folder of wheels of
 # what the machine lacks, e.g. pydantic, shapely; installed to /tmp/site without an index), OUT (/tmp/out).
 # OUT receives train.log, log.jsonl, config.json and best.pt without its optimiser state (a third of the size).
@@ -31,6 +33,8 @@ mix_version=()
 if [ -n "${MIX_VERSION:-}" ]; then mix_version=(--mix-version "$MIX_VERSION"); fi
 params=()
 if [ "${PARAMS:-}" = 1 ]; then params=(--spline-params); fi
+params+=(--match "${MATCH:-index}")
+if [ "${ONLY_ENCODER:-}" = 1 ]; then params+=(--only-encoder); fi
 python3 -m curve_vae.cli train --run-dir "$RUN" --init-from "${INIT:-$REPO/models/vae.pt}" --mix broad \
   "${mix_version[@]}" "${params[@]}" --n-train "${NTRAIN:-2000000}" --data "${DATA:-/tmp/d.npz}" --workers "${WORKERS:-16}" \
   --device "${DEVICE:-cuda}" --batch-size 512 --lr "${LR:-3e-4}" --warmup "${WARMUP:-0.05}" --epochs 1000 \

@@ -12,8 +12,7 @@ import torch
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.slow
-def test_a_stage_from_a_checkout_leaves_a_slim_best_checkpoint_and_its_log(tmp_path):
+def _stage(tmp_path: Path, **settings: str) -> tuple[subprocess.CompletedProcess, Path, Path]:
     out, run = tmp_path / "out", tmp_path / "run"
     env = {
         **os.environ,
@@ -22,16 +21,21 @@ def test_a_stage_from_a_checkout_leaves_a_slim_best_checkpoint_and_its_log(tmp_p
         "NTRAIN": "600",
         "WORKERS": "1",
         "BUDGET": "2",
-        "MIX_VERSION": "2",
-        "PARAMS": "1",
         "OUT": str(out),
         "RUN": str(run),
         "DATA": str(tmp_path / "d.npz"),
+        **settings,
     }
     env.pop("PYTHONPATH", None)
     done = subprocess.run(
         ["bash", str(ROOT / "scripts" / "gpu_stage.sh")], env=env, cwd=tmp_path, capture_output=True, text=True
     )
+    return done, out, run
+
+
+@pytest.mark.slow
+def test_a_stage_from_a_checkout_leaves_a_slim_best_checkpoint_and_its_log(tmp_path):
+    done, out, run = _stage(tmp_path, MIX_VERSION="2", PARAMS="1")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "initialised from" in done.stdout and "stage done" in done.stdout
     config = json.loads((out / "config.json").read_text())
@@ -43,3 +47,15 @@ def test_a_stage_from_a_checkout_leaves_a_slim_best_checkpoint_and_its_log(tmp_p
     assert "optimizer" not in slim and "model" in slim
     assert (out / "best.pt").stat().st_size < (run / "best.pt").stat().st_size
     assert not (ROOT / "d.npz").exists() and (tmp_path / "d.npz").exists()
+
+
+@pytest.mark.slow
+def test_a_twin_stage_of_the_encoder_alone_draws_twins_and_marks_the_model(tmp_path):
+    done, out, _ = _stage(tmp_path, MATCH="twin", ONLY_ENCODER="1")
+    assert done.returncode == 0, done.stdout + done.stderr
+    config = json.loads((out / "config.json").read_text())
+    assert config["data"]["twins"] is True and config["train"]["match"] == "twin" and config["train"]["only_encoder"]
+    assert config["model"]["spline_match"] is True  # the service places its points at their closest points
+    slim = torch.load(out / "best.pt", map_location="cpu", weights_only=False)
+    shipped = torch.load(ROOT / "models" / "vae.pt", map_location="cpu", weights_only=False)["model"]
+    assert all(torch.equal(slim["model"][k], v) for k, v in shipped.items() if k.startswith("decoder."))
