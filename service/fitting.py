@@ -46,6 +46,7 @@ class Fitting:
     spline_degree: int
     has_splines: bool
     has_params: bool
+    closest_match: bool
     model_size: float
     n_points: int
     decode_model_splines: Any
@@ -66,8 +67,9 @@ class Fitting:
             params = prep.params if prep.params is not None else self.decode_model_splines(mean)[2]
             own = np.linspace(0.0, 1.0, self.n_points)
             around = [np.interp(a, own, p) for a, p in zip(around, params)]
+        known = (prep.decoded, prep.ctrl, prep.params) if prep.ctrl is not None else None  # pose "auto" decoded them
         with np.errstate(all="ignore"):
-            z, (out, ctrl, params), feet = self.refine_latents(mean, targets, around, steps)
+            z, (out, ctrl, params), feet = self.refine_latents(mean, targets, around, steps, decoded=known)
         return dataclasses.replace(
             prep, mean=z.astype(np.float32), log_var=log_var, decoded=out, ctrl=ctrl, params=params, feet=feet
         )
@@ -78,6 +80,8 @@ class Fitting:
         targets: Sequence[np.ndarray],
         around: Sequence[np.ndarray],
         steps: int,
+        *,
+        decoded: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None,
     ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray | None], list[np.ndarray]]:
         """`steps` damped Gauss–Newton steps on each latent (B, latent_dim) towards its curve `targets[i]` (n_i, 2),
         model plane, whose points start matched to spline parameters `around[i]` (n_i,).
@@ -85,18 +89,22 @@ class Fitting:
         Returns the refined latents (float64), their decoding (curves, control points, learned parameters or None)
         and each target point's parameter on its refined spline. Never further from the targets than the latents
         given at `around`: a curve whose step raises its distance keeps the previous latent. A fresh Jacobian every
-        JACOBIAN_EVERY steps (read at each call, so a measurement can set it).
+        JACOBIAN_EVERY steps (read at each call, so a measurement can set it). `decoded`: the latents' decoding
+        when the caller has it already.
         """
         assert self.knots is not None, "refinement needs a B-spline head"
         z = np.array(latents, np.float64)
         count, dim = z.shape
-        decoded = _float64(self.decode_model_splines(z))
+        decoded = _float64(decoded if decoded is not None else self.decode_model_splines(z))
         # the start: each curve's closest points searched near its positions as given and near the same fractions of
         # the spline's length as of the target's, or those guesses themselves where closer (pooling points into
         # order can cost more than it gains), so that the fit is never further than the plain reconstruction
         feet, cost = [], np.empty(count)
         for i, (c, t, a) in enumerate(zip(decoded[1], targets, around)):
-            guesses = [np.asarray(a, np.float64), *_along(c, t)]
+            # a model trained on closest points decodes shapes, not where its even parameters fall: the guess along
+            # the spline's length alone
+            guesses = [*_along(c, t)] if self.closest_match else [np.asarray(a, np.float64), *_along(c, t)]
+            guesses = guesses or [np.asarray(a, np.float64)]
             starts = [(self._cost(c, t, u), u) for g in guesses for u in (self._feet(c, t, g), g)]
             cost[i], u = min(starts, key=lambda start: start[0])
             feet.append(u)

@@ -45,7 +45,6 @@ from curve_vae.geometry import (
     mse_per_curve,
     polyline_to_caller,
     pose_frames,
-    sample_bspline,
     self_intersects,
     smoothness,
     spline_to_caller,
@@ -64,9 +63,6 @@ PoseMode = Literal["auto", "as_is"]
 #: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
 POSE_CHORD_COUNT = 3
-#: Samples of a decoded spline its pose candidates are measured against, for a model trained on closest points
-#: (twice the model's points, as training measures it: training.model.DENSE).
-MATCH_SAMPLES = 321
 _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
 
 
@@ -172,9 +168,8 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
             _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
             decoded, ctrl, params = self.decode_model_splines(mean)
-            if self.closest_match:  # trained on closest points: measured so (assert: such a model has a spline head)
-                dense = [sample_bspline(c, MATCH_SAMPLES, self.spline_degree) for c in ctrl.astype(np.float64)]
-                err = np.array([closest_squared_distances(b, d).sum() for b, d in zip(batch, dense)])
+            if self.closest_match:  # trained on closest points: measured so, to the decoded spline's polyline
+                err = np.array([closest_squared_distances(b, d).sum() for b, d in zip(batch, decoded)])
             else:
                 err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
         k = len(batch) // max(len(inputs), 1)  # every curve has the same number of candidates, in a row

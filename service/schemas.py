@@ -553,7 +553,7 @@ class ModelInfo(BaseModel):
         None,
         description='The decoder\'s B-spline head (n_ctrl, degree, knots), when it has one: output "bspline" works. '
         "learned_params: whether the head places its points at parameters of its own (the spacing of the curve it "
-        "decodes) rather than evenly in the spline parameter. match: \"closest\" for a model trained on each point's "
+        'decodes) rather than evenly in the spline parameter. match: "closest" for a model trained on each point\'s '
         "distance to its closest point on the spline — a reconstruction's points are then the closest points on "
         "its spline to the input's, whatever their spacing; \"index\": point i of the model's own spacing.",
     )
