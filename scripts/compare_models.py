@@ -6,9 +6,10 @@ Each model runs the whole suite (training/suite.py: the paper's test curves as d
 moved; the trained families; the held-out ones; real airfoils) through `CurveRuntime.reconstruct` with the default
 request (frame and pose "auto", spacing "parameter", no refine), one intra-op thread. Rows: each set's mean relative
 RMSE per model, the arc-length ÷ parameter ratio, and the wall time of the whole suite relative to the first model,
-measured in one run (ratios only: this machine is noisy). `--placement index` also runs each model with its points
-at the decoder's own parameters, whatever its manifest says (what a model trained on closest points gains from
-being placed so).
+measured in one run (ratios only: this machine is noisy). `--placement` runs each model as its manifest says
+("manifest"), or with its points at the decoder's own parameters ("index") or at their closest points on the
+decoded spline, poses picked so too ("closest"), whatever its manifest says: what the placement alone gives, apart
+from what training on closest points gives.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("model_dirs", nargs="+", help="exported model directories (the first is the reference)")
     p.add_argument("--count", type=int, default=100, help="curves per suite set")
-    p.add_argument("--placement", choices=["manifest", "index"], nargs="+", default=["manifest"])
+    p.add_argument("--placement", choices=["manifest", "index", "closest"], nargs="+", default=["manifest"])
     p.add_argument("--out", default=None, help="also write the table as JSON here")
     a = p.parse_args()
     sets = suite_sets(paper_test_split(), count=a.count)
@@ -34,9 +35,9 @@ def main() -> None:
     for model_dir in a.model_dirs:
         for placement in a.placement:
             runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
-            if placement == "index":
-                runtime.closest_match = False
-            label = f"{runtime.manifest['version']} ({model_dir}{', index' if placement == 'index' else ''})"
+            if placement != "manifest":
+                runtime.closest_match = placement == "closest"
+            label = f"{runtime.manifest['version']} ({model_dir}{'' if placement == 'manifest' else ', ' + placement})"
             start = time.perf_counter()
             report = run_suite(runtime, sets)
             columns[label] = {"seconds": time.perf_counter() - start, "sets": report}
