@@ -36,7 +36,7 @@ def main() -> None:
         for placement in a.placement:
             runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
             if placement != "manifest":
-                runtime.closest_match = placement == "closest"
+                runtime.closest_placement = placement == "closest"
             label = f"{runtime.manifest['version']} ({model_dir}{'' if placement == 'manifest' else ', ' + placement})"
             start = time.perf_counter()
             report = run_suite(runtime, sets)

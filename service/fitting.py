@@ -46,7 +46,6 @@ class Fitting:
     spline_degree: int
     has_splines: bool
     has_params: bool
-    closest_match: bool
     model_size: float
     n_points: int
     decode_model_splines: Any
@@ -101,10 +100,7 @@ class Fitting:
         # order can cost more than it gains), so that the fit is never further than the plain reconstruction
         feet, cost = [], np.empty(count)
         for i, (c, t, a) in enumerate(zip(decoded[1], targets, around)):
-            # a model trained on closest points decodes shapes, not where its even parameters fall: the guess along
-            # the spline's length alone
-            guesses = [*_along(c, t)] if self.closest_match else [np.asarray(a, np.float64), *_along(c, t)]
-            guesses = guesses or [np.asarray(a, np.float64)]
+            guesses = [np.asarray(a, np.float64), *_along(c, t)]
             starts = [(self._cost(c, t, u), u) for g in guesses for u in (self._feet(c, t, g), g)]
             cost[i], u = min(starts, key=lambda start: start[0])
             feet.append(u)

@@ -49,8 +49,9 @@ class ModelGraphs:
         self.spline_degree = int(spline["degree"]) if spline else 0
         self.knots = clamped_uniform_knots(int(spline["n_ctrl"]), self.spline_degree) if spline else None
         self.learned_params = bool(spline and spline.get("learned_params"))
-        # trained on closest points (training's match "closest"): input points are placed at their closest points
-        self.closest_match = bool(spline and spline.get("match") == "closest")
+        # how a reconstruction's points are placed (training.export.PLACEMENTS): at the input points' closest points on
+        # the decoded spline, or at the head's parameters (manifests written before placements: index)
+        self.closest_placement = bool(spline and spline.get("placement") == "closest")
         # Where the data lives in the model plane (paper §3.1: a radius-64 disc in the 128×128 plane): the region a
         # valid sample must stay in.
         self.disc_center = np.asarray(manifest["frame"].get("center", list(MODEL_CENTER)), np.float64)

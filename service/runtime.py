@@ -133,12 +133,12 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         pose "auto" (frame "auto" only): each curve is tried in the poses of `geometry.pose_frames` — so a
         curve, its reversal, mirror image and rotations all get the same candidates — encoded and decoded in
         each, and the pose whose reconstruction is closest to the input is kept, with its latent.
-        refine > 0: that many fitting steps on each kept latent (`_refined`). A model trained on closest points
-        (`closest_match`) has each input point matched to its closest point on its reconstruction even without
-        steps, unless `placed` is False (encoding only).
+        refine > 0: that many fitting steps on each kept latent (`_refined`). A model placed "closest" (its
+        manifest's spline.placement, `closest_placement`) has each input point matched to its closest point on its
+        reconstruction even without steps, unless `placed` is False (encoding only).
         """
         prep = self._prepare(curves, frame, spacing, pose)
-        return self._refined(prep, refine) if refine > 0 or (placed and self.closest_match) else prep
+        return self._refined(prep, refine) if refine > 0 or (placed and self.closest_placement) else prep
 
     def _prepare(self, curves: Sequence[np.ndarray], frame: FrameMode, spacing: Spacing, pose: PoseMode) -> Prepared:
         posing = frame == "auto" and pose == "auto"
@@ -168,7 +168,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
             _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
             decoded, ctrl, params = self.decode_model_splines(mean)
-            if self.closest_match:  # trained on closest points: measured so, to the decoded spline's polyline
+            if self.closest_placement:  # the points go to their closest points: measured so, to the decoded polyline
                 err = np.array([closest_squared_distances(b, d).sum() for b, d in zip(batch, decoded)])
             else:
                 err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))

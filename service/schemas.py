@@ -553,9 +553,9 @@ class ModelInfo(BaseModel):
         None,
         description='The decoder\'s B-spline head (n_ctrl, degree, knots), when it has one: output "bspline" works. '
         "learned_params: whether the head places its points at parameters of its own (the spacing of the curve it "
-        'decodes) rather than evenly in the spline parameter. match: "closest" for a model trained on each point\'s '
-        "distance to its closest point on the spline — a reconstruction's points are then the closest points on "
-        "its spline to the input's, whatever their spacing; \"index\": point i of the model's own spacing.",
+        "decodes) rather than evenly in the spline parameter. placement: how a reconstruction's points are placed on "
+        "its spline: \"closest\", each at the closest point to the input's point, whatever the input's spacing (the "
+        "shipped model's); \"index\", at the model's own spacing, point i at the head's parameter i.",
     )
     files: dict[str, FileInfo] = Field(description="sha256 and size of each exported file, from the manifest.")
     providers: list[str] = Field(description="onnxruntime execution providers the sessions actually run on.")

@@ -37,10 +37,6 @@ class ModelConfig:
     # spline, such as arc length; off: point i sits at i/(n_points-1). Zero weights in that channel give the
     # even parameters exactly, so a model without it continues with the channel added (checkpoint.widen).
     spline_params: bool = False
-    # Trained with match "closest" (TrainConfig.match): each point was measured to its closest point on the decoded
-    # spline, so the spline's shape is the model's answer and not where its even parameters fall; the service then
-    # places each input point at its closest point on it. No weights of its own.
-    spline_match: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "variant", ALIASES.get(self.variant.lower(), self.variant.lower()))
@@ -52,14 +48,12 @@ class ModelConfig:
             raise ValueError(f"spline_ctrl must be 0 (off) or 4 … {self.n_points}, got {self.spline_ctrl}")
         if self.spline_params and not self.spline_ctrl:
             raise ValueError("spline_params needs the B-spline head (spline_ctrl > 0)")
-        if self.spline_match and not self.spline_ctrl:
-            raise ValueError("spline_match needs the B-spline head (spline_ctrl > 0)")
 
     def same_weights(self, other: ModelConfig) -> bool:
-        """Whether the two configs have the same trainable weights (the spline head and its match have none)."""
+        """Whether the two configs have the same trainable weights (the spline head has none of its own)."""
 
         def key(c: ModelConfig) -> tuple[ModelConfig, bool]:  # learned parameters add a channel; the head none
-            return replace(c, spline_ctrl=0, spline_params=False, spline_match=False), c.spline_params
+            return replace(c, spline_ctrl=0, spline_params=False), c.spline_params
 
         return key(self) == key(other)
 

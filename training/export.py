@@ -56,8 +56,15 @@ class _DecoderGraph(nn.Module):
         return curves if ctrl is None else (curves, ctrl) if params is None else (curves, ctrl, params)
 
 
-def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
-    """How the decoder's control points make its curves, for consumers of the graph."""
+#: How a consumer places a reconstruction's points (the manifest's spline.placement): "closest", each input point at its
+#: closest point on the decoded spline (the service's default for a model with a B-spline head: never further from
+#: the input than "index"), or "index", point i at the head's parameter i.
+PLACEMENTS = ("closest", "index")
+
+
+def spline_manifest(cfg: ModelConfig, placement: str = "closest") -> dict[str, Any] | None:
+    """How the decoder's control points make its curves, for consumers of the graph, and how to place a
+    reconstruction's points on them (`PLACEMENTS`)."""
     if not cfg.spline_ctrl:
         return None
     return {
@@ -70,9 +77,7 @@ def spline_manifest(cfg: ModelConfig) -> dict[str, Any] | None:
         else f"curve point i is the clamped uniform cubic B-spline at u = i/{cfg.n_points - 1}",
         "output": "control_points",
         **({"learned_params": True} if cfg.spline_params else {}),
-        # trained on each point's distance to its closest point on the spline: a consumer places each input
-        # point at its closest point on the decoded spline, not at the parameters above
-        **({"match": "closest"} if cfg.spline_match else {}),
+        "placement": placement,
     }
 
 
@@ -180,12 +185,15 @@ def export(
     weights: bool = True,
     prior: LatentPrior | None = None,
     prior_info: dict[str, Any] | None = None,
+    placement: str = "closest",
 ) -> dict[str, Any]:
     """Write encoder.onnx, decoder.onnx, (vae.pt, prior.npz) and manifest.json into out_dir; return the manifest.
 
     prior: the learned latent distribution (training/prior.py) the service samples from; prior_info
-    says how it was fitted.
+    says how it was fitted. placement: how the service places a reconstruction's points (`PLACEMENTS`).
     """
+    if placement not in PLACEMENTS:
+        raise ValueError(f"placement must be one of {', '.join(PLACEMENTS)}, got {placement!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     model = model.float().cpu().eval()
@@ -207,7 +215,7 @@ def export(
         "latent_dim": cfg.latent_dim,
         "files": {f: {"sha256": file_sha256(out / f), "bytes": (out / f).stat().st_size} for f in files},
         "graphs": _graphs_manifest(cfg),
-        **({"spline": spline_manifest(cfg)} if cfg.spline_ctrl else {}),
+        **({"spline": spline_manifest(cfg, placement)} if cfg.spline_ctrl else {}),
         **({"prior": _prior_manifest(prior, prior_info)} if prior is not None else {}),
         "frame": _frame_manifest(cfg, model_size),
         "model_config": asdict(cfg),
@@ -230,6 +238,7 @@ def export_checkpoint(
     version: str,
     data_cache: str | Path | None = None,
     spline_ctrl: int | None = None,
+    placement: str = "closest",
     training_info: str | Path | None = None,
     prior_components: int = 8,
     say: Any = print,
@@ -239,6 +248,7 @@ def export_checkpoint(
 
     data_cache: the data set cache of the checkpoint's configuration (default: its default cache file).
     spline_ctrl: the B-spline head to export with in place of the checkpoint's (it has no weights).
+    placement: how the service places a reconstruction's points (`PLACEMENTS`; a head's manifest records it).
     training_info: a JSON file merged into the manifest's training section (wall time, hardware, stages).
     """
     from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
@@ -274,6 +284,7 @@ def export_checkpoint(
         extra={"training": _training_record(ckpt, training_info)},
         prior=prior,
         prior_info=prior_info,
+        placement=placement,
     )
     return manifest, data_cfg, test
 

@@ -35,6 +35,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         version=a.version,
         data_cache=a.data,
         spline_ctrl=a.spline_ctrl,
+        placement=a.placement,
         training_info=a.training_info or None,
         prior_components=a.prior_components if a.prior else 0,
     )
@@ -170,6 +171,14 @@ def _add_export(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="export with this B-spline output head (control points, 0: none) in place of the checkpoint's; "
         "the head has no weights, so any checkpoint takes any head (default: the checkpoint's)",
+    )
+    s.add_argument(
+        "--placement",
+        choices=("closest", "index"),
+        default="closest",
+        help="with a B-spline head, how the service places a reconstruction's points, recorded in the manifest: "
+        "closest (each input point at its closest point on the decoded spline: never further from the input) or "
+        "index (point i at the head's parameter i, as models before 0.10.1 were served) (default: closest)",
     )
     s.add_argument(
         "--evaluate",

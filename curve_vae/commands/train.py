@@ -107,7 +107,6 @@ def cmd_train(a: argparse.Namespace) -> int:
         latent_dim=a.latent_dim,
         spline_ctrl=started.spline_ctrl if a.spline_ctrl is None else a.spline_ctrl,
         spline_params=started.spline_params if a.spline_params is None else a.spline_params,
-        spline_match=a.match in ("closest", "twin"),  # shapes, not where the even parameters fall: placed closest
     )
     cfg = TrainConfig(**{f.name: getattr(a, f.name) for f in fields(TrainConfig)})
     run_dir = Path(a.run_dir)

@@ -67,7 +67,7 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
         ),
         "spline": (
             {"n_ctrl": m["spline"]["n_ctrl"], "degree": m["spline"]["degree"], "knots": m["spline"]["knots"]}
-            | {"learned_params": runtime.has_params, "match": "closest" if runtime.closest_match else "index"}
+            | {"learned_params": runtime.has_params, "placement": "closest" if runtime.closest_placement else "index"}
             if m.get("spline")
             else None
         ),

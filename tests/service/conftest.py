@@ -54,11 +54,11 @@ def params_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="session")
 def closest_model_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The untrained B-spline VAE marked as trained on closest points (its manifest's spline "match"), as
-    `curve-vae train --match closest` exports one: the service places the input's points at their closest points."""
+    """The untrained B-spline VAE placed "closest" (its manifest's spline.placement, as `curve-vae export` writes
+    it by default): the service places the input's points at their closest points on the reconstruction."""
     out = _copy(FIXTURES / "untrained-spline31", tmp_path_factory.mktemp("closest_model"))
     manifest = json.loads((out / "manifest.json").read_text())
-    manifest["spline"]["match"] = "closest"
+    manifest["spline"]["placement"] = "closest"
     (out / "manifest.json").write_text(json.dumps(manifest, indent=2))
     return out
 

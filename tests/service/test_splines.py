@@ -58,7 +58,7 @@ def test_returned_splines_evaluate_back_to_the_returned_points(head_client, path
 def test_model_info_names_the_spline_head(client):
     spline = client.get("/model").json()["spline"]
     assert spline["n_ctrl"] == 31 and spline["degree"] == 3 and len(spline["knots"]) == 35
-    assert spline["learned_params"] is False and spline["match"] == "index"
+    assert spline["learned_params"] is False and spline["placement"] == "index"
 
 
 def test_model_info_tells_a_head_with_learned_parameters(params_model_dir, params_runtime):

@@ -47,4 +47,4 @@ def test_init_from_weights_without_learned_parameters_widens_them_and_keeps_them
     assert json.loads((tmp_path / "kept" / "config.json").read_text())["model"]["spline_params"] is True
     # the parameter channel is not dropped silently
     assert main(["train", "--run-dir", "dropped", "--init-from", str(again), "--no-spline-params", *tiny]) != 0
-    assert "'spline_params': True, 'spline_match': False} model, not" in capsys.readouterr().err
+    assert "'spline_params': True} model, not" in capsys.readouterr().err

@@ -1,5 +1,5 @@
-"""A model trained on closest points (`curve-vae train --match closest`, the manifest's spline "match"): the service
-returns each input point's closest point on the decoded spline, and picks the pose whose spline passes closest."""
+"""A model placed "closest" (the manifest's spline.placement, `curve-vae export --placement`): the service returns each
+input point's closest point on the decoded spline, and picks the pose whose spline passes closest."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def _user_curves() -> list[np.ndarray]:
 
 
 def test_the_manifest_says_how_points_are_placed(closest_runtime, runtime):
-    assert closest_runtime.closest_match and not runtime.closest_match
+    assert closest_runtime.closest_placement and not runtime.closest_placement
 
 
 def test_each_returned_point_is_on_the_spline_and_no_further_than_the_models_own_point(closest_runtime, runtime):
@@ -68,7 +68,7 @@ def test_an_interpolation_row_of_one_curve_is_its_reconstruction(closest_runtime
 def test_over_http_the_reconstruction_is_the_runtimes(closest_model_dir, closest_runtime):
     c = _user_curves()[3]
     with TestClient(create_app(Settings(model_dir=closest_model_dir))) as client:
-        assert client.get("/model").json()["spline"]["match"] == "closest"
+        assert client.get("/model").json()["spline"]["placement"] == "closest"
         r = client.post("/reconstruct", json={"curves": [c.tolist()], "output": "both"})
         assert r.status_code == 200, r.text
         body = r.json()
