@@ -43,7 +43,7 @@ def test_pose_auto_beats_as_is_on_a_stroke_unlike_the_papers_curves(shipped_runt
 
 def test_interpolating_a_curve_with_its_reversal_gives_the_curve(shipped_runtime):
     c = _stroke()
-    (own,), _ = shipped_runtime.reconstruct([c], n_points=len(c))
+    (own,), _ = shipped_runtime.reconstruct([c])  # at its own points, as a sweep between inputs of its length
     w = np.array([[1.0, 0.0], [0.7, 0.3], [0.5, 0.5], [0.2, 0.8]])
     out, frames = shipped_runtime.interpolate([c, c[::-1]], w)
     mine = shipped_runtime.encode([c])[2][0]
