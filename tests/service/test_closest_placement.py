@@ -77,3 +77,19 @@ def test_over_http_the_reconstruction_is_the_runtimes(closest_model_dir, closest
     np.testing.assert_allclose(np.array(body["curves"][0]), want, atol=1e-6 * np.abs(want).max())
     np.testing.assert_allclose(body["splines"][0]["params"], splines[0].params, atol=1e-12)
     assert body["mse"][0] == mse[0] or abs(body["mse"][0] - mse[0]) <= 1e-9 * mse[0]
+
+
+def test_the_shipped_model_is_placed_closest_and_comes_back_closer_so(shipped_runtime):
+    assert shipped_runtime.closest_placement  # models/manifest.json: spline.placement
+    a = 0.4
+    rot = np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+    paper = [0.1 * c @ rot + [50.0, 20.0] for c in bspline_curves(8, seed=31)]
+    sets = {"parameter": paper, "arc length": [resample(c, 120) for c in paper]}
+    for name, curves in sets.items():
+        _, closest = shipped_runtime.reconstruct(curves)
+        shipped_runtime.closest_placement = False
+        try:
+            _, own = shipped_runtime.reconstruct(curves)
+        finally:
+            shipped_runtime.closest_placement = True
+        assert closest.mean() < 0.8 * own.mean(), (name, closest.mean(), own.mean())
