@@ -208,7 +208,7 @@ class Decoder(nn.Module):
             self.register_buffer("knots", knots, persistent=False)
             self.register_buffer("closed", last_span_mask(knots), persistent=False)
             # the spline at twice the points' density, for losses that measure the whole curve (match "closest")
-            fine = spline_head(cfg.spline_ctrl, DENSE * (cfg.n_points - 1) + 1)[0]
+            fine = spline_head(cfg.spline_ctrl, SAMPLES_PER_INTERVAL * (cfg.n_points - 1) + 1)[0]
             self.register_buffer("dense_basis", torch.tensor(fine, dtype=torch.float32), persistent=False)
 
     def forward(self, z: torch.Tensor, *, full: bool | None = None) -> torch.Tensor:
@@ -273,8 +273,8 @@ def bspline_basis(u: torch.Tensor, knots: torch.Tensor, closed: torch.Tensor, de
     return b
 
 
-#: Samples of the decoded spline per point interval in a dense decoding (VAE.forward(dense=True)).
-DENSE = 2
+#: Samples of the decoded spline per interval between its points in a dense decoding (VAE.forward(dense=True)).
+SAMPLES_PER_INTERVAL = 2
 
 
 class VAE(nn.Module):
@@ -322,7 +322,8 @@ class VAE(nn.Module):
 
     def forward(self, curves: torch.Tensor, *, dense: bool = False) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """Decoded curves (B, N, 2), latent mean and log-variance; dense: the decoded splines sampled from start to end
-        at DENSE times the points' density instead (B, DENSE·(N-1)+1, 2), shapes whatever the spacing (spline head)."""
+        at SAMPLES_PER_INTERVAL times the points' density instead (B, SAMPLES_PER_INTERVAL·(N-1)+1, 2): shapes,
+        whatever the spacing (spline head)."""
         mean, log_var = self.encoder(curves)
         z = mean
         if self.training:
