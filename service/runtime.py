@@ -17,7 +17,7 @@ model input. "arc_length" resamples evenly by arc length instead (geometry.adapt
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 
-Length (~470 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a
+Length (~480 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a
 batch's frames, input positions and splines from `prepare` through the graphs to the result, turning geometry's
 errors into the service's InputError with the field and curve they concern. Its parts live beside it: the
 sessions, signature checks and raw graph runs are `service.graphs` (the base class `ModelGraphs`); the pure frame
