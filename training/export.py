@@ -58,7 +58,7 @@ class _DecoderGraph(nn.Module):
 
 #: How a consumer places a reconstruction's points (the manifest's spline.placement): "closest", each input point at its
 #: closest point on the decoded spline (the service's default for a model with a B-spline head: never further from
-#: the input than "index"), or "index", point i at the head's parameter i.
+#: the input than "index" on the same spline), or "index", point i at the head's parameter i.
 PLACEMENTS = ("closest", "index")
 
 

@@ -177,7 +177,8 @@ def _add_export(sub: argparse._SubParsersAction) -> None:
         choices=("closest", "index"),
         default="closest",
         help="with a B-spline head, how the service places a reconstruction's points, recorded in the manifest: "
-        "closest (each input point at its closest point on the decoded spline: never further from the input) or "
+        "closest (each input point at its closest point on the decoded spline: never further from the input than "
+        "the model's own points on that spline) or "
         "index (point i at the head's parameter i, as models before 0.10.1 were served) (default: closest)",
     )
     s.add_argument(
