@@ -1,13 +1,14 @@
 """Trainer: loop, optimiser, schedule, checkpoints, resume, early stopping, DDP.
 
-Knows nothing about curves beyond "a (N, n_points, 2) float array" (with match "twin", each curve beside its twin:
-(N, 2, n_points, 2)): the model owns the architecture, `losses` owns the objectives, which cfg.match picks. Run under `torchrun --nproc-per-node K` for
-data-parallel training (gloo on CPU, nccl on GPU); a single process needs no launcher.
-Checkpoint files are training/checkpoint.py's.
+Knows nothing about curves beyond "a (N, n_points, 2) float array" (with match "twin", each curve beside its
+twin: (N, 2, n_points, 2)): the model owns the architecture, `losses` owns the objectives, which cfg.match
+picks. Run under `torchrun --nproc-per-node K` for data-parallel training (gloo on CPU, nccl on GPU); a single
+process needs no launcher. Checkpoint files are training/checkpoint.py's.
 
-Length (~570 lines): the step (and its three objectives), the schedules, the clock of a time budget and the run's named steps share
-RunState, _Parts (model, optimiser, schedule, clock, generator) and the DDP process; `train()` itself
-(~60 lines) reads top to bottom: set-up, then each epoch's pass, validation, record and stop rules.
+Length (~570 lines): the step (and its three objectives), the schedules, the clock of a time budget and the
+run's named steps share RunState, _Parts (model, optimiser, schedule, clock, generator) and the DDP process;
+`train()` itself (~60 lines) reads top to bottom: set-up, then each epoch's pass, validation, record and stop
+rules.
 """
 
 from __future__ import annotations
