@@ -129,9 +129,18 @@ def closest_params(
     pts = np.asarray(points, np.float64)
     a = np.clip(np.asarray(around, np.float64), 0.0, 1.0)
     grid = np.linspace(0.0, 1.0, dense)
-    d2 = ((pts[:, None, :] - sample_bspline(ctrl, dense, degree)[None]) ** 2).sum(-1)  # (n, dense)
-    d2[np.abs(grid[None, :] - a[:, None]) > window] = np.inf
-    u = grid[d2.argmin(axis=1)]
+    samples = sample_bspline(ctrl, dense, degree)
+    width = int(np.ceil(2 * window * (dense - 1))) + 2  # samples a window can hold
+    if width >= dense:  # the window spans the curve: every sample
+        d2 = ((pts[:, None, :] - samples[None]) ** 2).sum(-1)  # (n, dense)
+        d2[np.abs(grid[None, :] - a[:, None]) > window] = np.inf
+        u = grid[d2.argmin(axis=1)]
+    else:  # only the samples of each point's window: (n, width), those beyond it at infinity
+        first = np.clip(np.ceil((a - window) * (dense - 1) - 1e-9).astype(int), 0, dense - 1)
+        idx = np.minimum(first[:, None] + np.arange(width)[None, :], dense - 1)
+        d2 = ((pts[:, None, :] - samples[idx]) ** 2).sum(-1)
+        d2[np.abs(grid[idx] - a[:, None]) > window] = np.inf
+        u = grid[idx[np.arange(len(pts)), d2.argmin(axis=1)]]
     lo, hi = np.clip(a - window, 0.0, 1.0), np.clip(a + window, 0.0, 1.0)
     spline = BSpline(clamped_uniform_knots(len(ctrl), degree), ctrl, degree)
     d1, d2s = spline.derivative(1), spline.derivative(2)
