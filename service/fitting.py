@@ -161,7 +161,9 @@ class Fitting:
         return BSpline.design_matrix(np.clip(u, 0.0, 1.0), self.knots, self.spline_degree).toarray()
 
     def _cost(self, ctrl: np.ndarray, target: np.ndarray, u: np.ndarray) -> float:
-        return float(((target - self._basis(u) @ np.asarray(ctrl, np.float64)) ** 2).sum())
+        """Sum of squared distances from the target's points to the spline at u (scipy's evaluation: no matrix)."""
+        spline = BSpline(self.knots, np.asarray(ctrl, np.float64), self.spline_degree)
+        return float(((target - spline(np.clip(u, 0.0, 1.0))) ** 2).sum())
 
 
 def _along(ctrl: np.ndarray, target: np.ndarray) -> list[np.ndarray]:
