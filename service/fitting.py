@@ -95,14 +95,15 @@ class Fitting:
         z = np.array(latents, np.float64)
         count, dim = z.shape
         decoded = _float64(decoded if decoded is not None else self.decode_model_splines(z))
-        # the start: each curve's closest points searched near its positions as given and near the same fractions of
-        # the spline's length as of the target's, or those guesses themselves where closer (pooling points into
-        # order can cost more than it gains), so that the fit is never further than the plain reconstruction
+        # the start: two guesses of where the target's points sit (its positions as given, and the same fractions of
+        # the spline's length as of the target's); the closest points searched near the closer guess, or a guess
+        # itself where closer still (pooling points into order can cost more than it gains), so that the fit is
+        # never further than the plain reconstruction
         feet, cost = [], np.empty(count)
         for i, (c, t, a) in enumerate(zip(decoded[1], targets, around)):
-            guesses = [np.asarray(a, np.float64), *_along(c, t)]
-            starts = [(self._cost(c, t, u), u) for g in guesses for u in (self._feet(c, t, g), g)]
-            cost[i], u = min(starts, key=lambda start: start[0])
+            guesses = [(self._cost(c, t, g), g) for g in (np.asarray(a, np.float64), *_along(c, t))]
+            closest = self._feet(c, t, min(guesses, key=lambda guess: guess[0])[1])
+            cost[i], u = min([(self._cost(c, t, closest), closest), *guesses], key=lambda start: start[0])
             feet.append(u)
         damping = np.full(count, 1e-2)
         jac = np.zeros(0)
