@@ -109,6 +109,7 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
                 providers=settings.providers,
                 batch_size=settings.batch_size,
                 sessions=config,
+                placement=settings.placement,
             )
         )
     except ModelLoadError as e:

@@ -38,6 +38,7 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
         int,
         "most refine work in one request: steps × (input points + 300 per curve)",
     ),
+    ("--placement", "placement", str, "model: as the model's manifest says; closest or index whatever it says"),
     ("--batch-size", "batch_size", int, "curves per ONNX run"),
     ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0: the CPU quota shared out"),
     ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),
@@ -54,6 +55,7 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
 _CHOICES = {
     "providers": ["cpu", "cuda", "auto"],
     "log_level": ["critical", "error", "warning", "info", "debug", "trace"],
+    "placement": ["model", "closest", "index"],
 }
 
 

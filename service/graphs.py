@@ -70,11 +70,13 @@ class ModelGraphs:
         batch_size: int = 64,
         warm_up: bool = True,
         sessions: SessionConfig | None = None,
+        placement: str = "model",
     ) -> Self:
         """Open a model directory; raises ModelLoadError with what to fix when it cannot serve.
 
         `sessions` sets threads, spinning and the number of session pairs (service.sessions); without it, one pair
-        of `intra_op_threads` threads."""
+        of `intra_op_threads` threads. `placement`: "model" places a reconstruction's points as the manifest's
+        spline.placement says; "closest" or "index" whatever it says (CURVE_VAE_PLACEMENT)."""
         root = Path(model_dir)
         manifest = read_manifest(root)
         provider_list = resolve_providers(providers)
@@ -83,6 +85,7 @@ class ModelGraphs:
         pool = SessionPool(
             [open_pair(paths, provider_list, config, require_cuda=providers == "cuda") for _ in range(config.sessions)]
         )
+        spline = manifest.get("spline")
         prior = None
         if manifest.get("prior"):
             path = root / str(manifest["prior"].get("file", PRIOR_FILE))
@@ -93,6 +96,12 @@ class ModelGraphs:
         runtime = cls(
             *pool.pairs[0], manifest, batch_size=batch_size, requested_providers=providers, prior=prior, pool=pool
         )
+        if placement not in ("model", "closest", "index"):
+            raise ValueError(f"placement must be model, closest or index, got {placement!r}")
+        if placement == "closest" and not spline:
+            raise ModelLoadError(f"{root}: placement closest needs a model with a B-spline head; this one has none")
+        if placement != "model":
+            runtime.closest_placement = placement == "closest"
         if warm_up:
             runtime.warm_up()
         return runtime

@@ -57,6 +57,10 @@ class Settings(BaseSettings):
     # Fitting work of one request, steps × (input points + 300 per curve) (service/deps.py check_refine): about 35 s
     # of one CPU core here, under request_timeout; 256 curves of 161 points may take 10 steps.
     max_refine_work: int = Field(1_200_000, ge=0)
+    # Where a reconstruction's points go: "model", as the model's manifest says (spline.placement: the shipped model
+    # "closest", each input point at its closest point on the curve); "index", the model's own points, about half the
+    # CPU per single-curve /reconstruct (docs/BENCHMARKS.md) for 18–59% more error (docs/RESULTS.md); or "closest".
+    placement: Literal["model", "closest", "index"] = "model"
     # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
     cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)
     # API keys (service/access.py), comma-separated or a JSON list; empty = open. Set by environment only,

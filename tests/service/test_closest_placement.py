@@ -4,6 +4,7 @@ input point's closest point on the decoded spline, and picks the pose whose spli
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from fastapi.testclient import TestClient
 
 from curve_vae.geometry import closest_squared_distances, evaluate_bspline, pose_frames, resample
@@ -93,3 +94,18 @@ def test_the_shipped_model_is_placed_closest_and_comes_back_closer_so(shipped_ru
         finally:
             shipped_runtime.closest_placement = True
         assert closest.mean() < 0.8 * own.mean(), (name, closest.mean(), own.mean())
+
+
+def test_the_server_setting_overrides_the_manifest(model_dir, raw_model_dir, closest_runtime):
+    from curve_vae.service.model_files import ModelLoadError
+    from curve_vae.service.runtime import CurveRuntime
+
+    c = _user_curves()[4]
+    with TestClient(create_app(Settings(model_dir=model_dir, placement="closest"))) as client:  # an "index" manifest
+        assert client.get("/model").json()["spline"]["placement"] == "closest"
+        body = client.post("/reconstruct", json={"curves": [c.tolist()]}).json()
+    (want,), _ = closest_runtime.reconstruct([c])
+    np.testing.assert_allclose(np.array(body["curves"][0]), want, atol=1e-6 * np.abs(want).max())
+    assert not CurveRuntime.load(model_dir, providers="cpu", placement="index").closest_placement
+    with pytest.raises(ModelLoadError, match="placement closest needs a model with a B-spline head"):
+        CurveRuntime.load(raw_model_dir, providers="cpu", placement="closest")
