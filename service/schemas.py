@@ -287,7 +287,9 @@ class ReconstructRequest(_Request):
 class ReconstructResponse(CurvesResponse):
     mse: list[float] = Field(
         description="Per curve: mean squared error over points and coordinates (paper eq. 4) between the input and "
-        "its reconstruction at the input's own points, in the caller's frame."
+        "its reconstruction at the input's own points, in the caller's frame: each input point against the returned "
+        "point matched to it (with the shipped model's closest placement, its closest point on the reconstruction; "
+        "GET /model: spline.placement)."
     )
 
 
