@@ -17,8 +17,8 @@ def mse_per_curve(target: np.ndarray, pred: np.ndarray) -> np.ndarray:
 
 def closest_squared_distances(points: np.ndarray, curve: np.ndarray) -> np.ndarray:
     """Each of `points` (n, 2)'s squared distance to its closest point on the polyline `curve` (m, 2), the first and
-    last points to the curve's first and last points (a reconstruction's ends are the input's): (n,). What a model
-    trained with match "closest" is trained on, and how the service picks its pose for one."""
+    last points to the curve's first and last points (a reconstruction's ends are the input's): (n,). How the service
+    picks the pose of a model placed "closest" (training's match "closest" measures the same, in torch)."""
     pts, line = np.asarray(points, np.float64), np.asarray(curve, np.float64)
     d = shapely.distance(shapely.points(pts[1:-1]), shapely.linestrings(line)) ** 2
     ends = ((pts[[0, -1]] - line[[0, -1]]) ** 2).sum(-1)

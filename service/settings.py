@@ -58,8 +58,9 @@ class Settings(BaseSettings):
     # of one CPU core here, under request_timeout; 256 curves of 161 points may take 10 steps.
     max_refine_work: int = Field(1_200_000, ge=0)
     # Where a reconstruction's points go: "model", as the model's manifest says (spline.placement: the shipped model
-    # "closest", each input point at its closest point on the curve); "index", the model's own points, about half the
-    # CPU per single-curve /reconstruct (docs/BENCHMARKS.md) for 18–59% more error (docs/RESULTS.md); or "closest".
+    # "closest", each input point at its closest point on the curve); "index", the model's own points: about half the
+    # CPU of a single-curve /reconstruct posed as is (docs/BENCHMARKS.md), giving up closest's 18–59% lower error
+    # (docs/RESULTS.md); or "closest".
     placement: Literal["model", "closest", "index"] = "model"
     # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
     cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)

@@ -20,8 +20,7 @@ from torch import nn
 from curve_vae.training.checkpoint import CHECKPOINT_VERSION, load_checkpoint
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.model import VAE
-from curve_vae.training.train import validation_closest
-from curve_vae.training.train import validation_mse as validation_eq4
+from curve_vae.training.validation import validation_measure
 
 __all__ = ["average_state_dicts", "recompute_batchnorm", "average_checkpoints"]
 
@@ -79,9 +78,7 @@ def average_checkpoints(
     if len(cfgs) != 1:
         raise ValueError(f"the checkpoints hold different models: {[c['model_config'] for c in ckpts]}")
     model = VAE(ModelConfig(**ckpts[0]["model_config"]))
-    # the run's own validation measure: eq. 4, or each point to its closest point for a run that trained so
-    closest = ckpts[-1]["train_config"].get("match", "index") != "index"
-    validation_mse = validation_closest if closest else validation_eq4
+    validation_mse = validation_measure(ckpts[-1]["train_config"].get("match", "index"))  # the run's own measure
     record: dict[str, Any] = {"sources": [], "bn_curves": 0 if train_curves is None else len(train_curves)}
     for p, c in zip(paths, ckpts, strict=True):
         src: dict[str, Any] = {"path": str(p), "epoch": c["state"]["epoch"]}

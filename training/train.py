@@ -5,7 +5,7 @@ twin: (N, 2, n_points, 2)): the model owns the architecture, `losses` owns the o
 picks. Run under `torchrun --nproc-per-node K` for data-parallel training (gloo on CPU, nccl on GPU); a single
 process needs no launcher. Checkpoint files are training/checkpoint.py's.
 
-Length (~570 lines): the step (and its three objectives), the schedules, the clock of a time budget and the
+Length (~540 lines): the step (and its three objectives), the schedules, the clock of a time budget and the
 run's named steps share RunState, _Parts (model, optimiser, schedule, clock, generator) and the DDP process;
 `train()` itself (~60 lines) reads top to bottom: set-up, then each epoch's pass, validation, record and stop
 rules.
@@ -29,7 +29,6 @@ import torch.distributed as dist
 from torch import nn
 from tqdm import tqdm
 
-from curve_vae.geometry import mse_per_curve
 from curve_vae.training.checkpoint import (
     CHECKPOINT_VERSION,
     atomic_save,
@@ -40,8 +39,9 @@ from curve_vae.training.checkpoint import (
 )
 from curve_vae.training.config import SCHEDULES, ModelConfig, TrainConfig
 from curve_vae.training.data import DataConfig, load_or_generate
-from curve_vae.training.losses import closest_loss, closest_point_terms, vae_loss
+from curve_vae.training.losses import closest_loss, vae_loss
 from curve_vae.training.model import VAE
+from curve_vae.training.validation import validation_measure
 
 __all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch"]
 
@@ -170,40 +170,6 @@ def _agree(flag: bool) -> bool:
     t = torch.tensor([int(flag)])
     dist.broadcast(t, 0)
     return bool(t.item())
-
-
-@torch.no_grad()
-def reconstruct(
-    model: nn.Module, curves: np.ndarray | torch.Tensor, *, batch: int = 1000, device: torch.device | None = None
-) -> np.ndarray:
-    """Decode the latent mean of each curve (paper: reconstruction at inference), float32."""
-    device = device or next(model.parameters()).device
-    model.eval()
-    x = torch.as_tensor(curves, dtype=torch.float32)
-    out = [model(x[i : i + batch].to(device))[0].float().cpu() for i in range(0, len(x), batch)]
-    return torch.cat(out).numpy()
-
-
-def validation_mse(model: nn.Module, curves: np.ndarray | torch.Tensor, *, device: torch.device | None = None) -> float:
-    """Paper eq. 4 averaged over `curves`, reconstructing from the latent mean (model selection's number)."""
-    target = curves.numpy() if isinstance(curves, torch.Tensor) else np.asarray(curves)
-    return float(mse_per_curve(target, reconstruct(model, target, device=device)).mean())
-
-
-@torch.no_grad()
-def validation_closest(
-    model: nn.Module, curves: np.ndarray | torch.Tensor, *, batch: int = 250, device: torch.device | None = None
-) -> float:
-    """Match "closest"'s model-selection number: each point's squared distance to its closest point on the spline
-    decoded from the curve's latent mean, averaged as eq. 4 (`closest_point_terms`' mse)."""
-    device = device or next(model.parameters()).device
-    model.eval()
-    x = torch.as_tensor(curves, dtype=torch.float32)
-    total = 0.0
-    for i in range(0, len(x), batch):
-        part = x[i : i + batch].to(device)
-        total += float(closest_point_terms(part, model(part, dense=True)[0])["mse"]) * len(part)
-    return total / max(1, len(x))
 
 
 def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch: int, clock: Clock):
@@ -399,8 +365,7 @@ def _budget_bar(cfg: TrainConfig, state: RunState, shown: bool) -> tqdm | None:
 
 def _validate(proc: _Process, parts: _Parts, val: torch.Tensor, cfg: TrainConfig) -> float:
     """The validation MSE, rank 0's on every process, so that all stop together; a plateau schedule steps on it."""
-    measure = validation_mse if cfg.match == "index" else validation_closest
-    val_mse = measure(parts.model, val, device=proc.device)
+    val_mse = validation_measure(cfg.match)(parts.model, val, device=proc.device)
     if proc.distributed:
         v = torch.tensor([val_mse], dtype=torch.float64)
         dist.broadcast(v, 0)
