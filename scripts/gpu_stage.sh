@@ -7,9 +7,9 @@
 #
 # Settings (environment): BUDGET seconds of training (400), LR peak (3e-4), WARMUP (0.05), NTRAIN curves (2000000),
 # MIX_VERSION (the latest), PARAMS (1: --spline-params, a head that learns its points' parameters; default: INIT's
-# head), MATCH (index, closest or twin: what the reconstruction error measures, `curve-vae train --match`; a
-# twin stage — each curve against the same curve evenly in its own parameter — is the next step towards a model that
-# does not care how points are spaced: docs/RESULTS.md), ONLY_ENCODER (1: --only-encoder), DEVICE (cuda), WORKERS drawing the data (16), INIT weights (models/vae.pt), RUN folder
+# head), MATCH (index, closest, twin or mixed: what the reconstruction error measures, `curve-vae train --match`;
+# mixed — index for curves at their own spacing, closest points for the rest — lets the decoder give a respaced curve
+# its own shape instead of bending it to put even parameters at the points: docs/RESULTS.md), ONLY_ENCODER (1: --only-encoder), DEVICE (cuda), WORKERS drawing the data (16), INIT weights (models/vae.pt), RUN folder
 # (/tmp/r), DATA cache (/tmp/d.npz: a second stage on the same curves reads it), WHEELS (a folder of wheels of
 # what the machine lacks, e.g. pydantic, shapely; installed to /tmp/site without an index), OUT (/tmp/out).
 # OUT receives train.log, log.jsonl, config.json and best.pt without its optimiser state (a third of the size).

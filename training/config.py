@@ -59,7 +59,7 @@ class ModelConfig:
 
 
 SCHEDULES = ("onecycle", "cosine", "constant", "plateau")
-MATCHES = ("index", "closest", "twin")
+MATCHES = ("index", "closest", "twin", "mixed")
 
 
 @dataclass(frozen=True)
@@ -84,7 +84,8 @@ class TrainConfig:
     only_params: bool = False  # train only the head's parameter channel (VAE.learn_only_params)
     # index: eq. 4, point i to point i; closest: each point to its closest point (spacing-free); twin: eq. 4 against
     # the curve's twin, the same curve evenly in its own parameter (data twins): whatever the input's spacing, the
-    # decoder's even parameters fall where the curve's own do
+    # decoder's even parameters fall where the curve's own do; mixed: index for curves drawn evenly in their own
+    # parameter (equal to their twins), closest for the rest (losses.mixed_loss)
     match: str = "index"
     only_encoder: bool = False  # train only the encoder; decoder, BatchNorm statistics frozen (VAE.learn_only_encoder)
 

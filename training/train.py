@@ -1,6 +1,6 @@
 """Trainer: loop, optimiser, schedule, checkpoints, resume, early stopping, DDP.
 
-Knows nothing about curves beyond "a (N, n_points, 2) float array" (with match "twin", each curve beside its
+Knows nothing about curves beyond "a (N, n_points, 2) float array" (with match "twin" or "mixed", each curve beside its
 twin: (N, 2, n_points, 2)): the model owns the architecture, `losses` owns the objectives, which cfg.match
 picks. Run under `torchrun --nproc-per-node K` for data-parallel training (gloo on CPU, nccl on GPU); a single
 process needs no launcher. Checkpoint files are training/checkpoint.py's.
@@ -39,8 +39,8 @@ from curve_vae.training.checkpoint import (
 )
 from curve_vae.training.config import SCHEDULES, ModelConfig, TrainConfig
 from curve_vae.training.data import DataConfig, load_or_generate
-from curve_vae.training.losses import closest_loss, vae_loss
-from curve_vae.training.model import VAE
+from curve_vae.training.losses import closest_loss, mixed_loss, vae_loss
+from curve_vae.training.model import SAMPLES_PER_INTERVAL, VAE
 from curve_vae.training.validation import validation_measure
 
 __all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch"]
@@ -118,8 +118,9 @@ def train_one_epoch(
     bar: tqdm | None = None,
     clock: Clock | None = None,
 ) -> dict[str, float]:
-    """One pass over `data[order]` in batches; returns the mean of each loss term. Match "twin": data (n, 2, N, 2),
-    each curve and its twin, the target of its reconstruction.
+    """One pass over `data[order]` in batches; returns the mean of each loss term. Match "twin" or "mixed": data
+    (n, 2, N, 2), each curve and its twin (the target of its reconstruction, or which says whether it is at its own
+    spacing).
 
     With a clock on a time budget, the pass ends early once the budget is spent (on every
     DDP process at the same step: rank 0's clock decides).
@@ -156,6 +157,11 @@ def _batch_terms(model: nn.Module, x: torch.Tensor, cfg: TrainConfig, device: to
         with autocast(device, cfg.bf16):
             pred, mean, log_var = model(x[:, 0])
         return vae_loss(x[:, 1], pred, mean, log_var, beta=cfg.beta, lap_weight=cfg.lap_weight)
+    if cfg.match == "mixed":  # index where the curve is its twin (its own spacing), its shape alone elsewhere
+        with autocast(device, cfg.bf16):
+            curve, mean, log_var = model(x[:, 0], dense=True)
+        terms = {"beta": cfg.beta, "lap_weight": cfg.lap_weight, "stride": SAMPLES_PER_INTERVAL}
+        return mixed_loss(x[:, 0], x[:, 1], curve, mean, log_var, **terms)
     with autocast(device, cfg.bf16):
         pred, mean, log_var = model(x, dense=cfg.match == "closest")
     if cfg.match == "closest":
@@ -251,9 +257,9 @@ def _load_splits(
             ds = load_or_generate(data_cfg, cache)
     assert ds is not None
     train_np = ds.train[: cfg.train_limit] if cfg.train_limit else ds.train
-    if cfg.match == "twin":  # each curve with its twin: (n, 2, N, 2)
+    if cfg.match in ("twin", "mixed"):  # each curve with its twin: (n, 2, N, 2)
         if ds.train_twins is None:
-            raise ValueError('match "twin" needs a data set with twins (mix "broad", DataConfig.twins)')
+            raise ValueError(f'match {cfg.match!r} needs a data set with twins (mix "broad", DataConfig.twins)')
         train_np = np.stack([train_np, ds.train_twins[: len(train_np)]], axis=1)
     return torch.from_numpy(np.ascontiguousarray(train_np)), torch.from_numpy(np.ascontiguousarray(ds.val))
 
@@ -271,6 +277,9 @@ class _Parts:
 
 
 def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_per_epoch: int) -> _Parts:
+    if cfg.match == "mixed" and (not model_cfg.spline_ctrl or model_cfg.spline_params):
+        # its index half measures the decoder's even parameters, which learned parameters would not serve
+        raise ValueError('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
     model = VAE(model_cfg).to(proc.device)
     trained = (
         model.learn_only_params()

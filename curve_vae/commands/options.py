@@ -77,7 +77,7 @@ def data_config(a: argparse.Namespace):
         mix=mix,
         source=a.curves or "",
         mix_version=a.mix_version if mix == "broad" else 0,
-        twins=getattr(a, "match", "") == "twin",  # training with match "twin" learns from each curve's twin
+        twins=getattr(a, "match", "") in ("twin", "mixed"),  # match "twin" or "mixed" learns from each curve's twin
     )
 
 

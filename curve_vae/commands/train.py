@@ -68,9 +68,10 @@ def add_train_options(p: argparse.ArgumentParser) -> None:
         "afterwards with curve-vae average (0: off)",
         "only_params": "with --spline-params: train only where the points sit along the curves (the head's "
         "parameter channel); every other weight and BatchNorm statistic stays the starting model's",
-        "match": "what the reconstruction error measures: index (eq. 4, point i to point i) or closest (each "
+        "match": "what the reconstruction error measures: index (eq. 4, point i to point i); closest (each "
         "point to its closest point on the decoded spline and back, whatever the points' spacing; needs the "
-        "B-spline head; validation and model selection measure it too)",
+        "B-spline head; validation and model selection measure it too); twin (eq. 4 against the curve drawn "
+        "evenly in its own parameter); mixed (index for curves drawn at their own spacing, closest for the rest)",
         "only_encoder": "train only the encoder: the decoder's weights and every BatchNorm statistic stay the "
         "starting model's, so every latent decodes as before and only which latent a curve gets changes",
     }

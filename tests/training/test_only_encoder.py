@@ -1,5 +1,6 @@
 """Training the encoder alone: every latent decodes as before; only which latent a curve gets changes."""
 
+import numpy as np
 import pytest
 import torch
 
@@ -91,3 +92,42 @@ def test_match_twin_reconstructs_each_curve_as_its_twin_and_closest_measures_sha
     assert dense.shape == (16, 321, 2)
     with pytest.raises(ValueError, match="match must be one of"):
         TrainConfig(match="nearest")
+
+
+def test_match_mixed_measures_curves_at_their_own_spacing_by_index_and_the_rest_by_their_shape():
+    from curve_vae.training.losses import closest_point_terms, laplacian
+
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant="cnn1", spline_ctrl=31)).eval()
+    model.learn_only_encoder()
+    x, other = _curves(16, seed=4), _curves(16, seed=5)
+    native = torch.arange(16) < 6  # the first six are their own twins; the rest were drawn at another spacing
+    twin = torch.where(native.view(-1, 1, 1), x, other)
+    with torch.no_grad():
+        pred = model(x)[0]
+        dense = model(x, dense=True)[0]
+        np.testing.assert_allclose(dense[:, ::2].numpy(), pred.numpy(), atol=1e-3)  # every other sample is a point
+        index = (x - pred).square().mean((1, 2))
+        lap = (laplacian(x) - laplacian(pred)).abs().mean((1, 2))
+        close = closest_point_terms(x, dense, per_curve=True)
+    want_mse = (index[:6].sum() + close["mse"][6:].sum()) / 16
+    opt = torch.optim.SGD([p for p in model.parameters() if p.requires_grad], lr=0.0)
+    cfg = TrainConfig(match="mixed", only_encoder=True, batch_size=16, beta=0.0)
+    got = train_one_epoch(model, torch.stack([x, twin], dim=1), torch.arange(16), opt, None, cfg, "cpu")
+    assert got["mse"] == pytest.approx(float(want_mse), rel=1e-4)
+    assert got["lap"] == pytest.approx(float(lap[:6].sum() / 16), rel=1e-4)  # the Laplacian of matched points only
+    assert got["back"] == pytest.approx(float(close["back"][6:].sum() / 16), rel=1e-4)
+    assert got["native"] == pytest.approx(6 / 16)
+    assert got["loss"] == pytest.approx(got["mse"] + got["lap"] + got["back"], rel=1e-5)
+
+
+def test_match_mixed_refuses_a_model_whose_points_are_not_at_even_parameters(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    torch.manual_seed(0)
+    cfg = ModelConfig(spline_ctrl=31, spline_params=True)
+    start = tmp_path / "start.pt"
+    torch.save({"model_config": cfg.__dict__, "model": VAE(cfg).state_dict()}, start)
+    tiny = ["--n-train", "64", "--n-val", "16", "--n-test", "16", "--epochs", "1", "--batch-size", "32"]
+    args = ["--run-dir", "mx", "--init-from", str(start), "--match", "mixed", "--mix", "broad", *tiny, "--no-progress"]
+    assert main(["train", *args]) != 0
+    assert 'match "mixed" needs the B-spline head at even parameters' in capsys.readouterr().err
