@@ -4,7 +4,9 @@ The model takes `n_points` points (161) in its 128×128 plane. `to_model_plane` 
 curve there — through its `Frame` when it has one (frame.py), then to `n_points` points: along the
 point index with spacing "parameter" (the caller's own spacing kept, so a curve of `n_points`
 passes untouched),
-evenly by arc length with "arc_length" — and says where each of the caller's points sits along
+evenly by arc length with "arc_length", at even steps of the parameters of the cubic B-spline that fits it
+closest with "natural" (`bspline.natural_params`: the spacing of the paper's curves, whatever the caller's) — and
+says where each of the caller's points sits along
 the result. `polyline_to_caller` and `spline_to_caller` bring a model-plane result back: at those
 positions, or at any count spaced as asked, mapped through the frame. From a B-spline head's
 control points the points are the spline's at the returned parameters, and the control points
@@ -18,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline, sample_bspline
+from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline, natural_params, sample_bspline
 from curve_vae.geometry.frame import Frame, arc_fractions, at_fractions, resample
 
 #: Largest float32: the graphs' input type, so the bound of a model-plane coordinate.
@@ -46,18 +48,33 @@ def joined_ends(points: np.ndarray) -> np.ndarray:
 
 
 def to_model_plane(
-    points: np.ndarray, frame: Frame | None, *, model_size: float, n_points: int, spacing: str = "parameter"
+    points: np.ndarray,
+    frame: Frame | None,
+    *,
+    model_size: float,
+    n_points: int,
+    spacing: str = "parameter",
+    natural: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """One caller curve (n, 2) -> its model-plane points (n_points, 2) and where its own points sit along them.
 
     frame None: the points are in the model plane already. The second value is the fraction in [0, 1] of the
     model's points at which each of the caller's points sits (for `polyline_to_caller`); None when the model's
-    points are the caller's. Raises BeyondFloat32 where a model-plane coordinate does not fit in float32.
+    points are the caller's. spacing "natural": the curve read at even steps of its points' `natural_params`
+    (`natural`, computed here when not given; they do not depend on the frame). Raises BeyondFloat32 where a
+    model-plane coordinate does not fit in float32.
     """
     pts = np.asarray(points, np.float64)
     m = frame.to_model(pts, model_size) if frame is not None else pts
     fractions = None
-    if spacing == "arc_length":
+    if spacing == "natural":
+        fractions = natural_params(pts) if natural is None else np.asarray(natural, np.float64)
+        if frame is not None and frame.reverse:  # m lists the points the other way round: so do their parameters
+            fractions = (1.0 - fractions)[::-1]
+        at = fractions + np.arange(len(fractions)) * 1e-12  # strictly increasing, for np.interp
+        grid = np.linspace(0.0, 1.0, n_points)
+        m = np.stack([np.interp(grid, at, m[:, 0]), np.interp(grid, at, m[:, 1])], axis=1)
+    elif spacing == "arc_length":
         fractions = arc_fractions(m)
         m = resample(m, n_points)
     elif len(pts) != n_points:
@@ -84,8 +101,8 @@ def polyline_to_caller(
     they are. frame None: left in the model plane.
     """
     curve = np.asarray(out, np.float64)
-    if n_points is not None:
-        curve = resample(curve, n_points, spacing=spacing)
+    if n_points is not None:  # a returned curve's spacing: by arc length, or the result's own for every other reading
+        curve = resample(curve, n_points, spacing="arc_length" if spacing == "arc_length" else "parameter")
     elif fractions is not None:
         curve = at_fractions(curve, fractions)
     return frame.from_model(curve, model_size) if frame is not None else curve

@@ -13,7 +13,9 @@ With frame "model" the frame steps are skipped. Resampling ("spacing"): by defau
 points are taken as given and interpolated along the index ("parameter": the paper's B-spline
 samples are spaced so, and the default model was also trained at arc-length and uneven spacings);
 a 161-point curve then passes untouched and 50, 160 or 500 points of the same curve give the same
-model input. "arc_length" resamples evenly by arc length instead (geometry.adapt). Nothing here
+model input. "arc_length" resamples evenly by arc length instead, "natural" at even steps of the parameters of the
+cubic B-spline that fits the points closest (the paper's curves' spacing, whatever the caller's), and "auto" tries
+the given and the natural reading and keeps the closer reconstruction (geometry.adapt). Nothing here
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 
@@ -43,6 +45,7 @@ from curve_vae.geometry import (
     curve_length,
     fit_frame,
     mse_per_curve,
+    natural_params,
     polyline_to_caller,
     pose_frames,
     self_intersects,
@@ -58,7 +61,9 @@ from curve_vae.service.inputs import InputError
 from curve_vae.service.sampling import Sampling
 
 FrameMode = Literal["auto", "model"]
-Spacing = Literal["parameter", "arc_length"]
+Spacing = Literal["parameter", "arc_length", "natural", "auto"]
+#: The readings of a curve that spacing "auto" tries, each in every pose: the reconstruction closest to the input wins.
+AUTO_READINGS: tuple[Spacing, ...] = ("parameter", "natural")
 PoseMode = Literal["auto", "as_is"]
 #: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
@@ -133,15 +138,18 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         pose "auto" (frame "auto" only): each curve is tried in the poses of `geometry.pose_frames` — so a
         curve, its reversal, mirror image and rotations all get the same candidates — encoded and decoded in
         each, and the pose whose reconstruction is closest to the input is kept, with its latent.
-        refine > 0: that many fitting steps on each kept latent (`_refined`). A model placed "closest" (its
-        manifest's spline.placement, `closest_placement`) has each input point matched to its closest point on its
-        reconstruction even without steps, unless `placed` is False (encoding only).
+        spacing "auto": so are two readings of each curve in each pose, its points as given ("parameter") and at
+        even steps of their `natural_params` ("natural"). refine > 0: that many fitting steps on each kept latent
+        (`_refined`). A model placed "closest" (its manifest's spline.placement, `closest_placement`) has each input
+        point matched to its closest point on its reconstruction even without steps, unless `placed` is False
+        (encoding only).
         """
         prep = self._prepare(curves, frame, spacing, pose)
         return self._refined(prep, refine) if refine > 0 or (placed and self.closest_placement) else prep
 
     def _prepare(self, curves: Sequence[np.ndarray], frame: FrameMode, spacing: Spacing, pose: PoseMode) -> Prepared:
         posing = frame == "auto" and pose == "auto"
+        readings = AUTO_READINGS if spacing == "auto" else (spacing,)
         rows, frames, fractions, inputs = [], [], [], []
         with np.errstate(all="ignore"):
             for i, c in enumerate(curves):
@@ -153,15 +161,17 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
                         if posing
                         else [fit_frame(pts) if frame == "auto" else None]
                     )
+                    natural = natural_params(pts) if "natural" in readings else None  # the same in every pose
                 except ValueError as e:  # all points coincide
                     raise InputError(("curves", i), str(e)) from e
                 for f in candidates:
-                    m, fraction = self._to_model_points(pts, f, spacing, i)
-                    rows.append(m)
-                    frames.append(f)
-                    fractions.append(fraction)
+                    for reading in readings:
+                        m, fraction = self._to_model_points(pts, f, reading, i, natural)
+                        rows.append(m)
+                        frames.append(f)
+                        fractions.append(fraction)
         batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, self.n_points, 2), np.float32)
-        if not posing:
+        if not posing and len(readings) == 1:
             return Prepared(batch, frames, fractions, inputs)
         with np.errstate(all="ignore"):
             mean, log_var = self.encode_model(batch)
@@ -187,11 +197,13 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         )
 
     def _to_model_points(
-        self, pts: np.ndarray, f: Frame | None, spacing: Spacing, i: int
+        self, pts: np.ndarray, f: Frame | None, spacing: Spacing, i: int, natural: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray | None]:
         """One caller curve -> its model-plane points (n_points, 2) and where its own points sit along them."""
         try:
-            return to_model_plane(pts, f, model_size=self.model_size, n_points=self.n_points, spacing=spacing)
+            return to_model_plane(
+                pts, f, model_size=self.model_size, n_points=self.n_points, spacing=spacing, natural=natural
+            )
         except BeyondFloat32:
             raise InputError(
                 ("curves", i),

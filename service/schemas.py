@@ -71,16 +71,22 @@ PoseMode = Annotated[
 ]
 
 SpacingMode = Annotated[
-    Literal["parameter", "arc_length"],
+    Literal["parameter", "arc_length", "natural", "auto"],
     Field(
         description=(
             'How points are spaced along a curve. "parameter" (default): points are taken as given and interpolated '
             "along their order — the paper's B-spline samples are spaced so, and the default model was also trained "
             "on points spaced by arc length and unevenly; 50, 161 or 500 samples of a curve give the same result. "
             '"arc_length": every curve is resampled evenly by arc length first, and returned curves are spaced so '
-            "(with the default model, better for spirals and sharp-cornered arcs, worse for airfoils). Returned curves "
-            'of `n_points` with "parameter" are at the model\'s own spacing: evenly in its spline parameter, or where '
-            "a head that learns its points' parameters places them (GET /model: spline.learned_params)."
+            "(with the default model, better for spirals and sharp-cornered arcs, worse for airfoils). "
+            '"natural": every curve is read at even steps of the parameters of the cubic B-spline with 10 control '
+            "points that fits its points closest — the spacing of the paper's curves, whatever the curve's own. "
+            '"auto": both the points as given and the natural reading are tried (in every pose) and the '
+            "reconstruction closest to the input is kept: the closest answer for drawn strokes, coordinate files and "
+            'curves spaced by arc length (docs/RESULTS.md), at about 2.7× the compute of "parameter". Returned '
+            'curves of `n_points` with "parameter", "natural" or "auto" are at the model\'s own spacing: evenly in '
+            "its spline parameter, or where a head that learns its points' parameters places them (GET /model: "
+            "spline.learned_params)."
         )
     ),
 ]
