@@ -131,9 +131,11 @@ def torch_eager(model_dir: Path, *, threads: int, batch: int, seconds: float = 5
 def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
     """Milliseconds per request of what the server does besides HTTP, in-process on one 1-thread session:
     the raw encoder + decoder run, `CurveRuntime.reconstruct` (pose "as_is": frames, resampling, B-spline
-    back), and for 128 curves also parsing and validating the JSON body and rendering the answer."""
+    back), and for 128 curves also parsing and validating the JSON body and rendering the answer; for one curve
+    drawn by arc length, the default request (pose "auto") and spacing "auto" as well."""
     import orjson
 
+    from curve_vae.geometry import resample
     from curve_vae.service.deps import check_curves
     from curve_vae.service.fastjson import JSON
     from curve_vae.service.runtime import CurveRuntime
@@ -163,6 +165,11 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
         out[f"parse_validate_b{batch}_ms"] = ms(parse)
         rec, mse = runtime.reconstruct(as_lists, pose="as_is")
         out[f"render_b{batch}_ms"] = ms(lambda rec=rec, mse=mse: JSON({"curves": rec, "mse": mse}))
+    # one curve drawn by arc length, as a page or a coordinate file sends it: the default request (pose "auto", six
+    # pose candidates) and spacing "auto" (each pose read two ways, geometry.natural_params first)
+    drawn = [resample(c.astype(np.float64), len(c)) for c in curves(1, seed=1)]
+    out["reconstruct_pose_auto_b1_ms"] = ms(lambda: runtime.reconstruct(drawn))
+    out["reconstruct_spacing_auto_b1_ms"] = ms(lambda: runtime.reconstruct(drawn, spacing="auto"))
     return out
 
 

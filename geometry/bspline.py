@@ -201,7 +201,14 @@ def natural_params(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: int
     if turn.sum() > 0 and (turn * u[1:-1]).sum() / turn.sum() > 0.5:
         # fitted from the end where the curve turns most, whichever way it is listed: a curve and its reversal get
         # the same parameters to rounding (the fit's path from its start is not symmetric in the order)
-        return (1.0 - natural_params(pts[::-1], n_ctrl=n_ctrl, steps=steps))[::-1]
+        back = pts[::-1]
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(back, axis=0), axis=1))])
+        return (1.0 - _fit_params(back, s / s[-1], n_ctrl, steps))[::-1]
+    return _fit_params(pts, u, n_ctrl, steps)
+
+
+def _fit_params(pts: np.ndarray, u: np.ndarray, n_ctrl: int, steps: int) -> np.ndarray:
+    """`natural_params`' fit from parameters u, the points as listed."""
     knots = clamped_uniform_knots(n_ctrl, 3)
     basis, slope = _basis_and_slope(u, knots, 3)
     ctrl = np.linalg.lstsq(basis, pts, rcond=None)[0]

@@ -4,12 +4,16 @@
 
 Each model runs the whole suite (training/suite.py: the paper's test curves as drawn, at arc-length spacing and
 moved; the trained families; the held-out ones; real airfoils) through `CurveRuntime.reconstruct` with the default
-request (frame and pose "auto", spacing "parameter", no refine), one intra-op thread. Rows: each set's mean relative
-RMSE per model, the arc-length ÷ parameter ratio, and the wall time of the whole suite relative to the first model,
-measured in one run (ratios only: this machine is noisy). `--placement` runs each model as its manifest says
-("manifest"), or with its points at the decoder's own parameters ("index") or at their closest points on the
-decoded spline, poses picked so too ("closest"), whatever its manifest says: what the placement alone gives, apart
-from what training on closest points gives.
+request (frame and pose "auto", spacing "parameter" unless `--spacing` says otherwise, no refine), one intra-op
+thread. Rows: each set's mean relative RMSE per model, the arc-length ÷ parameter ratio, and the wall time of the
+whole suite relative to the first model, measured in one run (ratios only: this machine is noisy).
+
+`--placement` runs each model as its manifest says ("manifest"), or with its points at the decoder's own parameters
+("index") or at their closest points on the decoded spline, poses picked so too ("closest"), whatever its manifest
+says: what the placement alone gives, apart from what training on closest points gives. `--spacing` runs each with
+each reading of the curves (the request's `spacing`: "parameter", "arc_length", "natural" or "auto"):
+
+    .venv/bin/python scripts/compare_models.py models --count 200 --spacing parameter arc_length natural auto
 """
 
 from __future__ import annotations
@@ -28,6 +32,9 @@ def main() -> None:
     p.add_argument("model_dirs", nargs="+", help="exported model directories (the first is the reference)")
     p.add_argument("--count", type=int, default=100, help="curves per suite set")
     p.add_argument("--placement", choices=["manifest", "index", "closest"], nargs="+", default=["manifest"])
+    p.add_argument(
+        "--spacing", choices=["parameter", "arc_length", "natural", "auto"], nargs="+", default=["parameter"]
+    )
     p.add_argument("--out", default=None, help="also write the table as JSON here")
     a = p.parse_args()
     sets = suite_sets(paper_test_split(), count=a.count)
@@ -37,11 +44,16 @@ def main() -> None:
             runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
             if placement != "manifest":
                 runtime.closest_placement = placement == "closest"
-            label = f"{runtime.manifest['version']} ({model_dir}{'' if placement == 'manifest' else ', ' + placement})"
-            start = time.perf_counter()
-            report = run_suite(runtime, sets)
-            columns[label] = {"seconds": time.perf_counter() - start, "sets": report}
-            print(f"measured {label}: {columns[label]['seconds']:.0f} s", flush=True)
+            for spacing in a.spacing:
+                how = [
+                    *([] if placement == "manifest" else [placement]),
+                    *([] if spacing == "parameter" else [spacing]),
+                ]
+                label = f"{runtime.manifest['version']} ({', '.join([model_dir, *how])})"
+                start = time.perf_counter()
+                report = run_suite(runtime, sets, spacing=spacing)
+                columns[label] = {"seconds": time.perf_counter() - start, "sets": report}
+                print(f"measured {label}: {columns[label]['seconds']:.0f} s", flush=True)
     first = next(iter(columns.values()))["seconds"]
     labels = list(columns)
     print(f"\n| set | {' | '.join(labels)} |\n|---|{'---|' * len(labels)}")

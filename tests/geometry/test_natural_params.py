@@ -88,3 +88,12 @@ def test_the_natural_reading_says_where_the_callers_points_sit():
     # the caller's points, read back from the model's points at their fractions, are where they were
     back = np.stack([np.interp(fractions, np.linspace(0, 1, 161), m[:, k]) for k in range(2)], axis=1)
     assert _rel(back, drawn) < 1e-3
+
+
+def test_a_curve_that_turns_alike_at_both_ends_is_fitted_either_way_it_is_listed():
+    a = np.linspace(0.0, 0.8 * np.pi, 161)
+    arc = np.stack([np.cos(a), np.sin(a)], axis=1)  # turns evenly: the turning's centre is at the middle, to rounding
+    for c in (arc, arc[::-1], arc * [-1.0, 1.0]):
+        u = natural_params(c)
+        assert u[0] == 0.0 and u[-1] == 1.0 and np.all(np.diff(u) >= 0)
+        np.testing.assert_allclose(u, np.linspace(0, 1, 161), atol=0.02)  # an arc's even spacing fits as it is
