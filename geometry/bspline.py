@@ -184,10 +184,10 @@ def natural_params(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: int
     in its parameter — one of the paper's curves — could have, whatever spacing it was drawn at. The shape does not
     pin the parameters everywhere (along gentle stretches many fit about as well) and the fit stops after `steps`,
     so a paper curve drawn by arc length is read nearer its own spacing, not at it (median 8.6% of the diagonal
-    point by point, against 15.5% as drawn: docs/RESULTS.md, "Reading a curve at its natural spacing"). The parameters follow the
-    shape: they do not change when the curve is moved, turned, scaled or mirrored, and a reversed curve gets
-    1 − u reversed (the fit starts from the end the curve turns most towards, whichever way it is listed). Curves
-    of fewer than 2·n_ctrl points keep their arc-length fractions.
+    point by point, against 15.5% as drawn: docs/RESULTS.md, "Reading a curve at its natural spacing"). The
+    parameters follow the shape: they do not change when the curve is moved, turned, scaled or mirrored, and a
+    reversed curve gets 1 − u reversed (the fit starts from the end the curve turns most towards, whichever way it
+    is listed). Curves of fewer than 2·n_ctrl points keep their arc-length fractions.
     """
     pts = np.asarray(points, np.float64)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
