@@ -35,7 +35,7 @@ class Augmenting:
         seed: int,
         neighbours: int | None = None,
         frame: FrameMode = "auto",
-        spacing: Spacing = "parameter",
+        spacing: Spacing = "auto",
         pose: PoseMode = "auto",
     ) -> AugmentPlan:
         """Encode the seed curves once and fix who may be mixed with whom; see `AugmentPlan`.

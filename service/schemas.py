@@ -226,7 +226,7 @@ class EncodeRequest(_Request):
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
     frame: FrameMode = "auto"
     pose: PoseMode = "auto"
-    spacing: SpacingMode = "parameter"
+    spacing: SpacingMode = "auto"
     refine: RefineSteps = 0
 
 
@@ -283,7 +283,7 @@ class ReconstructRequest(_Request):
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
     frame: FrameMode = "auto"
     pose: PoseMode = "auto"
-    spacing: SpacingMode = "parameter"
+    spacing: SpacingMode = "auto"
     refine: RefineSteps = 0
     n_points: NPoints = None
     output: OutputMode = "points"
@@ -321,7 +321,7 @@ class InterpolateRequest(_Request):
     )
     frame: FrameMode = "auto"
     pose: PoseMode = "auto"
-    spacing: SpacingMode = "parameter"
+    spacing: SpacingMode = "auto"
     refine: RefineSteps = 0
     n_points: NPoints = None
     output: OutputMode = "points"
@@ -442,7 +442,7 @@ class AugmentRequest(_Request):
     )
     frame: FrameMode = "auto"
     pose: PoseMode = "auto"
-    spacing: SpacingMode = "parameter"
+    spacing: SpacingMode = "auto"
     n_points: NPoints = None
     output: OutputMode = "points"
     metrics: MetricsFlag = False

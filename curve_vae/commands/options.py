@@ -117,7 +117,11 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
         "--n-points", type=int, default=None, help="points per curve (default: the model's 161, or the inputs' length)"
     )
     p.add_argument(
-        "--spacing", choices=["parameter", "arc_length"], default="parameter", help="point spacing (default: parameter)"
+        "--spacing",
+        choices=["parameter", "arc_length", "natural", "auto"],
+        default="auto",
+        help="how the seed curves' points are read, as the service's `spacing` (default: auto, the closer of the "
+        "points as given and their natural spacing)",
     )
     p.add_argument(
         "--metrics", action="store_true", help="add smoothness, self-intersection and length per curve (JSON only)"

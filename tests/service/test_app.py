@@ -57,10 +57,10 @@ def test_decode_in_the_model_plane_and_in_a_frame(client, runtime):
 
 
 def test_encode_then_decode_in_the_returned_frames_is_the_reconstruction(client, curves):
-    c = (curves(2) * 3 - 11).tolist()
-    enc = client.post("/encode", json={"curves": c}).json()
+    c = (curves(2) * 3 - 11).tolist()  # read as given (spacing "parameter"): the returned points are the model's
+    enc = client.post("/encode", json={"curves": c, "spacing": "parameter"}).json()
     dec = client.post("/decode", json={"latents": enc["mean"], "frames": enc["frames"]}).json()
-    rec = client.post("/reconstruct", json={"curves": c}).json()
+    rec = client.post("/reconstruct", json={"curves": c, "spacing": "parameter"}).json()
     np.testing.assert_allclose(dec["curves"], rec["curves"], rtol=1e-6, atol=1e-6)
 
 

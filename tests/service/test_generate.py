@@ -144,7 +144,15 @@ def test_the_stream_holds_one_chunk_at_a_time(make_client, runtime, monkeypatch)
     monkeypatch.setattr(runtime, "decode_model_splines", lambda z: seen.append(len(z)) or decode(z))
     r = client.post(
         "/augment",
-        json={"curves": [CURVE, CURVE[::-1]], "count": 1000, "format": "npy", "seed": 1, "pose": "as_is"},
+        # one reading of each seed in one pose: no decoding before the stream's (spacing "auto" decodes to choose)
+        json={
+            "curves": [CURVE, CURVE[::-1]],
+            "count": 1000,
+            "format": "npy",
+            "seed": 1,
+            "pose": "as_is",
+            "spacing": "parameter",
+        },
     )
     assert r.status_code == 200 and len(r.content) == 128 + 1000 * 7 * 2 * 4
     assert max(seen) == runtime.batch_size and sum(seen) == 1000

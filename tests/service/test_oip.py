@@ -304,11 +304,11 @@ def test_integral_numbers_are_integers_in_a_shape(client):
 
 
 def test_raw_tensors_are_what_the_rest_routes_send_in_the_model_plane(client, runtime):
-    """/encode with frame "model" at the model's point count, and /decode without frames, run the same graphs on the
-    same tensors as /v2 (what docs/DEPLOYMENT.md tells a Triton client)."""
+    """/encode with frame "model" and spacing "parameter" at the model's point count, and /decode without frames,
+    run the same graphs on the same tensors as /v2 (what docs/DEPLOYMENT.md tells a Triton client)."""
     curves = bspline_curves(2, seed=9)
     raw = outputs_of(client.post("/v2/models/encoder/infer", json={"inputs": [tensor("curves", curves)]}).json())
-    rest = client.post("/encode", json={"curves": curves.tolist(), "frame": "model"}).json()
+    rest = client.post("/encode", json={"curves": curves.tolist(), "frame": "model", "spacing": "parameter"}).json()
     np.testing.assert_allclose(rest["mean"], raw["mean"], atol=1e-5)
     np.testing.assert_allclose(rest["log_var"], raw["log_var"], atol=1e-5)
     decoded = outputs_of(

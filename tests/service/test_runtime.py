@@ -137,7 +137,7 @@ def test_reconstruction_follows_scale_and_shift(runtime, curves, scale, shift, n
 
 def test_model_frame_passes_coordinates_untouched(raw_runtime, curves):
     c = curves(2)
-    out, mse = raw_runtime.reconstruct(list(c), frame="model")
+    out, mse = raw_runtime.reconstruct(list(c), frame="model", spacing="parameter")  # the points as given
     mean, _ = raw_runtime.encode_model(c)
     direct = raw_runtime.decode_model(mean)
     np.testing.assert_array_equal(np.stack(out), direct.astype(np.float64))
@@ -149,7 +149,7 @@ def test_spline_head_points_are_the_spline_at_its_params(runtime, curves):
     the model's frame at its 161 points they are the graph's own curves (to float32 rounding)."""
     c = curves(2)
     splines: list = []
-    out, _ = runtime.reconstruct(list(c), frame="model", splines=splines)
+    out, _ = runtime.reconstruct(list(c), frame="model", spacing="parameter", splines=splines)
     direct = runtime.decode_model(runtime.encode_model(c)[0])
     np.testing.assert_allclose(np.stack(out), direct, rtol=0, atol=1e-4)
     for curve, spline in zip(out, splines, strict=True):
@@ -160,7 +160,7 @@ def test_spline_head_points_are_the_spline_at_its_params(runtime, curves):
 def test_auto_frame_maps_into_and_out_of_the_model_frame(runtime, curves):
     c = curves(1)[0] * 0.01 + 5.0
     frame = fit_frame(c)
-    mean, _, frames = runtime.encode([c], pose="as_is")
+    mean, _, frames = runtime.encode([c], pose="as_is", spacing="parameter")
     assert frames == [frame]
     mean_model, _ = runtime.encode_model(frame.to_model(c, runtime.model_size)[None])
     np.testing.assert_allclose(mean, mean_model, atol=1e-5)
@@ -258,7 +258,7 @@ def test_interpolants_keep_a_common_input_length(runtime, curves):
 def test_n_way_weights_mix_latent_means(runtime, curves):
     c = list(curves(4, 161, seed=7))
     w = np.array([[0.25, 0.25, 0.25, 0.25], [1.5, -0.5, 0.0, 0.0]])
-    out, frames = runtime.interpolate(c, w, frame="model")
+    out, frames = runtime.interpolate(c, w, frame="model", spacing="parameter")
     mean, _ = runtime.encode_model(np.stack(c))
     np.testing.assert_allclose(out, runtime.decode_model(w @ mean.astype(np.float64)), atol=1e-5)
     assert frames == [None, None]
