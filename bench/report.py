@@ -15,6 +15,7 @@ ROW_LABELS = {
     "B_npy": "B with .npy bodies",
     "latency_1": "/reconstruct, 1 curve, 1 connection",
     "latency_1_pose_auto": '/reconstruct, 1 curve, pose "auto" (6 poses), 1 connection',
+    "latency_1_default": '/reconstruct, 1 curve, the defaults (pose, spacing "auto": 12 readings), 1 connection',
     "interpolate": "/interpolate, pair, 5 steps, 16 connections",
     "interpolate_pose_auto": '/interpolate, pair, 5 steps, pose "auto", 16 connections',
     "spinning": "B, spinning on (`--spinning true`)",

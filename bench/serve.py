@@ -7,8 +7,9 @@
 It starts `python -m curve_vae.service.cli` (uvicorn, the service's defaults unless a run says otherwise) on a
 loopback port for each configuration, drives it with wrk (POST bodies from a small Lua script, tests/bench run through
 `bench/post.lua`), and reads the server's CPU time from /proc (all its processes), so the server's cost per
-request shows apart from wrk's. Single-curve requests use pose "as_is" (one encoder and one decoder run per
-curve: the ceiling's unit of work); the default pose "auto" tries six poses, 6x the inference. The report is a
+request shows apart from wrk's. Requests use pose "as_is" and spacing "parameter" (one encoder and one decoder run
+per curve: the ceiling's unit of work); the default pose "auto" tries six poses, 6x the inference, and the default
+spacing "auto" two readings of each (the breakdown's last line: one curve, in-process). The report is a
 Markdown section (`bench.report`; printed, and written with --markdown FILE) and JSON (--json FILE).
 """
 
@@ -185,11 +186,13 @@ def augment(server: Server, seeds: np.ndarray, count: int) -> dict[str, float]:
     got = 0
     for offset in range(0, count, page):
         n = min(page, count - offset)
-        body = json_body(seeds, count=n, offset=offset, seed=1, pose="as_is")
+        body = json_body(seeds, count=n, offset=offset, seed=1, pose="as_is", spacing="parameter")
         got += len(json.loads(post(f"{server.url}/augment", body))["curves"])
     json_s = time.perf_counter() - start
     start = time.perf_counter()
-    data = post(f"{server.url}/augment", json_body(seeds, count=count, seed=1, pose="as_is", format="npy"))
+    data = post(
+        f"{server.url}/augment", json_body(seeds, count=count, seed=1, pose="as_is", spacing="parameter", format="npy")
+    )
     npy_s = time.perf_counter() - start
     assert got == count and np.load(io.BytesIO(data)).shape[0] == count
     return {"count": count, "json_s": json_s, "npy_s": npy_s, "json_cps": count / json_s, "npy_cps": count / npy_s}
@@ -257,7 +260,7 @@ def _load(
 
 def _single() -> bytes:
     """B's body: one curve, JSON, pose as_is."""
-    return json_body(ceiling.curves(1, seed=1), pose="as_is")
+    return json_body(ceiling.curves(1, seed=1), pose="as_is", spacing="parameter")
 
 
 def _default_server_runs(
@@ -270,19 +273,20 @@ def _default_server_runs(
     server = Server(model_dir)
     try:
         if "A" in runs:
-            r = load("A", server, "/reconstruct", json_body(many, pose="as_is"), c=2)
+            r = load("A", server, "/reconstruct", json_body(many, pose="as_is", spacing="parameter"), c=2)
             r["curves_per_s"] = r["rps"] * 128
         if "B" in runs:
             load("B", server, "/reconstruct", single)
         if "B_npy" in runs:
-            load("B_npy", server, "/reconstruct?pose=as_is", npy_body(one), "application/x-npy")
+            load("B_npy", server, "/reconstruct?pose=as_is&spacing=parameter", npy_body(one), "application/x-npy")
         if "latency" in runs:
             load("latency_1", server, "/reconstruct", single, c=1)
-            load("latency_1_pose_auto", server, "/reconstruct", json_body(one), c=1)
+            load("latency_1_pose_auto", server, "/reconstruct", json_body(one, spacing="parameter"), c=1)
+            load("latency_1_default", server, "/reconstruct", json_body(one), c=1)
         if "interpolate" in runs:
             pair = ceiling.curves(2, seed=3)
-            load("interpolate", server, "/interpolate", json_body(pair, steps=5, pose="as_is"))
-            load("interpolate_pose_auto", server, "/interpolate", json_body(pair, steps=5))
+            load("interpolate", server, "/interpolate", json_body(pair, steps=5, pose="as_is", spacing="parameter"))
+            load("interpolate_pose_auto", server, "/interpolate", json_body(pair, steps=5, spacing="parameter"))
         if "augment" in runs:
             print("augment ...", file=sys.stderr)
             report["augment"] = augment(server, ceiling.curves(8, seed=4), augment_count)

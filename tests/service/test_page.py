@@ -215,7 +215,7 @@ def test_fit_closely_refines_the_reconstructions_and_the_mix(browser, server):
     )
     fitted = state(page)
     assert fitted["recon"][0]["mse"] < plain["recon"][0]["mse"] / 2, (plain["recon"][0], fitted["recon"][0])
-    body = {"curves": fitted["curves"], "spacing": "arc_length", "n_points": 100, "output": "both", "refine": 10}
+    body = {"curves": fitted["curves"], "spacing": "auto", "n_points": 100, "output": "both", "refine": 10}
     answer = httpx.post(server.url + "/reconstruct", json=body, timeout=30).json()
     np.testing.assert_allclose(drawn(page, "path.reconstruction >> nth=0"), answer["curves"][0], atol=2e-3)
     mix = httpx.post(server.url + "/interpolate", json=fitted["result"]["body"], timeout=30).json()
