@@ -9,13 +9,12 @@ without HTTP:
         --encoder--> mean, log_var --(affine mix)--> decoder --> (161, 2) in the model plane
         --polyline_to_caller / spline_to_caller: n points, same spacing--> caller's frame
 
-With frame "model" the frame steps are skipped. Resampling ("spacing"): by default a curve's
-points are taken as given and interpolated along the index ("parameter": the paper's B-spline
-samples are spaced so, and the default model was also trained at arc-length and uneven spacings);
-a 161-point curve then passes untouched and 50, 160 or 500 points of the same curve give the same
-model input. "arc_length" resamples evenly by arc length instead, "natural" at even steps of the parameters of the
-cubic B-spline that fits the points closest (the paper's curves' spacing, whatever the caller's), and "auto" tries
-the given and the natural reading and keeps the closer reconstruction (geometry.adapt). Nothing here
+With frame "model" the frame steps are skipped. Resampling ("spacing"): "parameter" takes a curve's points as
+given and interpolates along the index (the paper's B-spline samples are spaced so); a 161-point curve then passes
+untouched and 50, 160 or 500 points of the same curve give the same model input. "natural" reads the curve at even
+steps of the parameters of the cubic B-spline fitted to it (the paper's curves' spacing, recovered in part),
+"arc_length" evenly by arc length (geometry.adapt), and "auto", the default, tries "parameter" and "natural" and
+keeps the closer reconstruction, as pose "auto" does with poses. Nothing here
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 

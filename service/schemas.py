@@ -74,18 +74,18 @@ SpacingMode = Annotated[
     Literal["parameter", "arc_length", "natural", "auto"],
     Field(
         description=(
-            'How points are spaced along a curve. "parameter" (default): points are taken as given and interpolated '
-            "along their order — the paper's B-spline samples are spaced so, and the default model was also trained "
-            "on points spaced by arc length and unevenly; 50, 161 or 500 samples of a curve give the same result. "
-            '"arc_length": every curve is resampled evenly by arc length first, and returned curves are spaced so '
-            "(with the default model, better for spirals and sharp-cornered arcs, worse for airfoils). "
-            '"natural": every curve is read at even steps of the parameters of the cubic B-spline with 10 control '
-            "points that fits its points closest — the spacing of the paper's curves, whatever the curve's own. "
-            '"auto": both the points as given and the natural reading are tried (in every pose) and the '
-            "reconstruction closest to the input is kept: the closest answer for drawn strokes, coordinate files and "
-            'curves spaced by arc length (docs/RESULTS.md), at about 2.7× the compute of "parameter". Returned '
-            'curves of `n_points` with "parameter", "natural" or "auto" are at the model\'s own spacing: evenly in '
-            "its spline parameter, or where a head that learns its points' parameters places them (GET /model: "
+            'How the points of a curve are read. "auto" (the default wherever curves are posted): the two readings '
+            'below, "parameter" and "natural", are both tried (in every pose) and the reconstruction closest to the '
+            "input is kept — at least as close as either on every family of the evaluation suite, and the closest for "
+            "drawn strokes, coordinate files and curves spaced by arc length, at about 2.6× the CPU of "
+            '"parameter" for one curve (docs/RESULTS.md). "parameter": the points as given, interpolated along '
+            "their order (the paper's curves are spaced so; 50, 161 or 500 samples of a curve give the same result) "
+            '— the fast path. "natural": the curve read at even steps of the parameters of the cubic B-spline with '
+            "10 control points fitted to it (the paper's curves' spacing, recovered in part, whatever the curve's "
+            'own). "arc_length": every curve resampled evenly by arc length, and returned curves spaced so. Returned '
+            'curves of `n_points` with "parameter", "natural" or "auto" (and /decode\'s and /sample\'s, whose '
+            'default is "parameter") are at the model\'s own spacing: evenly in its spline parameter, or where a head '
+            "that learns its points' parameters places them (GET /model: "
             "spline.learned_params)."
         )
     ),
