@@ -97,3 +97,12 @@ def test_a_curve_that_turns_alike_at_both_ends_is_fitted_either_way_it_is_listed
         u = natural_params(c)
         assert u[0] == 0.0 and u[-1] == 1.0 and np.all(np.diff(u) >= 0)
         np.testing.assert_allclose(u, np.linspace(0, 1, 161), atol=0.02)  # an arc's even spacing fits as it is
+
+
+def test_a_long_curve_is_fitted_on_some_of_its_points_and_the_rest_follow_by_arc_length():
+    c = _paper_curves(1)[0]
+    few, many = resample(c, 161), resample(c, 4096)  # both evenly by arc length: index fraction = arc fraction
+    u_few, u_many = natural_params(few), natural_params(many)  # the second fits 321 of its points (bounded cost)
+    np.testing.assert_allclose(np.interp(np.linspace(0, 1, 161), np.linspace(0, 1, 4096), u_many), u_few, atol=2e-3)
+    assert u_many[0] == 0.0 and u_many[-1] == 1.0 and np.all(np.diff(u_many) >= 0)
+    np.testing.assert_allclose(natural_params(many[::-1]), 1.0 - u_many[::-1], atol=1e-9)
