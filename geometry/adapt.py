@@ -5,7 +5,8 @@ curve there — through its `Frame` when it has one (frame.py), then to `n_point
 point index with spacing "parameter" (the caller's own spacing kept, so a curve of `n_points`
 passes untouched),
 evenly by arc length with "arc_length", at even steps of the parameters of the cubic B-spline that fits it
-closest with "natural" (`bspline.natural_params`: the spacing of the paper's curves, whatever the caller's) — and
+closest with "natural" (`bspline.natural_params`: a spacing the paper's curves could have, whatever the
+caller's) — and
 says where each of the caller's points sits along
 the result. `polyline_to_caller` and `spline_to_caller` bring a model-plane result back: at those
 positions, or at any count spaced as asked, mapped through the frame. From a B-spline head's
