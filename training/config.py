@@ -60,6 +60,8 @@ class ModelConfig:
 
 SCHEDULES = ("onecycle", "cosine", "constant", "plateau")
 MATCHES = ("index", "closest", "twin", "mixed")
+#: The matches that learn from each curve beside its twin (DataConfig.twins).
+TWIN_MATCHES = ("twin", "mixed")
 
 
 @dataclass(frozen=True)

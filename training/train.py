@@ -5,7 +5,7 @@ twin: (N, 2, n_points, 2)): the model owns the architecture, `losses` owns the o
 picks. Run under `torchrun --nproc-per-node K` for data-parallel training (gloo on CPU, nccl on GPU); a single
 process needs no launcher. Checkpoint files are training/checkpoint.py's.
 
-Length (~540 lines): the step (and its three objectives), the schedules, the clock of a time budget and the
+Length (~550 lines): the step (and its four objectives), the schedules, the clock of a time budget and the
 run's named steps share RunState, _Parts (model, optimiser, schedule, clock, generator) and the DDP process;
 `train()` itself (~60 lines) reads top to bottom: set-up, then each epoch's pass, validation, record and stop
 rules.
@@ -37,7 +37,7 @@ from curve_vae.training.checkpoint import (
     widen,
     without_resume_state,
 )
-from curve_vae.training.config import SCHEDULES, ModelConfig, TrainConfig
+from curve_vae.training.config import SCHEDULES, TWIN_MATCHES, ModelConfig, TrainConfig
 from curve_vae.training.data import DataConfig, load_or_generate
 from curve_vae.training.losses import closest_loss, mixed_loss, vae_loss
 from curve_vae.training.model import SAMPLES_PER_INTERVAL, VAE
@@ -257,7 +257,7 @@ def _load_splits(
             ds = load_or_generate(data_cfg, cache)
     assert ds is not None
     train_np = ds.train[: cfg.train_limit] if cfg.train_limit else ds.train
-    if cfg.match in ("twin", "mixed"):  # each curve with its twin: (n, 2, N, 2)
+    if cfg.match in TWIN_MATCHES:  # each curve with its twin: (n, 2, N, 2)
         if ds.train_twins is None:
             raise ValueError(f'match {cfg.match!r} needs a data set with twins (mix "broad", DataConfig.twins)')
         train_np = np.stack([train_np, ds.train_twins[: len(train_np)]], axis=1)
@@ -277,9 +277,6 @@ class _Parts:
 
 
 def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_per_epoch: int) -> _Parts:
-    if cfg.match == "mixed" and (not model_cfg.spline_ctrl or model_cfg.spline_params):
-        # its index half measures the decoder's even parameters, which learned parameters would not serve
-        raise ValueError('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
     model = VAE(model_cfg).to(proc.device)
     trained = (
         model.learn_only_params()
@@ -506,6 +503,9 @@ def train(
     run_dir = Path(run_dir)
     if cfg.match != "index" and not model_cfg.spline_ctrl:
         raise ValueError(f"match {cfg.match!r} measures the decoded spline: it needs the B-spline head (--spline-ctrl)")
+    if cfg.match == "mixed" and model_cfg.spline_params:
+        # its index half measures the decoder's even parameters, which learned parameters would not serve
+        raise ValueError('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
     proc = _start_process(cfg)
     try:
         torch.manual_seed(cfg.seed)

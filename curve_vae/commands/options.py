@@ -64,6 +64,7 @@ def data_path(a: argparse.Namespace, config: Any) -> Path:
 
 
 def data_config(a: argparse.Namespace):
+    from curve_vae.training.config import TWIN_MATCHES
     from curve_vae.training.data import DataConfig
 
     mix = "files" if a.curves else a.mix
@@ -77,7 +78,7 @@ def data_config(a: argparse.Namespace):
         mix=mix,
         source=a.curves or "",
         mix_version=a.mix_version if mix == "broad" else 0,
-        twins=getattr(a, "match", "") in ("twin", "mixed"),  # match "twin" or "mixed" learns from each curve's twin
+        twins=getattr(a, "match", "") in TWIN_MATCHES,  # these matches learn from each curve beside its twin
     )
 
 
