@@ -15,7 +15,6 @@ from curve_vae.geometry.bspline import (
     evaluate_bspline,
     fit_bspline,
     fit_bspline_auto,
-    natural_params,
     params_at_arc_fractions,
     random_control_points,
     sample_bspline,
@@ -42,6 +41,7 @@ from curve_vae.geometry.metrics import (
     turning_angles,
 )
 from curve_vae.geometry.mixing import simplex_grid, simplex_grid_size
+from curve_vae.geometry.natural import natural_params, natural_readings
 
 __all__ = [
     "arc_length_params",
@@ -60,6 +60,7 @@ __all__ = [
     "fit_bspline",
     "fit_bspline_auto",
     "natural_params",
+    "natural_readings",
     "fit_frame",
     "mse_per_curve",
     "params_at_arc_fractions",

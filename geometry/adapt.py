@@ -5,7 +5,7 @@ curve there — through its `Frame` when it has one (frame.py), then to `n_point
 point index with spacing "parameter" (the caller's own spacing kept, so a curve of `n_points`
 passes untouched),
 evenly by arc length with "arc_length", at even steps of the parameters of the cubic B-spline that fits it
-closest with "natural" (`bspline.natural_params`: a spacing the paper's curves could have, whatever the
+closest with "natural" (`natural.natural_params`: a spacing the paper's curves could have, whatever the
 caller's) — and
 says where each of the caller's points sits along
 the result. `polyline_to_caller` and `spline_to_caller` bring a model-plane result back: at those
@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline, natural_params, sample_bspline
+from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline, sample_bspline
 from curve_vae.geometry.frame import Frame, arc_fractions, at_fractions, resample
+from curve_vae.geometry.natural import natural_params
 
 #: Largest float32: the graphs' input type, so the bound of a model-plane coordinate.
 F32_MAX = float(np.finfo(np.float32).max)

@@ -154,105 +154,20 @@ def closest_params(
     return u
 
 
-def _basis_and_slope(u: np.ndarray, knots: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray]:
+def basis_and_slope(u: np.ndarray, knots: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray]:
     """Basis (m, n_ctrl) of a clamped B-spline at parameters u (m,) and its derivative in u: N'_j = k·(N_{j,k-1} ÷
     (t_{j+k} − t_j) − N_{j+1,k-1} ÷ (t_{j+k+1} − t_{j+1}))."""
     u = np.clip(u, 0.0, 1.0)
-    basis = BSpline.design_matrix(u, knots, degree).toarray()
+    # extrapolate=True skips scipy's range check of u (a Python min and max over it): u is clipped to [0, 1] above
+    basis = BSpline.design_matrix(u, knots, degree, extrapolate=True).toarray()
     n = basis.shape[1]
-    low = BSpline.design_matrix(u, knots[1:-1], degree - 1).toarray()  # (m, n-1): N_{j,k-1} for j = 1 … n-1
+    low = BSpline.design_matrix(u, knots[1:-1], degree - 1, extrapolate=True).toarray()  # N_{j,k-1}, j = 1 … n-1
     span = knots[degree + 1 : degree + n] - knots[1:n]
     w = low * np.where(span > 0, degree / np.where(span > 0, span, 1.0), 0.0)
     slope = np.zeros_like(basis)
     slope[:, 1:] += w
     slope[:, :-1] -= w
     return basis, slope
-
-
-#: Control points of the spline whose parameters `natural_params` finds: the paper's curves have 10.
-NATURAL_CTRL = 10
-
-
-def natural_params(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: int = 40) -> np.ndarray:
-    """Where each point of a polyline (n, 2) sits, as a parameter in [0, 1], on a clamped uniform cubic B-spline
-    with `n_ctrl` control points that passes close to the points: the spline and the points' parameters fitted
-    together by `steps` Levenberg–Marquardt steps (the parameters eliminated by their Schur complement, so a step
-    solves a 2·n_ctrl system) from the points' arc-length fractions. The ends stay at 0 and 1, the parameters in
-    order.
-
-    Reading a curve at even steps of these parameters gives it a spacing that a 10-point B-spline sampled evenly
-    in its parameter — one of the paper's curves — could have, whatever spacing it was drawn at. The shape does not
-    pin the parameters everywhere (along gentle stretches many fit about as well) and the fit stops after `steps`,
-    so a paper curve drawn by arc length is read nearer its own spacing, not at it (point by point, 13% of the
-    diagonal off it against 17% as drawn, median of 200: scripts/natural_spacing.py). The
-    parameters follow the shape: they do not change when the curve is moved, turned, scaled or mirrored, and a
-    reversed curve gets 1 − u reversed (the fit starts from the end the curve turns most towards, whichever way it
-    is listed). Curves of fewer than 2·n_ctrl points keep their arc-length fractions; of a curve of more than
-    NATURAL_FIT_POINTS points, that many are fitted and the rest interpolated by arc length between them.
-    """
-    pts = np.asarray(points, np.float64)
-    extent = float(np.ptp(pts, axis=0).max()) if len(pts) else 0.0
-    if not extent > 0:
-        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
-    pts = (pts - pts[0]) / extent  # the shape alone, at a size where squares neither underflow nor overflow
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-    u = s / s[-1]
-    if len(pts) < 2 * n_ctrl:
-        return u
-    seg = np.diff(pts, axis=0)
-    turn = np.abs(np.arctan2(np.cross(seg[:-1], seg[1:]), (seg[:-1] * seg[1:]).sum(1)))
-    if turn.sum() > 0 and (turn * u[1:-1]).sum() / turn.sum() > 0.5:
-        # fitted from the end where the curve turns most, whichever way it is listed: a curve and its reversal get
-        # the same parameters to rounding (the fit's path from its start is not symmetric in the order)
-        back = pts[::-1]
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(back, axis=0), axis=1))])
-        return (1.0 - _fit_params(back, s / s[-1], n_ctrl, steps))[::-1]
-    return _fit_params(pts, u, n_ctrl, steps)
-
-
-#: Most points `natural_params` fits; the parameters of the points between them are interpolated by arc length, so
-#: a curve of 4,096 points costs what one of 321 does.
-NATURAL_FIT_POINTS = 321
-
-
-def _fit_params(pts: np.ndarray, u: np.ndarray, n_ctrl: int, steps: int) -> np.ndarray:
-    """`natural_params`' fit from parameters u (the points' arc-length fractions), the points as listed."""
-    if len(pts) > NATURAL_FIT_POINTS:
-        some = np.unique(np.round(np.linspace(0, len(pts) - 1, NATURAL_FIT_POINTS)).astype(int))
-        return np.interp(u, u[some], _fit_params(pts[some], u[some], n_ctrl, steps))
-    knots = clamped_uniform_knots(n_ctrl, 3)
-    basis, slope = _basis_and_slope(u, knots, 3)
-    ctrl = np.linalg.lstsq(basis, pts, rcond=None)[0]
-    r = basis @ ctrl - pts
-    cost, damping = float((r**2).sum()), 1e-3
-    for _ in range(steps):
-        tangent = slope @ ctrl
-        tangent[[0, -1]] = 0.0  # the ends stay where they are
-        uu = (tangent**2).sum(1) * (1 + damping) + 1e-12  # the parameters' block: diagonal, one per point
-        btb = basis.T @ basis
-        cc = np.kron(np.eye(2), btb)
-        cc += damping * np.diag(np.diag(cc))
-        cu = np.concatenate([basis * tangent[:, :1], basis * tangent[:, 1:]], axis=1).T  # (2·n_ctrl, n)
-        gc, gu = np.concatenate([basis.T @ r[:, 0], basis.T @ r[:, 1]]), (tangent * r).sum(1)
-        try:
-            dc = np.linalg.solve(cc - (cu / uu) @ cu.T, gc - cu @ (gu / uu))
-        except np.linalg.LinAlgError:
-            break
-        du = (gu - cu.T @ dc) / uu
-        trial_u = np.maximum.accumulate(np.clip(u - du, 0.0, 1.0))
-        trial_u[0], trial_u[-1] = 0.0, 1.0
-        trial_ctrl = ctrl - dc.reshape(2, n_ctrl).T
-        trial_basis, trial_slope = _basis_and_slope(trial_u, knots, 3)
-        trial_r = trial_basis @ trial_ctrl - pts
-        trial_cost = float((trial_r**2).sum())
-        if trial_cost < cost:  # a step is kept only where it brings the spline closer
-            u, ctrl, basis, slope, r, cost = trial_u, trial_ctrl, trial_basis, trial_slope, trial_r, trial_cost
-            damping = max(damping / 3, 1e-9)
-        else:
-            damping *= 4
-            if damping > 1e8:
-                break
-    return u
 
 
 @dataclass(frozen=True)

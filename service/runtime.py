@@ -45,6 +45,7 @@ from curve_vae.geometry import (
     fit_frame,
     mse_per_curve,
     natural_params,
+    natural_readings,
     polyline_to_caller,
     pose_frames,
     self_intersects,
@@ -61,8 +62,6 @@ from curve_vae.service.sampling import Sampling
 
 FrameMode = Literal["auto", "model"]
 Spacing = Literal["parameter", "arc_length", "natural", "auto"]
-#: The readings of a curve that spacing "auto" tries, each in every pose: the reconstruction closest to the input wins.
-AUTO_READINGS: tuple[Spacing, ...] = ("parameter", "natural")
 PoseMode = Literal["auto", "as_is"]
 #: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
@@ -91,6 +90,39 @@ class Prepared:
     params: np.ndarray | None = None  # (B, n_points) spline parameter of each model point, if the head learns them
     # With refine, the latents are fitted (service.fitting) and each input point is matched to its closest point:
     feet: list[np.ndarray] | None = None  # per curve, the spline parameter (model order) of each input point
+
+
+@dataclass
+class _Candidates:
+    """Readings of caller curves tried on the model (several per curve, in any order): what `_prepare` chooses
+    from, each measured by how far its reconstruction is from its model-plane points (`err`)."""
+
+    owner: list[int]  # the curve each candidate reads
+    model: np.ndarray
+    frames: list[Frame | None]
+    fractions: list[np.ndarray | None]
+    mean: np.ndarray
+    log_var: np.ndarray
+    decoded: np.ndarray
+    ctrl: np.ndarray | None
+    params: np.ndarray | None
+    err: np.ndarray
+
+    def closest(self, inputs: list[np.ndarray]) -> Prepared:
+        """Each curve's candidate whose reconstruction came closest."""
+        owner = np.asarray(self.owner, int)
+        best = [int(np.flatnonzero(owner == i)[self.err[owner == i].argmin()]) for i in range(len(inputs))]
+        return Prepared(
+            self.model[best],
+            [self.frames[b] for b in best],
+            [self.fractions[b] for b in best],
+            inputs,
+            self.mean[best],
+            self.log_var[best],
+            self.decoded[best],
+            None if self.ctrl is None else self.ctrl[best],
+            None if self.params is None else self.params[best],
+        )
 
 
 @dataclass(frozen=True)
@@ -148,31 +180,52 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
 
     def _prepare(self, curves: Sequence[np.ndarray], frame: FrameMode, spacing: Spacing, pose: PoseMode) -> Prepared:
         posing = frame == "auto" and pose == "auto"
-        readings = AUTO_READINGS if spacing == "auto" else (spacing,)
-        rows, frames, fractions, inputs = [], [], [], []
+        first = "parameter" if spacing == "auto" else spacing
+        inputs, poses, naturals = [], [], []
         with np.errstate(all="ignore"):
             for i, c in enumerate(curves):
                 pts = np.asarray(c, dtype=np.float64)
                 inputs.append(pts)
                 try:
-                    candidates: list[Frame | None] = (
+                    poses.append(
                         list(pose_frames(pts, chords=POSE_CHORD_COUNT))
                         if posing
                         else [fit_frame(pts) if frame == "auto" else None]
                     )
-                    natural = natural_params(pts) if "natural" in readings else None  # the same in every pose
+                    # the natural parameters do not depend on the pose: fitted once; "auto" tries each fit's
+                    naturals.append(
+                        natural_readings(pts)
+                        if spacing == "auto"
+                        else [natural_params(pts)]
+                        if spacing == "natural"
+                        else [None]
+                    )
                 except ValueError as e:  # all points coincide
                     raise InputError(("curves", i), str(e)) from e
-                for f in candidates:
-                    for reading in readings:
-                        m, fraction = self._to_model_points(pts, f, reading, i, natural)
-                        rows.append(m)
-                        frames.append(f)
-                        fractions.append(fraction)
-        batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, self.n_points, 2), np.float32)
-        if not posing and len(readings) == 1:
-            return Prepared(batch, frames, fractions, inputs)
+        # every curve in every pose, read as the request says; "auto": its points as given and each natural reading
+        readings = [
+            [(first, naturals[i][0])] + ([("natural", n) for n in naturals[i]] if spacing == "auto" else [])
+            for i in range(len(inputs))
+        ]
+        stage = [(i, f, r, n) for i in range(len(inputs)) for f in poses[i] for r, n in readings[i]]
+        if len(stage) == len(inputs):  # one candidate each: nothing to choose, nothing encoded yet
+            with np.errstate(all="ignore"):
+                rows = [self._to_model_points(inputs[i], f, r, i, n) for i, f, r, n in stage]
+                batch = np.stack([m for m, _ in rows]) if rows else np.zeros((0, self.n_points, 2))
+            return Prepared(batch.astype(np.float32), [f for _, f, _, _ in stage], [fr for _, fr in rows], inputs)
+        return self._candidates(inputs, stage).closest(inputs)
+
+    def _candidates(
+        self, inputs: list[np.ndarray], stage: list[tuple[int, Frame | None, Spacing, np.ndarray | None]]
+    ) -> _Candidates:
+        """Candidate readings (curve index, frame, spacing, natural parameters) encoded, decoded and measured."""
+        rows, fractions = [], []
         with np.errstate(all="ignore"):
+            for i, f, reading, natural in stage:
+                m, fraction = self._to_model_points(inputs[i], f, reading, i, natural)
+                rows.append(m)
+                fractions.append(fraction)
+            batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, self.n_points, 2), np.float32)
             mean, log_var = self.encode_model(batch)
             _check_finite(mean, "curves", _ENCODE_OVERFLOW)
             _check_finite(log_var, "curves", _ENCODE_OVERFLOW)
@@ -181,18 +234,17 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
                 err = np.array([closest_squared_distances(b, d).sum() for b, d in zip(batch, decoded)])
             else:
                 err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
-        k = len(batch) // max(len(inputs), 1)  # every curve has the same number of candidates, in a row
-        best = list(np.arange(len(inputs)) * k + err.reshape(len(inputs), k).argmin(axis=1))
-        return Prepared(
-            batch[best],
-            [frames[b] for b in best],
-            [fractions[b] for b in best],
-            inputs,
-            mean[best],
-            log_var[best],
-            decoded[best],
-            None if ctrl is None else ctrl[best],
-            None if params is None else params[best],
+        return _Candidates(
+            [i for i, _, _, _ in stage],
+            batch,
+            [f for _, f, _, _ in stage],
+            fractions,
+            mean,
+            log_var,
+            decoded,
+            ctrl,
+            params,
+            err,
         )
 
     def _to_model_points(

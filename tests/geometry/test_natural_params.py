@@ -11,6 +11,7 @@ from curve_vae.geometry import (
     arc_fractions,
     clamped_uniform_knots,
     natural_params,
+    natural_readings,
     random_control_points,
     resample,
     sample_bspline,
@@ -47,20 +48,39 @@ def test_the_parameters_are_those_of_a_spline_that_passes_through_the_points():
         assert _fit_rms(drawn, u) < 3e-3 * np.hypot(*np.ptp(drawn, axis=0))
 
 
-def test_the_natural_reading_of_the_papers_curves_drawn_by_arc_length_comes_closer_to_their_own_spacing():
+def test_the_natural_reading_of_the_papers_curves_drawn_by_arc_length_finds_their_own_spacing_for_most():
     even = _paper_curves(30)
-    natural, drawn = [], []
+    natural, drawn, from_arc = [], [], []
     for c in even:
         by_arc = resample(c, 161)
+        readings = natural_readings(by_arc)
         read, _ = to_model_plane(by_arc, None, model_size=1.0, n_points=161, spacing="natural")
         natural.append(_rel(read, c))
         drawn.append(_rel(by_arc, c))
-    natural, drawn = np.array(natural), np.array(drawn)
-    # point by point against the samples evenly in the parameter: the shape does not pin the parameter everywhere
-    # (straight stretches), so the reading is nearer, not equal (scripts/natural_spacing.py: closer for 84% of 200 of
-    # the paper's test curves, median 13% of the diagonal against 17%)
-    assert np.median(natural) < 0.75 * np.median(drawn), (np.median(natural), np.median(drawn))
-    assert np.mean(natural < drawn) >= 0.7
+        read, _ = to_model_plane(by_arc, None, model_size=1.0, n_points=161, spacing="natural", natural=readings[-1])
+        from_arc.append(_rel(read, c))
+    natural, drawn, from_arc = np.array(natural), np.array(drawn), np.array(from_arc)
+    # point by point against the samples evenly in the parameter: most curves are read at their own spacing (to 0.1%
+    # of the diagonal), none of them as drawn, and far fewer by the fit from the arc-length fractions (the second
+    # reading, or the only one where that fit came closest; scripts/natural_spacing.py measures it on the paper's
+    # test curves)
+    assert np.mean(natural < 1e-3) >= 0.4, np.sort(natural)
+    assert np.mean(drawn < 1e-3) == 0 and np.mean(from_arc < 1e-3) <= 0.5 * np.mean(natural < 1e-3)
+    assert np.mean(natural < drawn) >= 0.8
+
+
+def test_the_readings_are_the_closest_fit_first_then_the_fit_from_the_arc_length_fractions():
+    for c in _paper_curves(8):
+        drawn = resample(c, 140)
+        readings = natural_readings(drawn)
+        assert 1 <= len(readings) <= 2
+        np.testing.assert_array_equal(readings[0], natural_params(drawn))
+        for u in readings:
+            assert u[0] == 0.0 and u[-1] == 1.0 and np.all(np.diff(u) >= 0)
+        assert _fit_rms(drawn, readings[0]) < _fit_rms(drawn, readings[-1]) * (1 + 1e-9)
+        # the reversed curve's readings are these, reversed
+        for u, back in zip(readings, natural_readings(drawn[::-1]), strict=True):
+            np.testing.assert_allclose(back, 1.0 - u[::-1], atol=1e-9)
 
 
 def test_the_parameters_follow_the_shape_not_its_pose_scale_or_direction():

@@ -52,8 +52,9 @@ def test_the_pose_kept_is_the_one_whose_spline_passes_closest(closest_runtime):
 
 def test_encoding_is_not_changed_by_the_placement(closest_runtime, runtime):
     curves = _user_curves()
-    mean, log_var, _ = closest_runtime.encode(curves, pose="as_is")
-    want_mean, want_log_var, _ = runtime.encode(curves, pose="as_is")
+    # one reading, one pose (spacing "auto" chooses among readings by each placement's own distance)
+    mean, log_var, _ = closest_runtime.encode(curves, pose="as_is", spacing="parameter")
+    want_mean, want_log_var, _ = runtime.encode(curves, pose="as_is", spacing="parameter")
     np.testing.assert_array_equal(mean, want_mean)
     np.testing.assert_array_equal(log_var, want_log_var)
 

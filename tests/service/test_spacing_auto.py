@@ -1,12 +1,13 @@
 """Spacing "natural" and "auto": a curve read at even steps of the parameters of the cubic B-spline that fits it
-(`geometry.natural_params`), and both readings tried with the reconstruction closest to the input kept."""
+(`geometry.natural_params`), and the readings tried with the reconstruction closest to the input kept."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from curve_vae.geometry import natural_params, resample
+from curve_vae.geometry import natural_params, natural_readings, resample
+from curve_vae.service import runtime as runtime_module
 from curve_vae.service.schemas import ReconstructRequest
 
 from .conftest import bspline_curves
@@ -22,14 +23,24 @@ def _rel(curves: list[np.ndarray], out: list[np.ndarray]) -> np.ndarray:
     )
 
 
-def test_auto_keeps_the_closer_reading_and_brings_curves_drawn_by_arc_length_closer(shipped_runtime):
+def _each_reading(runtime, curves, monkeypatch, **options) -> dict[str, tuple]:
+    """What /reconstruct gives each reading spacing "auto" tries alone: the points as given, the closest natural
+    fit's reading, and the reading of the fit from the arc-length fractions (where it ends elsewhere)."""
+    out = {sp: runtime.reconstruct(curves, spacing=sp, **options) for sp in ("parameter", "natural")}
+    with monkeypatch.context() as m:
+        m.setattr(runtime_module, "natural_params", lambda pts: natural_readings(pts)[-1])
+        out["natural, from arc length"] = runtime.reconstruct(curves, spacing="natural", **options)
+    return out
+
+
+def test_auto_keeps_the_closest_reading_and_brings_curves_drawn_by_arc_length_closer(shipped_runtime, monkeypatch):
     curves = _drawn_by_arc_length(10, seed=31)
-    errors = {sp: _rel(curves, shipped_runtime.reconstruct(curves, spacing=sp)[0]) for sp in ("parameter", "natural")}
+    errors = {sp: _rel(curves, out[0]) for sp, out in _each_reading(shipped_runtime, curves, monkeypatch).items()}
     auto = _rel(curves, shipped_runtime.reconstruct(curves, spacing="auto")[0])
-    picked = np.isclose(auto, errors["parameter"], rtol=1e-9) | np.isclose(auto, errors["natural"], rtol=1e-9)
-    assert picked.all(), (auto, errors)  # each curve's answer is one of the two readings'
-    assert (auto <= np.maximum(errors["parameter"], errors["natural"]) * (1 + 1e-9)).all()
-    assert auto.mean() < 0.9 * errors["parameter"].mean(), (auto.mean(), errors["parameter"].mean())
+    picked = np.any([np.isclose(auto, e, rtol=1e-9) for e in errors.values()], axis=0)
+    assert picked.all(), (auto, errors)  # each curve's answer is one of the readings'
+    assert (auto <= np.max(list(errors.values()), axis=0) * (1 + 1e-9)).all()
+    assert auto.mean() < 0.8 * errors["parameter"].mean(), (auto.mean(), errors["parameter"].mean())
 
 
 def test_auto_answers_a_curve_reversed_or_mirrored_alike(shipped_runtime):
@@ -42,15 +53,13 @@ def test_auto_answers_a_curve_reversed_or_mirrored_alike(shipped_runtime):
         np.testing.assert_allclose(_rel(moved, shipped_runtime.reconstruct(moved, spacing="auto")[0]), want, rtol=1e-9)
 
 
-def test_without_pose_candidates_the_two_readings_still_compete(runtime):
+def test_without_pose_candidates_the_readings_still_compete(runtime, monkeypatch):
     curves = [c for c in bspline_curves(3, seed=33)] + [resample(c, 90) for c in bspline_curves(2, seed=34)]
     for frame, pose in (("model", "auto"), ("auto", "as_is")):
         out, mse = runtime.reconstruct(curves, frame=frame, pose=pose, spacing="auto")
-        one = {
-            sp: runtime.reconstruct(curves, frame=frame, pose=pose, spacing=sp)[1] for sp in ("parameter", "natural")
-        }
+        one = _each_reading(runtime, curves, monkeypatch, frame=frame, pose=pose)
         assert [len(o) for o in out] == [len(c) for c in curves]
-        assert np.all(np.isclose(mse, one["parameter"]) | np.isclose(mse, one["natural"]))
+        assert np.any([np.isclose(mse, m) for _, m in one.values()], axis=0).all()
 
 
 def test_the_natural_reading_puts_the_callers_points_at_their_natural_parameters(runtime):
