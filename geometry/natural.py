@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
-from curve_vae.geometry.bspline import basis_and_slope, clamped_uniform_knots
+from curve_vae.geometry.bspline import basis_and_slope
 
 #: Control points of the spline whose parameters `natural_params` finds: the paper's curves have 10.
 NATURAL_CTRL = 10
@@ -120,7 +120,7 @@ class _BatchFit:
     a clamped uniform cubic B-spline (n_ctrl control points) and its points' parameters."""
 
     def __init__(self, pts: np.ndarray, u: np.ndarray, n_ctrl: int) -> None:
-        self.pts, self.n_ctrl, self.knots = pts, n_ctrl, clamped_uniform_knots(n_ctrl, 3)
+        self.pts, self.n_ctrl = pts, n_ctrl
         self.u = u.copy()
         self.basis, self.slope = self._basis(self.u)
         btb = self.basis.transpose(0, 2, 1) @ self.basis + 1e-12 * np.eye(n_ctrl)
@@ -130,7 +130,7 @@ class _BatchFit:
         self.damping = np.full(len(u), 1e-3)
 
     def _basis(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        b, s = basis_and_slope(u.ravel(), self.knots, 3)
+        b, s = basis_and_slope(u.ravel(), self.n_ctrl)
         return b.reshape(*u.shape, self.n_ctrl), s.reshape(*u.shape, self.n_ctrl)
 
     def keep(self, rows: list[int]) -> None:
