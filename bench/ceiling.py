@@ -155,20 +155,25 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
         x = curves(batch, seed=batch)
         as_lists = [c.astype(np.float64) for c in x]
         out[f"onnx_b{batch}_ms"] = ms(lambda x=x: runtime.decode_model_splines(runtime.encode_model(x)[0]))
-        out[f"reconstruct_b{batch}_ms"] = ms(lambda c=as_lists: runtime.reconstruct(c, pose="as_is"))
-        body = orjson.dumps({"curves": x.astype(np.float64), "pose": "as_is"}, option=orjson.OPT_SERIALIZE_NUMPY)
+        out[f"reconstruct_b{batch}_ms"] = ms(
+            lambda c=as_lists: runtime.reconstruct(c, pose="as_is", spacing="parameter")
+        )
+        body = orjson.dumps(
+            {"curves": x.astype(np.float64), "pose": "as_is", "spacing": "parameter"}, option=orjson.OPT_SERIALIZE_NUMPY
+        )
 
         def parse(body: bytes = body) -> None:
             req = ReconstructRequest.model_validate(orjson.loads(body))
             check_curves(req.curves, settings)
 
         out[f"parse_validate_b{batch}_ms"] = ms(parse)
-        rec, mse = runtime.reconstruct(as_lists, pose="as_is")
+        rec, mse = runtime.reconstruct(as_lists, pose="as_is", spacing="parameter")
         out[f"render_b{batch}_ms"] = ms(lambda rec=rec, mse=mse: JSON({"curves": rec, "mse": mse}))
-    # one curve drawn by arc length, as a page or a coordinate file sends it: the default request (pose "auto", six
-    # pose candidates) and spacing "auto" (each pose read two ways, geometry.natural_params first)
+    # one curve drawn by arc length, as a page or a coordinate file sends it, with pose "auto" (six pose candidates):
+    # its points as given (spacing "parameter") and the default request (spacing "auto": each pose read as given and
+    # at each of its natural spacings, geometry.natural_readings first)
     drawn = [resample(c.astype(np.float64), len(c)) for c in curves(1, seed=1)]
-    out["reconstruct_pose_auto_b1_ms"] = ms(lambda: runtime.reconstruct(drawn))
+    out["reconstruct_pose_auto_b1_ms"] = ms(lambda: runtime.reconstruct(drawn, spacing="parameter"))
     out["reconstruct_spacing_auto_b1_ms"] = ms(lambda: runtime.reconstruct(drawn, spacing="auto"))
     return out
 

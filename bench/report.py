@@ -93,15 +93,16 @@ def _breakdown(r: dict[str, Any]) -> list[str]:
         "",
         "In-process, one 1-thread session, ms per request: "
         f"encoder + decoder {b['onnx_b1_ms']:.2f} (1 curve) / {b['onnx_b128_ms']:.0f} (128 curves); "
-        f"`CurveRuntime.reconstruct` pose as_is {b['reconstruct_b1_ms']:.2f} / {b['reconstruct_b128_ms']:.0f}; "
+        f"`CurveRuntime.reconstruct` pose as_is, spacing parameter {b['reconstruct_b1_ms']:.2f} / "
+        f"{b['reconstruct_b128_ms']:.0f}; "
         f"JSON parse + validation {b['parse_validate_b1_ms']:.2f} / {b['parse_validate_b128_ms']:.1f}; "
         f"rendering the answer {b['render_b1_ms']:.2f} / {b['render_b128_ms']:.1f}.",
     ]
     if "reconstruct_spacing_auto_b1_ms" in b:
         auto, pose = b["reconstruct_spacing_auto_b1_ms"], b["reconstruct_pose_auto_b1_ms"]
         lines.append(
-            f"One curve drawn by arc length, `CurveRuntime.reconstruct` as the default request (pose auto) {pose:.2f} "
-            f"ms, with spacing auto {auto:.2f} ms ({auto / pose:.2f}×)."
+            f"One curve drawn by arc length, `CurveRuntime.reconstruct` with pose auto: its points as given (spacing "
+            f"parameter) {pose:.2f} ms, the default request (spacing auto) {auto:.2f} ms ({auto / pose:.2f}×)."
         )
     if "B" in r:
         rest = r["B"]["server_cpu_ms_per_request"] - b["reconstruct_b1_ms"] - b["parse_validate_b1_ms"]

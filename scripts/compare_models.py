@@ -14,15 +14,21 @@ says: what the placement alone gives, apart from what training on closest points
 each reading of the curves (the request's `spacing`: "parameter", "arc_length", "natural" or "auto"):
 
     .venv/bin/python scripts/compare_models.py models --count 200 --spacing parameter arc_length natural auto
+
+`--natural-steps N` fits the natural readings (`geometry.natural_readings`) with N Levenberg–Marquardt steps instead
+of the service's 40; `--one-natural` has spacing "auto" try the closest fit's reading only, not also the fit from the
+arc-length fractions.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import time
 from pathlib import Path
 
+from curve_vae.geometry import natural_params, natural_readings
 from curve_vae.service.runtime import CurveRuntime
 from curve_vae.training.suite import paper_test_split, run_suite, suite_sets
 
@@ -36,7 +42,18 @@ def main() -> None:
         "--spacing", choices=["parameter", "arc_length", "natural", "auto"], nargs="+", default=["parameter"]
     )
     p.add_argument("--out", default=None, help="also write the table as JSON here")
+    p.add_argument("--natural-steps", type=int, default=None, help="steps of the natural fit (default: the service's)")
+    p.add_argument("--one-natural", action="store_true", help='spacing "auto" tries the closest natural fit only')
     a = p.parse_args()
+    from curve_vae.service import runtime as runtime_module
+
+    steps = {} if a.natural_steps is None else {"steps": a.natural_steps}
+    runtime_module.natural_params = functools.partial(natural_params, **steps)
+    runtime_module.natural_readings = (
+        (lambda pts: natural_readings(pts, **steps)[:1])
+        if a.one_natural
+        else functools.partial(natural_readings, **steps)
+    )
     sets = suite_sets(paper_test_split(), count=a.count)
     columns: dict[str, dict] = {}
     for model_dir in a.model_dirs:

@@ -12,9 +12,10 @@ without HTTP:
 With frame "model" the frame steps are skipped. Resampling ("spacing"): "parameter" takes a curve's points as
 given and interpolates along the index (the paper's B-spline samples are spaced so); a 161-point curve then passes
 untouched and 50, 160 or 500 points of the same curve give the same model input. "natural" reads the curve at even
-steps of the parameters of the cubic B-spline fitted to it (the paper's curves' spacing, recovered in part),
-"arc_length" evenly by arc length (geometry.adapt), and "auto", the default, tries "parameter" and "natural" and
-keeps the closer reconstruction, as pose "auto" does with poses. Nothing here
+steps of the parameters of the cubic B-spline fitted to it (the paper's curves' spacing, recovered for most of
+them), "arc_length" evenly by arc length (geometry.adapt), and "auto", the default, tries "parameter" and each of
+the curve's natural readings (geometry.natural_readings: one or two) and keeps the closest reconstruction, as pose
+"auto" does with poses. Nothing here
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 
@@ -169,10 +170,10 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
         pose "auto" (frame "auto" only): each curve is tried in the poses of `geometry.pose_frames` — so a
         curve, its reversal, mirror image and rotations all get the same candidates — encoded and decoded in
         each, and the pose whose reconstruction is closest to the input is kept, with its latent.
-        spacing "auto": so are two readings of each curve in each pose, its points as given ("parameter") and at
-        even steps of their `natural_params` ("natural"). refine > 0: that many fitting steps on each kept latent
-        (`_refined`). A model placed "closest" (its manifest's spline.placement, `closest_placement`) has each input
-        point matched to its closest point on its reconstruction even without steps, unless `placed` is False
+        spacing "auto": so are the readings of each curve in each pose, its points as given ("parameter") and at
+        even steps of each of their `natural_readings` ("natural"). refine > 0: that many fitting steps on each kept
+        latent (`_refined`). A model placed "closest" (its manifest's spline.placement, `closest_placement`) has each
+        input point matched to its closest point on its reconstruction even without steps, unless `placed` is False
         (encoding only).
         """
         prep = self._prepare(curves, frame, spacing, pose)

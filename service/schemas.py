@@ -74,15 +74,17 @@ SpacingMode = Annotated[
     Literal["parameter", "arc_length", "natural", "auto"],
     Field(
         description=(
-            'How the points of a curve are read. "auto" (the default wherever curves are posted): the two readings '
-            'below, "parameter" and "natural", are both tried (in every pose) and the reconstruction closest to the '
-            "input is kept — at least as close as either on every family of the evaluation suite, and the closest for "
-            "drawn strokes, coordinate files and curves spaced by arc length, at about 2.6× the CPU of "
+            'How the points of a curve are read. "auto" (the default wherever curves are posted): the readings '
+            'below, "parameter" and "natural" (and, where it differs, the natural reading of the fit from the points\' '
+            "arc-length fractions), are all tried in every pose and the reconstruction closest to the input is kept "
+            "— closer than the points as given on every family of the evaluation suite, the closest for drawn "
+            "strokes, coordinate files and curves spaced by arc length, at about 3.7× the CPU of "
             '"parameter" for one curve (docs/RESULTS.md). "parameter": the points as given, interpolated along '
             "their order (the paper's curves are spaced so; 50, 161 or 500 samples of a curve give the same result) "
             '— the fast path. "natural": the curve read at even steps of the parameters of the cubic B-spline with '
-            "10 control points fitted to it (the paper's curves' spacing, recovered in part, whatever the curve's "
-            'own). "arc_length": every curve resampled evenly by arc length, and returned curves spaced so. Returned '
+            "10 control points fitted to it closest (the paper's curves' own spacing for half of them, whatever "
+            'spacing they came in). "arc_length": every curve resampled evenly by arc length, and returned curves '
+            "spaced so. Returned "
             'curves of `n_points` with "parameter", "natural" or "auto" (and /decode\'s and /sample\'s, whose '
             'default is "parameter") are at the model\'s own spacing: evenly in its spline parameter, or where a head '
             "that learns its points' parameters places them (GET /model: "
