@@ -16,7 +16,8 @@ from curve_vae.geometry import Frame
 from curve_vae.service.inputs import InputError
 
 if TYPE_CHECKING:
-    from curve_vae.service.runtime import FrameMode, PoseMode, Prepared, Spacing, Spline
+    from curve_vae.service.prepared import Prepared
+    from curve_vae.service.runtime import FrameMode, PoseMode, Spacing, Spline
 
 
 class Augmenting:

@@ -26,7 +26,7 @@ from curve_vae.geometry import arc_fractions, closest_params, params_at_arc_frac
 from curve_vae.service.inputs import InputError
 
 if TYPE_CHECKING:
-    from curve_vae.service.runtime import Prepared
+    from curve_vae.service.prepared import Prepared
 
 #: Forward-difference step in latent units (the latent prior is a unit Gaussian; the decoder runs in float32).
 FD_STEP = 1e-2

@@ -19,13 +19,13 @@ the curve's natural readings (geometry.natural_readings: one or two) and keeps t
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 
-Length (~480 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a
-batch's frames, input positions and splines from `prepare` through the graphs to the result, turning geometry's
-errors into the service's InputError with the field and curve they concern. Its parts live beside it: the
-sessions, signature checks and raw graph runs are `service.graphs` (the base class `ModelGraphs`); the pure frame
-and length adaptation is `geometry.adapt`; augmentation `service.augmenting`, sampling `service.sampling` and the
-fitting of `refine` `service.fitting` (base classes too); the input error `service.inputs`; the mixing weights
-`geometry.mixing`.
+Length (~490 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a batch's
+frames, input positions and splines from `prepare` through the graphs to the result, turning geometry's errors into
+the service's InputError with the field and curve they concern. Its parts live beside it: the candidate readings and
+the kept batch are `service.prepared`; the sessions, signature checks and raw graph runs are `service.graphs` (the
+base class `ModelGraphs`); the pure frame and length adaptation is `geometry.adapt`; augmentation
+`service.augmenting`, sampling `service.sampling` and the fitting of `refine` `service.fitting` (base classes too);
+the input error `service.inputs`; the mixing weights `geometry.mixing`.
 """
 
 from __future__ import annotations
@@ -59,11 +59,15 @@ from curve_vae.service.augmenting import Augmenting
 from curve_vae.service.fitting import Fitting
 from curve_vae.service.graphs import ModelGraphs
 from curve_vae.service.inputs import InputError
+from curve_vae.service.prepared import Candidates, Prepared
 from curve_vae.service.sampling import Sampling
 
 FrameMode = Literal["auto", "model"]
 Spacing = Literal["parameter", "arc_length", "natural", "auto"]
 PoseMode = Literal["auto", "as_is"]
+#: A natural reading whose parameters are all within this of the points' index fractions reads the curve as given:
+#: spacing "auto" does not try it beside "parameter".
+SAME_READING = 1e-4
 #: Pose candidates a curve is tried in with pose "auto": its chord turned to −90°, −45° and −135°, each as drawn
 #: and reversed-and-mirrored (geometry.frame.pose_frames); the reconstruction closest to the input wins.
 POSE_CHORD_COUNT = 3
@@ -71,59 +75,6 @@ _ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the mo
 
 
 # --------------------------------------------------------------------------- curves in and out
-
-
-@dataclass(frozen=True)
-class Prepared:
-    """A batch of caller curves brought to the model, and what it takes to bring results back."""
-
-    model: np.ndarray  # (B, n_points, 2) float32 in the model plane
-    frames: list[Frame | None]  # the caller's frame of each curve; None for frame "model"
-    fractions: list[
-        np.ndarray | None
-    ]  # where each input point sits along the model's points, in [0, 1]; None: same points
-    inputs: list[np.ndarray]  # the caller's curves, float64
-    # With pose "auto", the curves are already encoded and decoded (that is how the pose is chosen):
-    mean: np.ndarray | None = None  # (B, latent_dim)
-    log_var: np.ndarray | None = None
-    decoded: np.ndarray | None = None  # (B, n_points, 2) model plane
-    ctrl: np.ndarray | None = None  # (B, n_ctrl, 2) with a B-spline head
-    params: np.ndarray | None = None  # (B, n_points) spline parameter of each model point, if the head learns them
-    # With refine, the latents are fitted (service.fitting) and each input point is matched to its closest point:
-    feet: list[np.ndarray] | None = None  # per curve, the spline parameter (model order) of each input point
-
-
-@dataclass
-class _Candidates:
-    """Readings of caller curves tried on the model (several per curve, in any order): what `_prepare` chooses
-    from, each measured by how far its reconstruction is from its model-plane points (`err`)."""
-
-    owner: list[int]  # the curve each candidate reads
-    model: np.ndarray
-    frames: list[Frame | None]
-    fractions: list[np.ndarray | None]
-    mean: np.ndarray
-    log_var: np.ndarray
-    decoded: np.ndarray
-    ctrl: np.ndarray | None
-    params: np.ndarray | None
-    err: np.ndarray
-
-    def closest(self, inputs: list[np.ndarray]) -> Prepared:
-        """Each curve's candidate whose reconstruction came closest."""
-        owner = np.asarray(self.owner, int)
-        best = [int(np.flatnonzero(owner == i)[self.err[owner == i].argmin()]) for i in range(len(inputs))]
-        return Prepared(
-            self.model[best],
-            [self.frames[b] for b in best],
-            [self.fractions[b] for b in best],
-            inputs,
-            self.mean[best],
-            self.log_var[best],
-            self.decoded[best],
-            None if self.ctrl is None else self.ctrl[best],
-            None if self.params is None else self.params[best],
-        )
 
 
 @dataclass(frozen=True)
@@ -204,8 +155,14 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
                 except ValueError as e:  # all points coincide
                     raise InputError(("curves", i), str(e)) from e
         # every curve in every pose, read as the request says; "auto": its points as given and each natural reading
+        # that does not put them where they are (a curve at the paper's own spacing is read so: nothing to add)
         readings = [
-            [(first, naturals[i][0])] + ([("natural", n) for n in naturals[i]] if spacing == "auto" else [])
+            [(first, naturals[i][0])]
+            + (
+                [("natural", n) for n in naturals[i] if np.abs(n - np.linspace(0.0, 1.0, len(n))).max() > SAME_READING]
+                if spacing == "auto"
+                else []
+            )
             for i in range(len(inputs))
         ]
         stage = [(i, f, r, n) for i in range(len(inputs)) for f in poses[i] for r, n in readings[i]]
@@ -218,7 +175,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
 
     def _candidates(
         self, inputs: list[np.ndarray], stage: list[tuple[int, Frame | None, Spacing, np.ndarray | None]]
-    ) -> _Candidates:
+    ) -> Candidates:
         """Candidate readings (curve index, frame, spacing, natural parameters) encoded, decoded and measured."""
         rows, fractions = [], []
         with np.errstate(all="ignore"):
@@ -235,7 +192,7 @@ class CurveRuntime(ModelGraphs, Augmenting, Sampling, Fitting):
                 err = np.array([closest_squared_distances(b, d).sum() for b, d in zip(batch, decoded)])
             else:
                 err = ((decoded.astype(np.float64) - batch) ** 2).sum(axis=(1, 2))
-        return _Candidates(
+        return Candidates(
             [i for i, _, _, _ in stage],
             batch,
             [f for _, f, _, _ in stage],

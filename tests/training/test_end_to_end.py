@@ -64,7 +64,10 @@ def test_export_parity_and_manifest(trained):
     tmp, data, cut, _, _ = trained
     out = tmp / "models"
     assert (
-        main(["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--version", "9.9.9"])
+        main(
+            ["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--version", "9.9.9"]
+            + ["--suite-count", "20"]  # the family suite's bookkeeping: tests/training/test_families.py
+        )
         == 0
     )
     manifest = json.loads((out / "manifest.json").read_text())
@@ -96,7 +99,8 @@ def test_export_parity_and_manifest(trained):
 def test_evaluate_exported_model(trained, capsys):
     tmp, data, _, _, _ = trained
     out = tmp / "eval"
-    assert main(["evaluate", "--model-dir", str(tmp / "models"), "--data", data, "--out", str(out)]) == 0
+    args = ["evaluate", "--model-dir", str(tmp / "models"), "--data", data, "--out", str(out), "--suite-count", "20"]
+    assert main(args) == 0
     printed = capsys.readouterr().out
     assert "test: MSE" in printed and "fresh_seed_7919: MSE" in printed
     report = json.loads((out / "report.json").read_text())
