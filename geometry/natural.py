@@ -20,6 +20,8 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
 from curve_vae.geometry.bspline import basis_and_slope
+from curve_vae.geometry.frame import arc_fractions
+from curve_vae.geometry.metrics import turning_angles
 
 #: Control points of the spline whose parameters `natural_params` finds: the paper's curves have 10.
 NATURAL_CTRL = 10
@@ -62,11 +64,10 @@ def natural_readings(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: i
     if not extent > 0:
         raise ValueError("all points coincide: a curve needs at least 2 distinct points")
     pts = (pts - pts[0]) / extent  # the shape alone, at a size where squares neither underflow nor overflow
-    u = _arc_fractions(pts)
+    u = arc_fractions(pts)
     if len(pts) < 2 * n_ctrl:
         return [u]
-    seg = np.diff(pts, axis=0)
-    turn = np.abs(np.arctan2(seg[:-1, 0] * seg[1:, 1] - seg[:-1, 1] * seg[1:, 0], (seg[:-1] * seg[1:]).sum(1)))
+    turn = turning_angles(pts)
     if turn.sum() > 0 and (turn * u[1:-1]).sum() / turn.sum() > 0.5:
         # fitted from the end where the curve turns most, whichever way it is listed: a curve and its reversal get
         # the same parameters to rounding (the fit's path from its start is not symmetric in the order)
@@ -74,17 +75,11 @@ def natural_readings(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: i
     return _fit(pts, n_ctrl, steps)
 
 
-def _arc_fractions(pts: np.ndarray) -> np.ndarray:
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-    return s / s[-1]
-
-
 def _starts(pts: np.ndarray) -> np.ndarray:
     """(K, n) first guesses at a polyline's parameters: its arc-length fractions, then NATURAL_STARTS' lengths
     stretched where it turns (only the first for a straight polyline)."""
-    seg = np.diff(pts, axis=0)
-    ds = np.linalg.norm(seg, axis=1)
-    turn = np.abs(np.arctan2(seg[:-1, 0] * seg[1:, 1] - seg[:-1, 1] * seg[1:, 0], (seg[:-1] * seg[1:]).sum(1)))
+    ds = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    turn = turning_angles(pts)
     local = (ds[:-1] + ds[1:]) / 2
     kappa = np.where(local > 0, turn / np.where(local > 0, local, 1.0), 0.0)  # at the inner points
     per_segment = np.concatenate([[kappa[0]], (kappa[:-1] + kappa[1:]) / 2, [kappa[-1]]])
@@ -101,7 +96,7 @@ def _starts(pts: np.ndarray) -> np.ndarray:
 def _fit(pts: np.ndarray, n_ctrl: int, steps: int) -> list[np.ndarray]:
     """`natural_readings`' fit of a polyline (n, 2) as listed, its points at most NATURAL_FIT_POINTS."""
     if len(pts) > NATURAL_FIT_POINTS:
-        u = _arc_fractions(pts)
+        u = arc_fractions(pts)
         some = np.unique(np.round(np.linspace(0, len(pts) - 1, NATURAL_FIT_POINTS)).astype(int))
         return [np.interp(u, u[some], r) for r in _fit(pts[some], n_ctrl, steps)]
     fit = _BatchFit(pts, _starts(pts), n_ctrl)

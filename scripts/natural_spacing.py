@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from curve_vae.geometry import closest_squared_distances, natural_readings, resample, to_model_plane
+from curve_vae.geometry import arc_fractions, closest_squared_distances, natural_readings, resample, to_model_plane
 from curve_vae.geometry.bspline import basis_and_slope
 from curve_vae.training.suite import paper_test_split
 
@@ -75,10 +75,8 @@ def main() -> None:
 
     as_drawn = np.array([rel(d, c) for d, c in zip(drawn, even)])
     print(f"as drawn: median {np.median(as_drawn):.2%}, mean {as_drawn.mean():.2%}")
-    own = []  # each drawn point's own B-spline parameter: where its arc length falls along the dense even samples
-    for c in even:
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
-        own.append(np.interp(np.linspace(0.0, s[-1], len(c)), s, np.linspace(0.0, 1.0, len(c))))
+    # each drawn point's own B-spline parameter: where its arc length falls along the even-parameter samples
+    own = [np.interp(np.linspace(0.0, 1.0, len(c)), arc_fractions(c), np.linspace(0.0, 1.0, len(c))) for c in even]
     print(
         f"the spline fitted at their own parameters: {np.median([fit_rms(d, u) for d, u in zip(drawn, own)]):.4%} "
         "of the diagonal from the points (median)"

@@ -19,7 +19,7 @@ the curve's natural readings (geometry.natural_readings: one or two) and keeps t
 imports torch. Reading and checking model files is `service.model_files`; the learned latent
 distribution is `service.prior`.
 
-Length (~490 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a batch's
+Length (~500 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a batch's
 frames, input positions and splines from `prepare` through the graphs to the result, turning geometry's errors into
 the service's InputError with the field and curve they concern. Its parts live beside it: the candidate readings and
 the kept batch are `service.prepared`; the sessions, signature checks and raw graph runs are `service.graphs` (the

@@ -84,6 +84,7 @@ def test_requests_are_routed_to_their_callers_under_concurrency(make_client, cli
 
     def encoder_runs() -> float:
         metrics = batched.get("/metrics").text
+        assert 'curve_vae_microbatch_rows_count{graph="encoder"}' in metrics
         assert 'curve_vae_microbatch_queue_seconds_count{graph="decoder"}' in metrics
         return float(metrics.split('curve_vae_microbatch_rows_count{graph="encoder"} ')[1].split()[0])
 

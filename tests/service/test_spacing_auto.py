@@ -79,3 +79,20 @@ def test_http_takes_both_readings_and_names_a_bad_one(client):
     assert r.status_code == 422 and "spacing" in r.text
     with pytest.raises(ValueError):
         ReconstructRequest(curves=[c], spacing="natrual")
+
+
+def test_a_natural_reading_that_puts_the_points_where_they_are_is_not_tried_again(runtime, monkeypatch):
+    """A curve at the paper's own spacing: its closest natural fit gives its points their index fractions
+    (runtime.SAME_READING), so "auto" does not try that reading beside "parameter"; a curve drawn by arc length gets
+    every natural reading in every pose."""
+    even = bspline_curves(1, seed=37)[0]
+    drawn = resample(even, len(even))
+    assert np.abs(natural_params(even) - np.linspace(0, 1, len(even))).max() <= runtime_module.SAME_READING
+    rows: list[int] = []
+    encode = runtime.encode_model
+    monkeypatch.setattr(runtime, "encode_model", lambda x: rows.append(len(x)) or encode(x))
+    runtime.reconstruct([even], spacing="auto")
+    runtime.reconstruct([drawn], spacing="auto")
+    poses = 2 * runtime_module.POSE_CHORD_COUNT
+    assert rows[0] == poses * len(natural_readings(even))  # "parameter", and the readings but the closest
+    assert rows[1] == poses * (1 + len(natural_readings(drawn)))
