@@ -136,11 +136,11 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
     import orjson
 
     from curve_vae.geometry import resample
+    from curve_vae.inference.runtime import CurveRuntime
+    from curve_vae.inference.sessions import SessionConfig
     from curve_vae.service.deps import check_curves
     from curve_vae.service.fastjson import JSON
-    from curve_vae.service.runtime import CurveRuntime
     from curve_vae.service.schemas import ReconstructRequest
-    from curve_vae.service.sessions import SessionConfig
     from curve_vae.service.settings import Settings
 
     runtime = CurveRuntime.load(model_dir, providers="cpu", sessions=SessionConfig(intra_op_threads=1))

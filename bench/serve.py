@@ -22,7 +22,6 @@ import json
 import os
 import platform
 import shutil
-import socket
 import subprocess
 import sys
 import tempfile
@@ -36,6 +35,7 @@ import numpy as np
 
 from bench import ceiling
 from bench.report import markdown
+from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parent.parent
 LUA = Path(__file__).resolve().parent / "post.lua"
@@ -58,62 +58,16 @@ RUNS = (
 # --------------------------------------------------------------------------- the server
 
 
-class Server:
-    """`python -m curve_vae.service.cli` on a free loopback port, with extra flags and environment."""
+class Server(LiveServer):
+    """`python -m curve_vae.service.cli` on a free loopback port with extra flags and environment, ready when made."""
 
     def __init__(self, model_dir: Path, *flags: str, env: dict[str, str] | None = None) -> None:
-        with socket.socket() as s:
-            s.bind(("127.0.0.1", 0))
-            self.port = s.getsockname()[1]
-        self.url = f"http://127.0.0.1:{self.port}"
-        cmd = [sys.executable, "-m", "curve_vae.service.cli", "--port", str(self.port), "--model-dir", str(model_dir)]
-        cmd += ["--providers", "cpu", "--log-level", "warning", *flags]
-        self.proc = subprocess.Popen(cmd, cwd=ROOT, env={**os.environ, **(env or {})})
-        deadline = time.monotonic() + 90
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise RuntimeError(f"server exited with {self.proc.returncode}: {' '.join(cmd)}")
-            try:
-                with urllib.request.urlopen(f"{self.url}/ready", timeout=1) as r:
-                    if r.status == 200:
-                        return
-            except OSError:
-                time.sleep(0.2)
-        self.stop()
-        raise TimeoutError(f"{self.url} not ready after 90 s")
-
-    def pids(self) -> list[int]:
-        """The server process and all its descendants (uvicorn's workers)."""
-        out, todo = [], [self.proc.pid]
-        while todo:
-            pid = todo.pop()
-            out.append(pid)
-            try:
-                todo += [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
-            except OSError:
-                pass
-        return out
-
-    def cpu_seconds(self) -> dict[int, float]:
-        """User + system CPU seconds of each server process so far."""
-        tick = os.sysconf("SC_CLK_TCK")
-        out = {}
-        for pid in self.pids():
-            try:
-                fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-            except OSError:
-                continue
-            out[pid] = (int(fields[11]) + int(fields[12])) / tick  # utime, stime
-        return out
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=15)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+        super().__init__("--model-dir", str(model_dir), "--providers", "cpu", *flags, env=env, cwd=ROOT, capture=False)
+        try:
+            self.wait_ready(timeout=90)
+        except BaseException:
+            self.stop()
+            raise
 
 
 # --------------------------------------------------------------------------- load

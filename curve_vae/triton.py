@@ -11,7 +11,7 @@ What Triton serves are raw tensors in the model's 128×128 plane: encoder `curve
 float32 → `mean`, `log_var` (B, 32); decoder `latent` (B, 32) → `curves` (B, 161, 2) and, with
 a B-spline head, `control_points` (B, K, 2). The REST service's geometry (frames, resampling
 to 161 points, blending frames for interpolants, the learned prior for sampling) happens
-around these calls, in `geometry/` and `service/runtime.py`; a Triton client that wants it
+around these calls, in `geometry/` and `inference/runtime.py`; a Triton client that wants it
 does the same before and after.
 """
 
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 
-from curve_vae.service.model_files import graph_file, read_manifest
+from curve_vae.inference.model_files import graph_file, read_manifest
 
 #: onnxruntime's tensor types → Triton's data types
 TRITON_TYPES = {"tensor(float)": "TYPE_FP32", "tensor(double)": "TYPE_FP64", "tensor(int64)": "TYPE_INT64"}

@@ -14,7 +14,7 @@ control points the points are the spline's at the returned parameters, and the c
 and parameters come back in the caller's frame and point order: a similarity maps a spline's
 points as it maps its control points.
 
-Pure numpy: the service's runtime (service/runtime.py) calls these around its ONNX sessions.
+Pure numpy: the service's runtime (inference/runtime.py) calls these around its ONNX sessions.
 """
 
 from __future__ import annotations

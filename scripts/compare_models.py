@@ -29,7 +29,7 @@ import time
 from pathlib import Path
 
 from curve_vae.geometry import natural_params, natural_readings
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.suite import paper_test_split, run_suite, suite_sets
 
 
@@ -45,7 +45,7 @@ def main() -> None:
     p.add_argument("--natural-steps", type=int, default=None, help="steps of the natural fit (default: the service's)")
     p.add_argument("--one-natural", action="store_true", help='spacing "auto" tries the closest natural fit only')
     a = p.parse_args()
-    from curve_vae.service import runtime as runtime_module
+    from curve_vae.inference import runtime as runtime_module
 
     steps = {} if a.natural_steps is None else {"steps": a.natural_steps}
     runtime_module.natural_params = functools.partial(natural_params, **steps)

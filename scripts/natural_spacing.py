@@ -32,7 +32,7 @@ from curve_vae.training.suite import paper_test_split
 
 def gap(model_dir: str, even: np.ndarray, drawn: list[np.ndarray]) -> None:
     """Where the arc-length gap of a model sits: its encoder's reading, or its decoder's reach."""
-    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.inference.runtime import CurveRuntime
     from curve_vae.training.data import DataConfig, generate_curves
 
     rt = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)

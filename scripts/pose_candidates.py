@@ -16,7 +16,7 @@ import json
 import time
 from pathlib import Path
 
-import curve_vae.service.runtime as rt
+import curve_vae.inference.runtime as rt
 from curve_vae.geometry import frame as geometry_frame
 from curve_vae.training.data import DataConfig, generate_curves
 from curve_vae.training.suite import run_suite, suite_sets

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from curve_vae.service.model_files import file_sha256
-from curve_vae.service.prior import PRIOR_FILE
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference.model_files import file_sha256
+from curve_vae.inference.prior import PRIOR_FILE
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.data import DataConfig, default_cache, generate_curves, load_or_generate
 from curve_vae.training.evaluate import sample_quality
 from curve_vae.training.prior import FIT_CURVES, fit_prior

@@ -1,4 +1,4 @@
-"""What fitting steps (the request option `refine`, service/fitting.py) buy and what they cost, through the service's
+"""What fitting steps (the request option `refine`, inference/fitting.py) buy and what they cost, through the service's
 runtime exactly as a request runs them.
 
     .venv/bin/python scripts/refine_tradeoff.py --model-dir models --count 50 --steps 0 3 5 10 20
@@ -25,8 +25,8 @@ from typing import Any
 import numpy as np
 
 from curve_vae.geometry import arc_fractions, closest_params, evaluate_bspline, self_intersects, smoothness
-from curve_vae.service import fitting
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference import fitting
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.suite import paper_test_split, relative_rmse, suite_sets
 
 SETS = ("paper", "paper, arc-length spacing", "paper, rotated")

@@ -17,7 +17,7 @@ import dataclasses
 import numpy as np
 
 from curve_vae.geometry import evaluate_bspline
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.suite import paper_test_split, suite_sets
 
 SETS = [

@@ -7,9 +7,10 @@ Starts `python -m curve_vae.service.cli` on a free loopback port (the shipped mo
 every endpoint up, reads the server's resident memory, then runs the clients until the time or the
 request budget is spent. Each request of the mix has an expected status (bad inputs are part of the
 mix and must get their 422): any other answer, or no answer, is an error. Reports requests, errors,
-bad inputs tried, p50/p99 latency per kind and overall, and the server's resident memory before and
-after; stops the server with SIGTERM and checks that it exits 0. Exit status 1 on any error, on
-memory growth over --max-rss-growth-mb, or on an unclean stop. Traffic goes to 127.0.0.1 only.
+bad inputs tried, p50/p99 latency per kind and overall, and the server's resident memory before and after, read
+every --memory-every seconds during the load with the slope of a line through the readings after the first quarter
+(`server_rss_slope_mb_per_min`); stops the server with SIGTERM and checks that it exits 0. Exit status 1 on any
+error, on memory growth over --max-rss-growth-mb, or on an unclean stop. Traffic goes to 127.0.0.1 only.
 """
 
 from __future__ import annotations
@@ -18,15 +19,15 @@ import argparse
 import asyncio
 import json
 import random
-import signal
-import socket
-import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
 import httpx
 import numpy as np
+
+from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -58,19 +59,6 @@ def request_mix(seed: int = 0) -> list[tuple[str, str, str, dict | None, int]]:
         ("bad-short", "POST", "/reconstruct", {"curves": [[[0, 0], [1, 1]]]}, 422),
         ("bad-latent", "POST", "/decode", {"latents": [[0.0] * 3]}, 422),
     ]
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _rss_mb(pid: int) -> float:
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1]) / 1024
-    raise RuntimeError(f"no VmRSS for process {pid}")
 
 
 async def _client(
@@ -105,28 +93,6 @@ async def _load(url: str, clients: int, duration: float, max_requests: int, seed
     return out
 
 
-def _start_server(port: int, model_dir: str) -> subprocess.Popen:
-    """The service on a loopback port, its output (one stream) kept for the report."""
-    cmd = [sys.executable, "-m", "curve_vae.service.cli", "--port", str(port), "--log-level", "warning",
-           "--model-dir", model_dir, "--providers", "cpu"]  # fmt: skip
-    return subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-
-
-def _wait_ready(server: subprocess.Popen, url: str, timeout: float = 60) -> None:
-    deadline = time.monotonic() + timeout
-    while True:
-        if server.poll() is not None:
-            raise RuntimeError(f"the server exited with {server.returncode}: {server.stdout.read()}")  # type: ignore[union-attr]
-        try:
-            if httpx.get(url + "/ready", timeout=1).status_code == 200:
-                return
-        except httpx.TransportError:
-            pass
-        if time.monotonic() > deadline:
-            raise TimeoutError(f"{url} not ready after {timeout:g} s")
-        time.sleep(0.1)
-
-
 def _warm_up(url: str, a: argparse.Namespace) -> None:
     """Every route once, before the first memory reading, then a short load of a different seed."""
     for _, method, path, body, _ in request_mix(a.seed):
@@ -134,19 +100,6 @@ def _warm_up(url: str, a: argparse.Namespace) -> None:
     # and every inference thread: each has its own session pair, whose memory arena grows on its first large
     # runs (~100 MB for the shipped model's second pair); that is a one-time cost, not a leak to measure
     asyncio.run(_load(url, a.clients, min(2.0, a.duration), a.max_requests, a.seed + 1))
-
-
-def _stop_server(server: subprocess.Popen) -> tuple[int, str]:
-    """SIGTERM (a kill after 60 s); the exit code and everything the server wrote."""
-    server.send_signal(signal.SIGTERM)
-    try:
-        code = server.wait(timeout=60)
-    except subprocess.TimeoutExpired:
-        server.kill()
-        code = server.wait()
-    log = server.stdout.read()  # type: ignore[union-attr]
-    server.stdout.close()  # type: ignore[union-attr]
-    return code, log
 
 
 def _traffic_report(clients: int, results: list, wall: float) -> dict:
@@ -174,23 +127,48 @@ def _traffic_report(clients: int, results: list, wall: float) -> dict:
     }
 
 
+def _sample_memory(server: LiveServer, every: float, stop: threading.Event, out: list) -> None:
+    """(seconds since the load began, resident MiB of the server's processes), every `every` seconds."""
+    t0 = time.monotonic()
+    while not stop.wait(every):
+        out.append((time.monotonic() - t0, server.rss_mib()))
+
+
+def memory_slope(samples: list[tuple[float, float]], *, skip: float = 0.25) -> float:
+    """MiB per minute of a least-squares line through the samples after the first `skip` of the run (warm-up: each
+    inference thread's arena grows on its first large runs)."""
+    if len(samples) < 4:
+        return 0.0
+    t, mib = np.array(samples).T
+    keep = t >= skip * t[-1]
+    return float(np.polyfit(t[keep] / 60, mib[keep], 1)[0]) if keep.sum() >= 3 else 0.0
+
+
 def run(a: argparse.Namespace) -> dict:
-    port = _free_port()
-    url = f"http://127.0.0.1:{port}"
-    server = _start_server(port, a.model_dir)
+    server = LiveServer("--model-dir", a.model_dir, "--providers", "cpu", cwd=ROOT)
+    samples: list[tuple[float, float]] = []
+    stop = threading.Event()
     try:
-        _wait_ready(server, url)
-        _warm_up(url, a)
-        rss_before = _rss_mb(server.pid)
+        server.wait_ready()
+        _warm_up(server.url, a)
+        rss_before = server.rss_mib()
+        sampler = threading.Thread(target=_sample_memory, args=(server, a.memory_every, stop, samples), daemon=True)
+        sampler.start()
         t0 = time.perf_counter()
-        results = asyncio.run(_load(url, a.clients, a.duration, a.max_requests, a.seed))
+        results = asyncio.run(_load(server.url, a.clients, a.duration, a.max_requests, a.seed))
         wall = time.perf_counter() - t0
-        rss_after = _rss_mb(server.pid)
+        stop.set()
+        sampler.join()
+        rss_after = server.rss_mib()
     finally:
-        code, log = _stop_server(server)
+        stop.set()
+        code = server.stop(timeout=60)
+        log = server.output()
     return {
         **_traffic_report(a.clients, results, wall),
         "server_rss_mb": {"before": round(rss_before, 1), "after": round(rss_after, 1)},
+        "server_rss_slope_mb_per_min": round(memory_slope(samples), 3),
+        "server_rss_samples": [[round(t, 1), round(m, 1)] for t, m in samples],
         "server_exit_code": code,
         "server_log_has_traceback": "Traceback" in log,
     }
@@ -204,6 +182,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--model-dir", default=str(ROOT / "models"), help="the model to serve (default: the shipped one)")
     p.add_argument("--max-rss-growth-mb", type=float, default=100.0, help="allowed memory growth (default: 100)")
     p.add_argument("--seed", type=int, default=0, help="seed of the request mix and the clients' choices")
+    p.add_argument("--memory-every", type=float, default=5.0, help="seconds between memory readings (default: 5)")
     p.add_argument("--out", default="", help="also write the report as JSON here")
     a = p.parse_args(argv)
     report = run(a)

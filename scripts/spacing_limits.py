@@ -29,7 +29,7 @@ import torch
 
 from curve_vae.geometry import resample
 from curve_vae.geometry.bspline import evaluate_bspline, fit_bspline
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.checkpoint import model_from_checkpoint
 from curve_vae.training.model import bspline_basis, increments_to_params, last_span_mask
 from curve_vae.training.suite import paper_test_split

@@ -31,7 +31,7 @@ import onnxruntime as ort
 import torch
 
 from curve_vae.geometry import smoothness, spline_head
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.airfoils import load_airfoils
 from curve_vae.training.checkpoint import model_from_checkpoint
 from curve_vae.training.data import DataConfig, default_cache, generate_curves, load_or_generate

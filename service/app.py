@@ -34,22 +34,22 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.middleware.cors import CORSMiddleware
 from starlette.exceptions import HTTPException
 
+from curve_vae.inference.batching import GraphBatcher
+from curve_vae.inference.batching import attach as attach_batcher
+from curve_vae.inference.cpus import available_cpus, inference_slots, session_config
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.model_files import ModelLoadError
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.access import ApiKeyMiddleware
-from curve_vae.service.batching import GraphBatcher
-from curve_vae.service.batching import attach as attach_batcher
-from curve_vae.service.cpus import available_cpus, inference_slots, session_config
 from curve_vae.service.errors import on_http_error, on_input_error, on_validation_error
-from curve_vae.service.inputs import InputError
 from curve_vae.service.metrics import Metrics, MetricsMiddleware
 from curve_vae.service.middleware import BodyLimitMiddleware
-from curve_vae.service.model_files import ModelLoadError
 from curve_vae.service.oip import DEFAULT_SIGNATURES, describe, signatures
 from curve_vae.service.openapi import state_bounds
 from curve_vae.service.routes.curves import curves_router
 from curve_vae.service.routes.design import design_router
 from curve_vae.service.routes.oip import oip_router
 from curve_vae.service.routes.ops import ops_router
-from curve_vae.service.runtime import CurveRuntime
 from curve_vae.service.settings import Settings, get_settings
 from curve_vae.service.web import mount_web
 

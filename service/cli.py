@@ -126,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
 
-    from curve_vae.service.model_files import ModelLoadError, read_manifest, resolve_providers
+    from curve_vae.inference.model_files import ModelLoadError, read_manifest, resolve_providers
 
     try:
         settings = settings_from_args(args)

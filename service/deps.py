@@ -16,10 +16,10 @@ from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
 from curve_vae.geometry import simplex_grid, simplex_grid_size
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.runtime import CurveRuntime, Spline
 from curve_vae.service import schemas as s
-from curve_vae.service.inputs import InputError
 from curve_vae.service.metrics import Metrics
-from curve_vae.service.runtime import CurveRuntime, Spline
 from curve_vae.service.settings import Settings
 
 T = TypeVar("T")
@@ -66,7 +66,7 @@ def check_n_points(n_points: int | None, settings: Settings) -> None:
         raise InputError(("n_points",), f"at most {settings.max_points}, got {n_points}")
 
 
-#: What one curve costs a fitting step beyond its points, in points: its decoder runs (service/fitting.py) take
+#: What one curve costs a fitting step beyond its points, in points: its decoder runs (inference/fitting.py) take
 #: about as long as matching 300 points (10 steps: ~86 ms for a 4-point curve, ~130 ms for a 161-point one).
 REFINE_POINTS_PER_CURVE = 300
 

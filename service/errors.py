@@ -14,7 +14,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from starlette.exceptions import HTTPException
 
-from curve_vae.service.inputs import InputError, format_loc
+from curve_vae.inference.errors import InputError, format_loc
 
 MAX_ERRORS_SHOWN = 20
 

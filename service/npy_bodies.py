@@ -22,7 +22,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
 from pydantic import BaseModel, ValidationError
 
-from curve_vae.service.inputs import InputError
+from curve_vae.inference.errors import InputError
 from curve_vae.service.settings import Settings
 
 MEDIA_TYPE = "application/x-npy"

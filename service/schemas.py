@@ -94,7 +94,7 @@ SpacingMode = Annotated[
 ]
 
 #: Most fitting steps a request may ask for (each costs about 7 decoder runs per curve: a Jacobian of 32 runs every
-#: 5th step, one run per step; service/fitting.py).
+#: 5th step, one run per step; inference/fitting.py).
 MAX_REFINE_STEPS = 30
 
 RefineSteps = Annotated[

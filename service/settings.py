@@ -32,14 +32,14 @@ class Settings(BaseSettings):
     model_dir: Path = DEFAULT_MODEL_DIR  # encoder.onnx, decoder.onnx and manifest.json
     providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
     # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among
-    # workers × inference_concurrency (service/cpus.py), so a container never runs more threads than its quota
+    # workers × inference_concurrency (inference/cpus.py), so a container never runs more threads than its quota
     intra_op_threads: int = Field(0, ge=0)
     inter_op_threads: int = Field(1, ge=0)  # onnxruntime's inter-op pool; the graphs run sequentially; 0: its default
     spinning: bool = False  # onnxruntime threads spin-wait between runs: CPU stolen from the other inferences
     # inferences running at once = threads of the inference executor; 0: one per CPU of this worker (cpus ÷ workers)
     inference_concurrency: int = Field(0, ge=0)
     sessions: int = Field(0, ge=0)  # encoder/decoder session pairs per worker; 0: one per inference running at once
-    # Micro-batching (service/batching.py): concurrent requests' graph runs gathered into one run of at most
+    # Micro-batching (inference/batching.py): concurrent requests' graph runs gathered into one run of at most
     # micro_batch_rows rows, waiting at most micro_batch_wait_ms for company. Off: slower on this CPU
     # (docs/BENCHMARKS.md); on a GPU turn it on.
     micro_batch: bool = False

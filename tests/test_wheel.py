@@ -8,19 +8,19 @@ the package.
 
 import json
 import os
-import socket
 import subprocess
 import sys
 import sysconfig
-import time
 import urllib.request
 import zipfile
 from pathlib import Path
 
 import pytest
 
+from curve_vae.service.live import LiveServer
+
 ROOT = Path(__file__).resolve().parents[1]
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.integration]
 
 
 @pytest.fixture(scope="module")
@@ -89,38 +89,16 @@ def test_the_installed_command_tells_one_version(venv, tmp_path):
     assert __version__ != "0.0.0"
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def test_the_installed_wheel_serves_its_shipped_model_from_anywhere(venv, tmp_path):
     from curve_vae import __version__
 
-    port = _free_port()
     env = {k: v for k, v in os.environ.items() if not k.startswith("CURVE_VAE_")}
-    proc = subprocess.Popen(
-        [str(venv / "bin" / "curve-vae"), "serve", "--port", str(port), "--log-level", "warning"],
-        cwd=tmp_path,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-    )
-    url = f"http://127.0.0.1:{port}"
+    # the wheel's own command, run from elsewhere, in an install without torch
+    assert subprocess.run([str(venv / "bin" / "python"), "-c", "import torch"], capture_output=True).returncode != 0
+    server = LiveServer(command=[str(venv / "bin" / "curve-vae"), "serve"], cwd=tmp_path, env=env)
     try:
-        for _ in range(300):
-            try:
-                with urllib.request.urlopen(url + "/ready", timeout=1) as r:
-                    if r.status == 200:
-                        break
-            except OSError:
-                if proc.poll() is not None:
-                    pytest.fail(f"curve-vae serve exited: {proc.stdout.read()}")
-                time.sleep(0.2)
-        else:
-            pytest.fail("the installed service never became ready")
+        server.wait_ready()
+        url = server.url
         with urllib.request.urlopen(url + "/model") as r:
             model = json.load(r)
         shipped = json.loads((ROOT / "models" / "manifest.json").read_text())
@@ -140,5 +118,4 @@ def test_the_installed_wheel_serves_its_shipped_model_from_anywhere(venv, tmp_pa
             answer = json.load(r)
         assert len(answer["curves"][0]) == len(curve)
     finally:
-        proc.terminate()
-        proc.wait(timeout=30)
+        server.stop()

@@ -28,7 +28,7 @@ def onnx_codec(model_dir: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]
     """Encoder/decoder callables over the ONNX graphs of an exported model, and its manifest: loaded as the
     service loads them (CurveRuntime: the manifest's tensor names, the graphs' sha256 checked), so what is
     measured is what users receive."""
-    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.inference.runtime import CurveRuntime
 
     return runtime_codec(CurveRuntime.load(model_dir, providers="cpu", warm_up=False))
 
@@ -233,7 +233,7 @@ def run_evaluation(
 ) -> dict[str, Any]:
     """Evaluate on each named test set; write report.json (and figures) into out_dir.
 
-    runtime: the exported model as the service runs it (service.runtime.CurveRuntime): adds the
+    runtime: the exported model as the service runs it (inference.runtime.CurveRuntime): adds the
     generation report of its priors, the first test set held out and the second as the real reference,
     and with suite_count > 0 the family suite (training/suite.py) of that many curves per set (with
     suite_refine > 0 also refined by that many fitting steps, as report["families_refined"] = {"refine": steps,

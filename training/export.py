@@ -25,8 +25,8 @@ from torch import nn
 
 from curve_vae.files import atomic_path, atomic_write_text
 from curve_vae.geometry import clamped_uniform_knots
-from curve_vae.service.model_files import file_sha256
-from curve_vae.service.prior import PRIOR_FILE, LatentPrior
+from curve_vae.inference.model_files import file_sha256
+from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
 from curve_vae.training.checkpoint import save_weights
 from curve_vae.training.model import VAE, ModelConfig
 
@@ -330,7 +330,7 @@ def measure_export(
     import shutil
     import tempfile
 
-    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.inference.runtime import CurveRuntime
     from curve_vae.training.data import generate_curves
     from curve_vae.training.evaluate import run_evaluation, runtime_codec
 

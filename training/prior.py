@@ -1,4 +1,4 @@
-"""Fit the learned latent distribution (service/prior.py) to the latent means of training curves, at export.
+"""Fit the learned latent distribution (inference/prior.py) to the latent means of training curves, at export.
 
 A full-covariance Gaussian mixture: 8 components bring the share of self-intersecting samples
 from 25% (one Gaussian) to 14% and the samples' nearest-neighbour distances to the real curves'
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curve_vae.service.prior import LatentPrior
+from curve_vae.inference.prior import LatentPrior
 
 COMPONENTS = 8  # measured: 1 → 25% self-intersecting samples, 8 → 13.8%, 32 → 11.6%
 FIT_CURVES = 20_000  # latent means of this many training curves: enough for 8 × 32-dim full covariances

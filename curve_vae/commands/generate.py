@@ -16,8 +16,8 @@ from curve_vae.progress import bar, counted, shown
 
 def cmd_sample(a: argparse.Namespace) -> int:
     from curve_vae.files import write_output
-    from curve_vae.service.payloads import sample_body, with_output
-    from curve_vae.service.sampling import fresh_seed
+    from curve_vae.inference.bodies import sample_body, with_output
+    from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
     runtime = model_runtime(a)
@@ -47,8 +47,8 @@ def cmd_augment(a: argparse.Namespace) -> int:
     import numpy as np
 
     from curve_vae.files import read_curves, write_npy_chunks, write_output
-    from curve_vae.service.payloads import augment_body
-    from curve_vae.service.sampling import fresh_seed
+    from curve_vae.inference.bodies import augment_body
+    from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
     runtime = model_runtime(a)
@@ -89,7 +89,7 @@ def cmd_augment(a: argparse.Namespace) -> int:
 
 def cmd_fit(a: argparse.Namespace) -> int:
     from curve_vae.files import read_curves, write_output
-    from curve_vae.service.payloads import fit_body
+    from curve_vae.inference.bodies import fit_body
 
     refuse_overwrite(a.output, a.force)
     body = fit_body(read_curves(a.input), a.n_ctrl, param=a.param, n_points=a.n_points, tolerance=a.tolerance)

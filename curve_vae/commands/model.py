@@ -62,7 +62,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
 
         data_cfg_d = torch.load(a.checkpoint, map_location="cpu", weights_only=True).get("data_config")  # vae.pt: none
     else:
-        from curve_vae.service.runtime import CurveRuntime
+        from curve_vae.inference.runtime import CurveRuntime
 
         runtime = CurveRuntime.load(a.model_dir, providers="cpu")
         enc, dec, meta = runtime_codec(runtime)

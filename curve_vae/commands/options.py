@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from curve_vae.service.cpus import available_cpus
+from curve_vae.inference.cpus import available_cpus
 from curve_vae.training.families import MIX_VERSION, MIXES
 
 DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
@@ -131,7 +131,7 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
 
 
 def model_runtime(a: argparse.Namespace):
-    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.inference.runtime import CurveRuntime
     from curve_vae.service.settings import DEFAULT_MODEL_DIR
 
     model_dir = a.model_dir or DEFAULT_MODEL_DIR

@@ -15,9 +15,15 @@ import numpy as np
 from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response, StreamingResponse
 
+from curve_vae.inference.augmenting import AugmentPlan
+from curve_vae.inference.bodies import augment_body, frames_json, sample_body, with_metrics, with_output
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
+from curve_vae.inference.npy import chunk_bytes, npy_header, npy_size
+from curve_vae.inference.runtime import CurveRuntime
+from curve_vae.inference.sampling import fresh_seed
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, C3, POST_ERRORS, curl_sample, example
-from curve_vae.service.augmenting import AugmentPlan
 from curve_vae.service.deps import (
     RuntimeDep,
     SettingsDep,
@@ -32,15 +38,9 @@ from curve_vae.service.deps import (
     splines_wanted,
 )
 from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.inputs import InputError
 from curve_vae.service.metrics import Metrics
-from curve_vae.service.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
-from curve_vae.service.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service.npy_bodies import OPENAPI_BODY as NPY_BODY
 from curve_vae.service.npy_bodies import npy_route
-from curve_vae.service.payloads import augment_body, frames_json, sample_body, with_metrics, with_output
-from curve_vae.service.runtime import CurveRuntime
-from curve_vae.service.sampling import fresh_seed
 from curve_vae.service.settings import Settings
 
 ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'

@@ -9,6 +9,8 @@ from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
 from curve_vae.geometry import revolve
+from curve_vae.inference.bodies import fit_body
+from curve_vae.inference.errors import InputError
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example
 from curve_vae.service.deps import (
@@ -18,8 +20,6 @@ from curve_vae.service.deps import (
     run_inference,
 )
 from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.inputs import InputError
-from curve_vae.service.payloads import fit_body
 
 design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 

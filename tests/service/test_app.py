@@ -7,8 +7,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from curve_vae.geometry import fit_frame, mse_per_curve
+from curve_vae.inference.model_files import ModelLoadError
 from curve_vae.service.app import create_app
-from curve_vae.service.model_files import ModelLoadError
 from curve_vae.service.settings import Settings
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]

@@ -11,8 +11,7 @@ from curve_vae.geometry import closest_squared_distances, evaluate_bspline, pose
 from curve_vae.geometry.adapt import to_model_plane
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
-
-from .conftest import bspline_curves
+from tests.helpers import bspline_curves
 
 
 def _user_curves() -> list[np.ndarray]:
@@ -98,8 +97,8 @@ def test_the_shipped_model_is_placed_closest_and_comes_back_closer_so(shipped_ru
 
 
 def test_the_server_setting_overrides_the_manifest(model_dir, raw_model_dir, closest_runtime):
-    from curve_vae.service.model_files import ModelLoadError
-    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.inference.model_files import ModelLoadError
+    from curve_vae.inference.runtime import CurveRuntime
 
     c = _user_curves()[4]
     with TestClient(create_app(Settings(model_dir=model_dir, placement="closest"))) as client:  # an "index" manifest

@@ -12,8 +12,8 @@ import httpx
 import pytest
 import uvicorn
 
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
-from curve_vae.service.runtime import CurveRuntime
 from curve_vae.service.settings import Settings
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]

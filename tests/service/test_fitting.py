@@ -1,4 +1,4 @@
-"""Refining reconstructions (`refine`, service.fitting): latents fitted to the caller's points through the real ONNX
+"""Refining reconstructions (`refine`, inference.fitting): latents fitted to the caller's points through the real ONNX
 decoder; closer reconstructions, never worse ones, and the API's bounds on the work asked for."""
 
 from __future__ import annotations
@@ -10,13 +10,12 @@ import pytest
 from fastapi.testclient import TestClient
 
 from curve_vae.geometry import evaluate_bspline, resample, self_intersects
+from curve_vae.inference.errors import InputError
 from curve_vae.service.app import create_app
-from curve_vae.service.inputs import InputError
 from curve_vae.service.schemas import MAX_REFINE_STEPS
 from curve_vae.service.settings import Settings
 from curve_vae.training.suite import relative_rmse
-
-from .conftest import bspline_curves
+from tests.helpers import bspline_curves
 
 
 def _naca_loop(thickness: float = 0.12) -> np.ndarray:

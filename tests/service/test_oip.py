@@ -13,7 +13,7 @@ from fastapi.testclient import TestClient
 from curve_vae.service import oip
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
-from tests.service.conftest import SHIPPED, bspline_curves
+from tests.helpers import SHIPPED, bspline_curves
 
 DATATYPE = {"tensor(float)": "FP32"}
 

@@ -76,7 +76,7 @@ print("ok")
 
 def test_importing_the_app_loads_no_torch():
     code = (
-        "import sys, curve_vae.service.app, curve_vae.service.cli, curve_vae.service.runtime; "
+        "import sys, curve_vae.service.app, curve_vae.service.cli, curve_vae.inference.runtime; "
         "assert 'torch' not in sys.modules; print('ok')"
     )
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)

@@ -16,7 +16,8 @@ import httpx
 import numpy as np
 import pytest
 
-from tests.service.conftest import ROOT, SHIPPED, LiveServer
+from curve_vae.service.live import LiveServer
+from tests.helpers import ROOT, SHIPPED
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 ARTIFACTS = ROOT / "test-artifacts"
@@ -28,6 +29,8 @@ if not Path(CHROMIUM).exists():
     pytest.skip("chromium is not installed (apt-get install chromium)", allow_module_level=True)
 
 from playwright.sync_api import Browser, Page, sync_playwright  # noqa: E402
+
+pytestmark = pytest.mark.integration
 
 ARGS = [
     "--headless=new",

@@ -12,7 +12,12 @@ import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from tests.service.conftest import SHIPPED, LiveServer
+import pytest
+
+from curve_vae.service.live import LiveServer
+from tests.helpers import SHIPPED
+
+pytestmark = pytest.mark.integration
 
 #: Rules JSON Schema cannot state, each with the message the service answers (a 422 naming the fields).
 CROSS_FIELD_RULES = {
@@ -41,7 +46,7 @@ OIP_CROSS_FIELD_RULES = {
 
 
 def test_schemathesis_finds_nothing_but_the_named_cross_field_rules(tmp_path):
-    server = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu", "--log-level", "warning")
+    server = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
     try:
         server.wait_ready()
         junit = tmp_path / "junit.xml"

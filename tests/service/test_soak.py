@@ -5,7 +5,11 @@ from __future__ import annotations
 import importlib.util
 import json
 
-from tests.service.conftest import ROOT, SHIPPED
+import pytest
+
+from tests.helpers import ROOT, SHIPPED
+
+pytestmark = pytest.mark.integration
 
 
 def test_short_soak_has_no_errors(tmp_path, capsys):

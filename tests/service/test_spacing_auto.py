@@ -7,10 +7,9 @@ import numpy as np
 import pytest
 
 from curve_vae.geometry import natural_params, natural_readings, resample
-from curve_vae.service import runtime as runtime_module
+from curve_vae.inference import runtime as runtime_module
 from curve_vae.service.schemas import ReconstructRequest
-
-from .conftest import bspline_curves
+from tests.helpers import bspline_curves
 
 
 def _drawn_by_arc_length(count: int, seed: int) -> list[np.ndarray]:

@@ -12,7 +12,7 @@ import pytest
 import torch
 
 from curve_vae.cli import main
-from curve_vae.service.model_files import file_sha256
+from curve_vae.inference.model_files import file_sha256
 from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
 
 pytestmark = pytest.mark.slow
@@ -265,7 +265,7 @@ def test_snapshots_keep_the_latest_epochs(trained, capsys):
 def test_export_with_spline_head(trained):
     """--spline-ctrl puts the B-spline head into decoder.onnx: control points out, curves = basis @ control points."""
     from curve_vae.geometry import spline_head
-    from curve_vae.service.runtime import CurveRuntime
+    from curve_vae.inference.runtime import CurveRuntime
 
     tmp, data, cut, _, _ = trained
     out = tmp / "models_spline"

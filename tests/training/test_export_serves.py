@@ -3,8 +3,8 @@
 import torch
 from fastapi.testclient import TestClient
 
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
-from curve_vae.service.runtime import CurveRuntime
 from curve_vae.service.settings import Settings
 from curve_vae.training.export import export
 from curve_vae.training.model import VAE, ModelConfig

@@ -23,10 +23,10 @@ from scipy.interpolate import BSpline
 from scipy.optimize import isotonic_regression
 
 from curve_vae.geometry import arc_fractions, closest_params, params_at_arc_fractions
-from curve_vae.service.inputs import InputError
+from curve_vae.inference.errors import InputError
 
 if TYPE_CHECKING:
-    from curve_vae.service.prepared import Prepared
+    from curve_vae.inference.prepared import Prepared
 
 #: Forward-difference step in latent units (the latent prior is a unit Gaussian; the decoder runs in float32).
 FD_STEP = 1e-2

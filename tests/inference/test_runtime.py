@@ -11,9 +11,9 @@ import onnxruntime as ort
 import pytest
 
 from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve, simplex_grid, simplex_grid_size
-from curve_vae.service.inputs import InputError
-from curve_vae.service.model_files import ModelLoadError, resolve_providers
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.model_files import ModelLoadError, resolve_providers
+from curve_vae.inference.runtime import CurveRuntime
 
 # ----------------------------------------------------------------------------- loading
 

@@ -16,16 +16,16 @@ steps of the parameters of the cubic B-spline fitted to it (the paper's curves' 
 them), "arc_length" evenly by arc length (geometry.adapt), and "auto", the default, tries "parameter" and each of
 the curve's natural readings (geometry.natural_readings: one or two) and keeps the closest reconstruction, as pose
 "auto" does with poses. Nothing here
-imports torch. Reading and checking model files is `service.model_files`; the learned latent
-distribution is `service.prior`.
+imports torch. Reading and checking model files is `inference.model_files`; the learned latent
+distribution is `inference.prior`.
 
 Length (~500 lines): one class whose methods share the choice of pose (which needs both graphs) and carry a batch's
 frames, input positions and splines from `prepare` through the graphs to the result, turning geometry's errors into
 the service's InputError with the field and curve they concern. Its parts live beside it: the candidate readings and
-the kept batch are `service.prepared`; the sessions, signature checks and raw graph runs are `service.graphs` (the
+the kept batch are `inference.prepared`; the sessions, signature checks and raw graph runs are `inference.graphs` (the
 base class `ModelGraphs`); the pure frame and length adaptation is `geometry.adapt`; augmentation
-`service.augmenting`, sampling `service.sampling` and the fitting of `refine` `service.fitting` (base classes too);
-the input error `service.inputs`; the mixing weights `geometry.mixing`.
+`inference.augmenting`, sampling `inference.sampling` and the fitting of `refine` `inference.fitting` (base classes too);
+the input error `inference.errors`; the mixing weights `geometry.mixing`.
 """
 
 from __future__ import annotations
@@ -55,12 +55,12 @@ from curve_vae.geometry import (
     to_model_plane,
 )
 from curve_vae.geometry.adapt import F32_MAX, is_closed, joined_ends
-from curve_vae.service.augmenting import Augmenting
-from curve_vae.service.fitting import Fitting
-from curve_vae.service.graphs import ModelGraphs
-from curve_vae.service.inputs import InputError
-from curve_vae.service.prepared import Candidates, Prepared
-from curve_vae.service.sampling import Sampling
+from curve_vae.inference.augmenting import Augmenting
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.fitting import Fitting
+from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.prepared import Candidates, Prepared
+from curve_vae.inference.sampling import Sampling
 
 FrameMode = Literal["auto", "model"]
 Spacing = Literal["parameter", "arc_length", "natural", "auto"]

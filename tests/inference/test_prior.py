@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from curve_vae.service.model_files import ModelLoadError
-from curve_vae.service.prior import PRIOR_FILE, LatentPrior
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.inference.model_files import ModelLoadError
+from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.evaluate import nearest_distances, sample_quality
 
 

@@ -14,7 +14,7 @@ from typing import Any
 import onnxruntime as ort
 
 from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.service.prior import PRIOR_FILE
+from curve_vae.inference.prior import PRIOR_FILE
 
 CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
 

@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from curve_vae.geometry import Frame, self_intersects
-from curve_vae.service.inputs import InputError
-from curve_vae.service.prior import LatentPrior
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.prior import LatentPrior
 
 if TYPE_CHECKING:
-    from curve_vae.service.runtime import Spacing, Spline
+    from curve_vae.inference.runtime import Spacing, Spline
 
 Prior = Literal["learned", "standard"]
 MAX_DRAWS = 10  # per sampled curve: the shipped prior rejects 25% of draws, so 10 fail with probability ~1e-6;
@@ -66,7 +66,7 @@ class Sampling:
         """New curves from a latent distribution, decoded into the model plane (or mapped into `frame`).
 
         prior "learned": the Gaussian mixture fitted to the training curves' latent means (the default where the
-        model ships one); "standard": the VAE's N(0, I). temperature scales the spread (see service/prior.py).
+        model ships one); "standard": the VAE's N(0, I). temperature scales the spread (see inference/prior.py).
         valid: a draw whose curve crosses itself or leaves the data's disc is rejected and item i draws again, at
         most max_draws times in all. Item i's draws come from its own generator default_rng([seed, i]), so the
         seed decides every curve, across rejections too, and the first items of a larger count are the items of

@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from curve_vae.geometry import Frame
-from curve_vae.service.inputs import InputError
+from curve_vae.inference.errors import InputError
 
 if TYPE_CHECKING:
-    from curve_vae.service.prepared import Prepared
-    from curve_vae.service.runtime import FrameMode, PoseMode, Spacing, Spline
+    from curve_vae.inference.prepared import Prepared
+    from curve_vae.inference.runtime import FrameMode, PoseMode, Spacing, Spline
 
 
 class Augmenting:

@@ -12,9 +12,9 @@ from typing import Any
 import numpy as np
 
 from curve_vae.geometry import Frame, fit_bspline, fit_bspline_auto
-from curve_vae.service.inputs import InputError
-from curve_vae.service.runtime import Spline, curve_metrics
-from curve_vae.service.sampling import Sampled
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.runtime import Spline, curve_metrics
+from curve_vae.inference.sampling import Sampled
 
 
 def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:

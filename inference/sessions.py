@@ -18,7 +18,7 @@ from typing import Any
 
 import onnxruntime as ort
 
-from curve_vae.service.model_files import CUDA, ModelLoadError
+from curve_vae.inference.model_files import CUDA, ModelLoadError
 
 SPINNING_KEYS = ("session.intra_op.allow_spinning", "session.inter_op.allow_spinning")
 

@@ -27,7 +27,7 @@ class Prepared:
     decoded: np.ndarray | None = None  # (B, n_points, 2) model plane
     ctrl: np.ndarray | None = None  # (B, n_ctrl, 2) with a B-spline head
     params: np.ndarray | None = None  # (B, n_points) spline parameter of each model point, if the head learns them
-    # With refine, the latents are fitted (service.fitting) and each input point is matched to its closest point:
+    # With refine, the latents are fitted (inference.fitting) and each input point is matched to its closest point:
     feet: list[np.ndarray] | None = None  # per curve, the spline parameter (model order) of each input point
 
 

@@ -1,4 +1,4 @@
-"""Fixtures of the service tests: real exported ONNX models, loaded runtimes, apps and a live server.
+"""Fixtures of the inference and service tests: real exported ONNX models, loaded runtimes, apps and live servers.
 
 The test model is untrained and small (Table 1's cnn1), committed under tests/fixtures/ by
 tests/fixtures/make_models.py, so these tests run in an install without torch; tests that need a
@@ -8,28 +8,28 @@ model that actually reconstructs use `shipped_runtime` (models/).
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import socket
-import subprocess
-import sys
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-import httpx
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from curve_vae.geometry import random_control_points, sample_bspline
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
-from curve_vae.service.runtime import CurveRuntime
+from curve_vae.service.live import LiveServer
 from curve_vae.service.settings import Settings
+from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves
 
-ROOT = Path(__file__).resolve().parents[2]
-SHIPPED = ROOT / "models"
-FIXTURES = ROOT / "tests" / "fixtures"
+#: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
+SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        if SERVER_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.integration)
 
 
 @pytest.fixture(scope="session")
@@ -118,61 +118,9 @@ def client(make_client: Callable[..., TestClient]) -> TestClient:
     return make_client()
 
 
-def bspline_curves(count: int, n_points: int = 161, *, seed: int = 0) -> np.ndarray:
-    """(count, n_points, 2) curves of the paper's kind, in the 128×128 plane."""
-    return sample_bspline(random_control_points(np.random.default_rng(seed), count), n_points)
-
-
 @pytest.fixture
 def curves() -> Callable[..., np.ndarray]:
     return bspline_curves
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-class LiveServer:
-    """`python -m curve_vae.service.cli` (what `curve-vae serve` runs) in a subprocess on a free loopback port."""
-
-    def __init__(self, *args: str, env: dict[str, str] | None = None) -> None:
-        self.port = free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
-        cmd = [sys.executable, "-m", "curve_vae.service.cli", "--port", str(self.port), "--log-level", "warning", *args]
-        self.proc = subprocess.Popen(
-            cmd,
-            cwd=ROOT,
-            env={**os.environ, **(env or {})},
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-
-    def wait_ready(self, timeout: float = 30.0) -> None:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise RuntimeError(f"server exited with {self.proc.returncode}:\n{self.proc.stdout.read()}")  # type: ignore[union-attr]
-            try:
-                if httpx.get(f"{self.url}/ready", timeout=1.0).status_code == 200:
-                    return
-            except httpx.TransportError:
-                pass
-            time.sleep(0.1)
-        raise TimeoutError(f"{self.url} not ready after {timeout} s")
-
-    def stop(self) -> int:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        self.proc.stdout.close()  # type: ignore[union-attr]
-        return self.proc.returncode
 
 
 @pytest.fixture
@@ -181,7 +129,7 @@ def server_factory() -> Iterator[Callable[..., LiveServer]]:
     servers: list[LiveServer] = []
 
     def start(*args: str, env: dict[str, str] | None = None) -> LiveServer:
-        servers.append(LiveServer(*args, env=env))
+        servers.append(LiveServer(*args, env=env, cwd=ROOT))
         return servers[-1]
 
     yield start
@@ -194,19 +142,13 @@ def shipped_server() -> Iterator[LiveServer]:
     """`curve-vae serve` on the shipped model, for tests of what users see (the page, the README's answers)."""
     if not (SHIPPED / "manifest.json").is_file():
         pytest.skip("no shipped model: models/manifest.json is absent")
-    server = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
-    try:
-        server.wait_ready()
+    with LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu", cwd=ROOT) as server:
         yield server
-    finally:
-        server.stop()
 
 
 @pytest.fixture(scope="session")
 def live_server(model_dir: Path) -> Iterator[LiveServer]:
-    server = LiveServer("--model-dir", str(model_dir), "--providers", "cpu", "--max-body-bytes", "200000")
-    try:
-        server.wait_ready()
+    with LiveServer(
+        "--model-dir", str(model_dir), "--providers", "cpu", "--max-body-bytes", "200000", cwd=ROOT
+    ) as server:
         yield server
-    finally:
-        server.stop()

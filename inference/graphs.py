@@ -1,10 +1,10 @@
 """One exported model's two ONNX graphs as the service runs them: opened, checked and warmed up, then run raw.
 
-`ModelGraphs.load(model_dir)` reads and checks the manifest (`service.model_files`), opens one encoder/decoder
-session pair per inference thread (`service.sessions`), checks the graphs' signatures against the manifest, reads
+`ModelGraphs.load(model_dir)` reads and checks the manifest (`inference.model_files`), opens one encoder/decoder
+session pair per inference thread (`inference.sessions`), checks the graphs' signatures against the manifest, reads
 the learned prior and runs a warm-up. `encode_model` and `decode_model(_splines)` take and return model-plane
 arrays in runs of `batch_size`, through the thread's micro-batcher when it has one. `CurveRuntime`
-(service.runtime) builds the caller's frames, lengths and poses on top.
+(inference.runtime) builds the caller's frames, lengths and poses on top.
 """
 
 from __future__ import annotations
@@ -17,10 +17,10 @@ import onnxruntime as ort
 
 from curve_vae.geometry import clamped_uniform_knots
 from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.service import batching
-from curve_vae.service.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
-from curve_vae.service.prior import PRIOR_FILE, LatentPrior
-from curve_vae.service.sessions import SessionConfig, SessionPool, open_pair
+from curve_vae.inference import batching
+from curve_vae.inference.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
+from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
+from curve_vae.inference.sessions import SessionConfig, SessionPool, open_pair
 
 
 class ModelGraphs:
@@ -74,7 +74,7 @@ class ModelGraphs:
     ) -> Self:
         """Open a model directory; raises ModelLoadError with what to fix when it cannot serve.
 
-        `sessions` sets threads, spinning and the number of session pairs (service.sessions); without it, one pair
+        `sessions` sets threads, spinning and the number of session pairs (inference.sessions); without it, one pair
         of `intra_op_threads` threads. `placement`: "model" places a reconstruction's points as the manifest's
         spline.placement says; "closest" or "index" whatever it says (CURVE_VAE_PLACEMENT)."""
         root = Path(model_dir)

@@ -1,0 +1,134 @@
+"""A real server on a loopback port, started in a subprocess and stopped again: for tests, benchmarks, the soak and
+anyone scripting against a local service.
+
+    with LiveServer("--model-dir", "models") as server:
+        httpx.post(f"{server.url}/reconstruct", json={"curves": [...]})
+
+`command` defaults to `python -m curve_vae.service.cli` (what `curve-vae serve` runs) in this interpreter; the
+wheel's test passes its installed `curve-vae serve` instead. Standard library only.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Self
+
+
+def free_port() -> int:
+    """A loopback port nothing listens on (now)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class LiveServer:
+    """The service in a subprocess on a free loopback port; `wait_ready` polls GET /ready until it answers 200."""
+
+    def __init__(
+        self,
+        *args: str,
+        env: dict[str, str] | None = None,
+        command: Sequence[str] | None = None,
+        cwd: str | Path | None = None,
+        capture: bool = True,
+        log_level: str = "warning",
+    ) -> None:
+        self.port = free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        base = list(command) if command is not None else [sys.executable, "-m", "curve_vae.service.cli"]
+        self.cmd = [*base, "--port", str(self.port), "--log-level", log_level, *args]
+        out = subprocess.PIPE if capture else None
+        self.proc = subprocess.Popen(
+            self.cmd,
+            cwd=cwd,
+            env={**os.environ, **(env or {})},
+            stdout=out,
+            stderr=subprocess.STDOUT if capture else None,
+            text=True,
+        )
+
+    def __enter__(self) -> Self:
+        try:
+            self.wait_ready()
+        except BaseException:
+            self.stop()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def output(self) -> str:
+        """What the server printed (a stopped server's, when captured)."""
+        if self.proc.stdout is None or self.proc.poll() is None:
+            return ""
+        return self.proc.stdout.read()
+
+    def wait_ready(self, timeout: float = 60.0) -> None:
+        """Poll /ready until 200; RuntimeError (with the server's output) if it exits, TimeoutError if it is slow."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"server exited with {self.proc.returncode}: {' '.join(self.cmd)}\n{self.output()}")
+            try:
+                with urllib.request.urlopen(f"{self.url}/ready", timeout=1) as r:
+                    if r.status == 200:
+                        return
+            except OSError:
+                pass
+            time.sleep(0.1)
+        raise TimeoutError(f"{self.url} not ready after {timeout:g} s")
+
+    def pids(self) -> list[int]:
+        """The server process and all its descendants (uvicorn's workers), from /proc."""
+        out, todo = [], [self.proc.pid]
+        while todo:
+            pid = todo.pop()
+            out.append(pid)
+            try:
+                todo += [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+            except OSError:
+                pass
+        return out
+
+    def cpu_seconds(self) -> dict[int, float]:
+        """User + system CPU seconds of each server process so far."""
+        tick = os.sysconf("SC_CLK_TCK")
+        out = {}
+        for pid in self.pids():
+            try:
+                fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            out[pid] = (int(fields[11]) + int(fields[12])) / tick  # utime, stime
+        return out
+
+    def rss_mib(self) -> float:
+        """Resident memory of the server's processes, MiB."""
+        total = 0
+        for pid in self.pids():
+            try:
+                for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+                    if line.startswith("VmRSS:"):
+                        total += int(line.split()[1])
+            except OSError:
+                continue
+        return total / 1024
+
+    def stop(self, timeout: float = 15.0) -> int:
+        """Terminate (then kill) the server; its exit code."""
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        return self.proc.returncode
