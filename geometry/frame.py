@@ -102,7 +102,8 @@ def blend_frames(frames: list[Frame], weights: np.ndarray) -> list[Frame]:
 #: Directions (radians) the chord of a posed curve is turned to: the paper's generator draws curves whose chord
 #: (first point -> last) points into the lower half-plane, about straight down, and which turn counter-clockwise.
 POSE_CHORDS = (-np.pi / 2, -np.pi / 4, -3 * np.pi / 4)
-#: A chord shorter than this share of the bounding box marks a closed-looking curve (see pose_frames).
+#: A chord shorter than this share of the curve's extent (twice its furthest point from its centroid) marks a
+#: closed-looking curve (see chord_heading).
 CLOSED = 0.05
 
 
@@ -117,16 +118,38 @@ def signed_turning(points: np.ndarray) -> float:
     return float(np.arctan2(cross, dot).sum())
 
 
+def turns_clockwise(points: np.ndarray) -> bool:
+    """Whether a curve turns clockwise overall, the side a posed curve is mirrored from: by its signed turning, or
+    where that is zero to rounding (straight lines, S-bends) by the signed area it encloses with its chord. Both
+    change sign with the point order and with a mirror image, and neither with a turn."""
+    turning = signed_turning(points)
+    if abs(turning) > 1e-9:
+        return turning < 0
+    x, y = np.asarray(points, np.float64).T
+    return float((x * np.roll(y, -1) - np.roll(x, -1) * y).sum()) < 0
+
+
 def chord_heading(points: np.ndarray) -> float:
     """Direction (radians) of a curve's chord, first point -> last. For a closed or nearly closed loop (an airfoil)
     the direction its opening would have: a counter-clockwise loop that starts on its right has its chord pointing
     down, as the paper's curves do."""
     pts = np.asarray(points, np.float64)
     chord = pts[-1] - pts[0]
-    if np.hypot(*chord) >= CLOSED * np.ptp(pts, axis=0).max():
+    reach = 2 * np.linalg.norm(pts - arc_centroid(pts), axis=1).max()  # the curve's extent, however it is turned
+    if np.hypot(*chord) >= CLOSED * reach:
         return float(np.arctan2(chord[1], chord[0]))
-    out = pts[0] - pts.mean(axis=0)
+    out = (pts[0] + pts[-1]) / 2 - arc_centroid(pts)  # alike for the loop listed either way, at any spacing
     return float(np.arctan2(out[1], out[0])) - np.pi / 2
+
+
+def arc_centroid(points: np.ndarray) -> np.ndarray:
+    """Centre of mass (2,) of a polyline (n, 2) as a wire: its segments' midpoints weighted by their lengths, so it
+    does not depend on how the points are spaced along it."""
+    pts = np.asarray(points, np.float64)
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    if not seg.sum() > 0:
+        return pts.mean(axis=0)
+    return (((pts[1:] + pts[:-1]) / 2) * seg[:, None]).sum(axis=0) / seg.sum()
 
 
 def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> list[Frame]:
@@ -139,7 +162,7 @@ def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> l
     """
     fit_frame(points)  # raises ValueError when all points coincide
     pts = np.asarray(points, np.float64)
-    mirror = signed_turning(pts) < 0
+    mirror = turns_clockwise(pts)
     heading = chord_heading(pts * ([-1.0, 1.0] if mirror else 1.0))
     poses = []
     for target in POSE_CHORDS[:chords]:
@@ -153,6 +176,25 @@ def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> l
             a = (np.eye(2) - 2 * np.outer(n, n)) @ np.array([[c, -s], [s, c]]) @ np.diag([-1.0, 1.0])
             poses.append((float(np.arctan2(a[1, 0], a[0, 0])), not mirror, True))
     return [posed_frame(pts, turn, mirror=mir, reverse=rev) for turn, mir, rev in poses]
+
+
+def canonical_frame(points: np.ndarray) -> Frame:
+    """The one pose a curve is read in: of `pose_frames`' first two candidates (turning counter-clockwise, chord
+    straight down; as drawn, or reversed and mirrored across the chord's normal), the one whose arc-length centroid
+    lies towards the chord's end — for a loop, whose centroid lies on its chord's normal, the one whose
+    product moment about the centroid (across × along the chord) is positive. Those two moves turn either statistic
+    into its negative, so a curve, its reversal, its mirror image and its rotations all come to the same posed
+    points (to rounding; a curve for which both are exactly zero is symmetric under the moves, or keeps the pose
+    it is listed in)."""
+    drawn, flipped = pose_frames(points, chords=1)
+    posed = (np.asarray(points, np.float64) - np.asarray(drawn.center)) @ drawn._linear()  # chord along −y
+    centroid = arc_centroid(posed)
+    offset = (posed[0, 1] + posed[-1, 1]) / 2 - centroid[1]  # along the chord (−y), from the ends' midpoint
+    if abs(offset) <= 1e-9 * drawn.size:
+        seg = np.linalg.norm(np.diff(posed, axis=0), axis=1)
+        rel = (posed[1:] + posed[:-1]) / 2 - centroid
+        offset = -float((seg * rel[:, 0] * rel[:, 1]).sum())
+    return drawn if offset >= 0 else flipped
 
 
 def posed_frame(points: np.ndarray, rotation: float, *, mirror: bool = False, reverse: bool = False) -> Frame:

@@ -20,7 +20,7 @@ from types import MappingProxyType
 import numpy as np
 
 from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
-from curve_vae.geometry.frame import chord_heading, posed_frame, signed_turning
+from curve_vae.geometry.frame import canonical_frame, chord_heading, posed_frame, turns_clockwise
 
 MODEL_SIZE = 92.6  # the larger bounding-box side of a posed curve in the model plane: the paper's curves' median
 DENSE = 641  # points per curve before respacing: 4× the model's, so every spacing interpolates finely
@@ -153,6 +153,9 @@ class MixSpec:
     shares: Mapping[str, float]  # family -> share of the mix; the paper's curves stay the largest single share
     paper_raw: float  # of the paper's share: drawn as the paper draws them (its pose, frame, parameter spacing)
     paper_spacings: tuple[str, ...]  # the rest, posed, each respaced at one of these drawn at random
+    # "service": chords turned at random between −135° and −45°, where pose_frames' candidates put them (to_pose);
+    # "canonical": every curve, the raw share too, in the one pose geometry.canonical_frame reads it in
+    pose: str = "service"
 
     def __post_init__(self) -> None:  # a read-only copy: a version, once made, draws the same curves for good
         object.__setattr__(self, "shares", MappingProxyType(dict(self.shares)))
@@ -175,6 +178,14 @@ MIXES = {
         {"paper": 0.55, "polygon": 0.21, "arc": 0.06, "spiral": 0.06, "wave": 0.06, "naca": 0.06},
         paper_raw=0.2,
         paper_spacings=("arc_length", "arc_length", "arc_length", "parameter", "warped"),
+    ),
+    # version 3's curves, each in the one pose the service reads it in (geometry.canonical_frame), so an encoder
+    # spends nothing on poses it is never shown; the raw fifth keeps the paper's parameter spacing
+    4: MixSpec(
+        {"paper": 0.55, "polygon": 0.21, "arc": 0.06, "spiral": 0.06, "wave": 0.06, "naca": 0.06},
+        paper_raw=0.2,
+        paper_spacings=("arc_length", "arc_length", "arc_length", "parameter", "warped"),
+        pose="canonical",
     ),
 }
 #: The version new data sets are drawn at.
@@ -219,17 +230,26 @@ def respace(dense: np.ndarray, n_points: int, spacings: list[str], rng: np.rando
 
 
 def to_pose(
-    curves: np.ndarray, rng: np.random.Generator, model_size: float, *, also: np.ndarray | None = None
+    curves: np.ndarray,
+    rng: np.random.Generator,
+    model_size: float,
+    *,
+    also: np.ndarray | None = None,
+    canonical: bool = False,
 ) -> np.ndarray:
     """Each curve mirrored to turn counter-clockwise, its chord turned to a random direction between −135° and
-    −45° (where the service's pose candidates put it), then shifted and scaled so its bounding box is centred
-    in the model plane with its larger side `model_size` — exactly as the service maps a posted curve. `also`
-    (same shape): other samples of the same curves, moved in place by each curve's move."""
+    −45° (where the service's pose candidates put it) — or, `canonical`, into geometry.canonical_frame's one
+    pose — then shifted and scaled so its bounding box is centred in the model plane with its larger side
+    `model_size`, exactly as the service maps a posted curve. `also` (same shape): other samples of the same
+    curves, moved in place by each curve's move."""
     out = np.empty_like(curves, dtype=np.float64)
     for i, c in enumerate(np.asarray(curves, np.float64)):
-        mirror = signed_turning(c) < 0
-        turn = rng.uniform(-0.75 * np.pi, -0.25 * np.pi) - chord_heading(c * [-1.0, 1.0] if mirror else c)
-        frame = posed_frame(c, turn, mirror=mirror)
+        if canonical:
+            frame = canonical_frame(c)
+        else:
+            mirror = turns_clockwise(c)
+            turn = rng.uniform(-0.75 * np.pi, -0.25 * np.pi) - chord_heading(c * [-1.0, 1.0] if mirror else c)
+            frame = posed_frame(c, turn, mirror=mirror)
         out[i] = frame.to_model(c, model_size)
         if also is not None:
             also[i] = frame.to_model(np.asarray(also[i], np.float64), model_size)
@@ -246,10 +266,12 @@ def draw_family(
     spacings: tuple[str, ...] = SPACINGS,
     chunk: int = 1024,
     twins: bool = False,
+    canonical: bool = False,
 ) -> np.ndarray:
     """`count` curves (count, n_points, 2) float32 of one family without self-intersections, each at a spacing
     drawn from `spacings`; in the model's pose and frame, or as drawn for model_size None. twins: (2, count,
-    n_points, 2), the curves and the same curves evenly in their own parameter, in the same pose ("twins")."""
+    n_points, 2), the curves and the same curves evenly in their own parameter, in the same pose ("twins").
+    canonical: each in geometry.canonical_frame's pose (to_pose)."""
     out, pairs, have = [], [], 0
     while have < count:
         dense = family(rng, chunk)
@@ -258,7 +280,7 @@ def draw_family(
         pts = respace(dense, n_points, list(rng.choice(spacings, len(dense))), rng)
         even = respace(dense, n_points, ["parameter"] * len(dense), rng) if twins else None
         if model_size is not None:
-            pts = to_pose(pts, rng, model_size, also=even)
+            pts = to_pose(pts, rng, model_size, also=even, canonical=canonical)
         out.append(pts.astype(np.float32))
         if even is not None:
             pairs.append(even.astype(np.float32))
@@ -307,27 +329,20 @@ def _mix_chunk(args: tuple[int, int, int, int, float, int, bool]) -> np.ndarray:
     rng = np.random.default_rng([seed, index])
     sizes = {name: int(count * share) for name, share in spec.shares.items()}
     sizes["paper"] += count - sum(sizes.values())  # the rounding's few curves: exactly `count` in all
+    canonical = spec.pose == "canonical"
+    posed = {"n_points": n_points, "model_size": model_size, "twins": twins, "canonical": canonical}
     parts = []
     for name, k in sizes.items():
         if name == "paper":
             raw = int(round(k * spec.paper_raw))
+            # evenly in their parameter: their own twins; in the paper's own pose and frame, or the canonical one
             drawn = draw_family(paper, raw, rng, n_points=n_points, model_size=None, spacings=("parameter",))
-            parts.append(np.stack([drawn, drawn]) if twins else drawn)  # evenly in their parameter: their own twins
-            parts.append(
-                draw_family(
-                    paper,
-                    k - raw,
-                    rng,
-                    n_points=n_points,
-                    model_size=model_size,
-                    spacings=spec.paper_spacings,
-                    twins=twins,
-                )
-            )
+            if canonical:
+                drawn = to_pose(drawn, rng, model_size, canonical=True).astype(np.float32)
+            parts.append(np.stack([drawn, drawn]) if twins else drawn)
+            parts.append(draw_family(paper, k - raw, rng, spacings=spec.paper_spacings, **posed))
         else:
-            parts.append(
-                draw_family(TRAIN_FAMILIES[name], k, rng, n_points=n_points, model_size=model_size, twins=twins)
-            )
+            parts.append(draw_family(TRAIN_FAMILIES[name], k, rng, **posed))
     return np.concatenate(parts, axis=1 if twins else 0)
 
 
