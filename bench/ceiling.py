@@ -129,23 +129,25 @@ def torch_eager(model_dir: Path, *, threads: int, batch: int, seconds: float = 5
 
 
 def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
-    """Milliseconds per request of what the server does besides HTTP, in-process on one 1-thread session:
-    the raw encoder + decoder run, `CurveRuntime.reconstruct` (pose "as_is": frames, resampling, B-spline
-    back), and for 128 curves also parsing and validating the JSON body and rendering the answer; for one curve
-    drawn by arc length, the default request (pose "auto") and spacing "auto" as well."""
+    """Milliseconds per request of what the server does besides HTTP, in-process on one 1-thread session: the raw
+    encoder + decoder run; `CurveRuntime.reconstruct` with the default reading (the model's own) on curves in a
+    caller's frame (turned, mirrored, spaced by arc length: geometry.canonical_frame's pose undone), with the fast
+    path (pose "as_is", spacing "parameter") and with the search (pose and spacing "search"); and for 128 curves
+    also parsing and validating the JSON body and rendering the answer. No encoding cache: every curve is read."""
     import orjson
 
-    from curve_vae.geometry import resample
+    from curve_vae.inference.reading import Reading
     from curve_vae.inference.runtime import CurveRuntime
     from curve_vae.inference.sessions import SessionConfig
-    from curve_vae.service.deps import check_curves
     from curve_vae.service.fastjson import JSON
+    from curve_vae.service.limits import check
     from curve_vae.service.schemas import ReconstructRequest
     from curve_vae.service.settings import Settings
 
-    runtime = CurveRuntime.load(model_dir, providers="cpu", sessions=SessionConfig(intra_op_threads=1))
+    runtime = CurveRuntime.load(model_dir, providers="cpu", sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
     settings = Settings()
     out: dict[str, float] = {}
+    fast, search = Reading(pose="as_is", spacing="parameter"), Reading(pose="search", spacing="search")
 
     def ms(fn: Any) -> float:
         done, took = _count(fn, 1, seconds)
@@ -153,28 +155,36 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
 
     for batch in (1, 128):
         x = curves(batch, seed=batch)
-        as_lists = [c.astype(np.float64) for c in x]
-        out[f"onnx_b{batch}_ms"] = ms(lambda x=x: runtime.decode_model_splines(runtime.encode_model(x)[0]))
-        out[f"reconstruct_b{batch}_ms"] = ms(
-            lambda c=as_lists: runtime.reconstruct(c, pose="as_is", spacing="parameter")
-        )
-        body = orjson.dumps(
-            {"curves": x.astype(np.float64), "pose": "as_is", "spacing": "parameter"}, option=orjson.OPT_SERIALIZE_NUMPY
-        )
+        posted = callers_curves(x, seed=batch)
+        out[f"onnx_b{batch}_ms"] = ms(lambda x=x: runtime.graphs.decode(runtime.graphs.encode(x)[0]))
+        out[f"reconstruct_default_b{batch}_ms"] = ms(lambda c=posted: runtime.reconstruct(c))
+        out[f"reconstruct_fast_b{batch}_ms"] = ms(lambda c=posted: runtime.reconstruct(c, fast))
+        if batch == 1:
+            out["reconstruct_search_b1_ms"] = ms(lambda c=posted: runtime.reconstruct(c, search))
+        body = orjson.dumps({"curves": np.stack(posted)}, option=orjson.OPT_SERIALIZE_NUMPY)
 
         def parse(body: bytes = body) -> None:
-            req = ReconstructRequest.model_validate(orjson.loads(body))
-            check_curves(req.curves, settings)
+            check(ReconstructRequest.model_validate(orjson.loads(body)), settings)
 
         out[f"parse_validate_b{batch}_ms"] = ms(parse)
-        rec, mse = runtime.reconstruct(as_lists, pose="as_is", spacing="parameter")
-        out[f"render_b{batch}_ms"] = ms(lambda rec=rec, mse=mse: JSON({"curves": rec, "mse": mse}))
-    # one curve drawn by arc length, as a page or a coordinate file sends it, with pose "auto" (six pose candidates):
-    # its points as given (spacing "parameter") and the default request (spacing "auto": each pose read as given and
-    # at each of its natural spacings, geometry.natural_readings first)
-    drawn = [resample(c.astype(np.float64), len(c)) for c in curves(1, seed=1)]
-    out["reconstruct_pose_auto_b1_ms"] = ms(lambda: runtime.reconstruct(drawn, spacing="parameter"))
-    out["reconstruct_spacing_auto_b1_ms"] = ms(lambda: runtime.reconstruct(drawn, spacing="auto"))
+        rec = runtime.reconstruct(posted)
+        out[f"render_b{batch}_ms"] = ms(lambda rec=rec: JSON({"curves": rec.curves, "mse": rec.mse}))
+    return out
+
+
+def callers_curves(model_plane: np.ndarray, *, seed: int) -> list[np.ndarray]:
+    """Curves as a caller sends them: each of the paper's curves turned by a random angle, mirrored or reversed at
+    random, scaled to pixel coordinates with y down, its 161 points spaced by arc length."""
+    from curve_vae.geometry import resample
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for c in model_plane.astype(np.float64):
+        a = rng.uniform(0, 2 * np.pi)
+        turn = np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+        c = (c - 64) @ turn * ([-1.0, 1.0] if rng.random() < 0.5 else 1.0)
+        c = (c[::-1] if rng.random() < 0.5 else c) * [3.0, -3.0] + [400.0, 300.0]
+        out.append(resample(c, len(c)).round(2))
     return out
 
 

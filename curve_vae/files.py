@@ -151,7 +151,7 @@ def write_output(path: str, payload: dict[str, Any], array_key: str | None = Non
 
 def write_npy_chunks(path: str, shape: tuple[int, ...], chunks: Iterable[np.ndarray]) -> None:
     """A float32 .npy of `shape` written chunk by chunk (memory bounded by one chunk), in place when complete."""
-    from curve_vae.inference.npy import npy_chunks
+    from curve_vae.npy import npy_chunks
 
     tmp = Path(path + ".tmp")
     try:

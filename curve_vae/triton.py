@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 
-from curve_vae.inference.model_files import graph_file, read_manifest
+from curve_vae.inference.manifest import Manifest
 
 #: onnxruntime's tensor types → Triton's data types
 TRITON_TYPES = {"tensor(float)": "TYPE_FP32", "tensor(double)": "TYPE_FP64", "tensor(int64)": "TYPE_INT64"}
@@ -65,14 +65,14 @@ def write_repository(
     force: bool = False,
 ) -> list[Path]:
     """Write the repository; returns the model folders. Refuses to replace existing ones unless `force`."""
-    manifest = read_manifest(model_dir)  # checks the graphs' sha256
+    manifest = Manifest.read(model_dir)  # checks the graphs' sha256
     out = Path(out)
     folders = []
     for graph in ("encoder", "decoder"):
         folder = out / f"{prefix}_{graph}"
         if folder.exists() and not force:
             raise ValueError(f"{folder} exists and is left as it is: pass --force to replace it, or give another --out")
-        src = Path(model_dir) / graph_file(manifest, graph)
+        src = Path(model_dir) / getattr(manifest.graphs, graph).file
         session = ort.InferenceSession(str(src), providers=["CPUExecutionProvider"])
         (folder / "1").mkdir(parents=True, exist_ok=True)
         tmp = folder / "1" / ".model.onnx.tmp"

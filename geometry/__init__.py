@@ -22,15 +22,19 @@ from curve_vae.geometry.bspline import (
 )
 from curve_vae.geometry.frame import (
     Frame,
+    arc_centroid,
     arc_fractions,
     at_fractions,
     blend_frames,
+    canonical_frame,
     fit_frame,
     pose_frames,
     posed_frame,
     resample,
     signed_turning,
+    turns_clockwise,
 )
+from curve_vae.geometry.matching import ordered_closest_params
 from curve_vae.geometry.mesh import Mesh, revolve
 from curve_vae.geometry.metrics import (
     closest_squared_distances,
@@ -51,7 +55,9 @@ __all__ = [
     "BSplineFit",
     "Frame",
     "Mesh",
+    "arc_centroid",
     "blend_frames",
+    "canonical_frame",
     "clamped_uniform_knots",
     "closest_params",
     "closest_squared_distances",
@@ -75,6 +81,8 @@ __all__ = [
     "simplex_grid",
     "simplex_grid_size",
     "signed_turning",
+    "turns_clockwise",
+    "ordered_closest_params",
     "smoothness",
     "spline_head",
     "spline_to_caller",

@@ -1,107 +1,45 @@
 """Data augmentation with the VAE (paper §4): seed curves encoded once, new curves mixed between them.
 
-`Augmenting` gives `CurveRuntime` its augment methods (it needs `prepare`, `_encoded`, `_mix` and `batch_size`);
-`AugmentPlan` is the seeded rule that draws item i of a sequence, the same whatever the page or chunk size.
+`AugmentPlan` is the seeded rule that draws item i of a sequence, the same whatever the page or chunk size;
+`neighbour_pools` fixes who may be mixed with whom. `CurveRuntime.plan_augment` and `.augment` use them.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from curve_vae.geometry import Frame
+from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
 
 if TYPE_CHECKING:
     from curve_vae.inference.prepared import Prepared
-    from curve_vae.inference.runtime import FrameMode, PoseMode, Spacing, Spline
 
 
-class Augmenting:
-    """The augment methods of CurveRuntime."""
-
-    batch_size: int
-    prepare: Any
-    _encoded: Any
-    _mix: Any
-
-    def plan_augment(
-        self,
-        curves: Sequence[np.ndarray],
-        *,
-        mode: AugmentMode = "pair",
-        seed: int,
-        neighbours: int | None = None,
-        frame: FrameMode = "auto",
-        spacing: Spacing = "auto",
-        pose: PoseMode = "auto",
-    ) -> AugmentPlan:
-        """Encode the seed curves once and fix who may be mixed with whom; see `AugmentPlan`.
-
-        neighbours: each anchor's partners come from its `neighbours` nearest curves by
-        Euclidean distance between latent means (interpolating near neighbours gives better
-        curves, paper §4); None: from all the other curves.
-        """
-        k = SOURCES_PER_MODE[mode]
-        if len(curves) < k:
-            raise InputError(("curves",), f"mode {mode} needs at least {k} curves, got {len(curves)}")
-        if neighbours is not None and neighbours < k - 1:
-            raise InputError(
-                ("neighbours",), f"mode {mode} mixes each curve with {k - 1} others: at least {k - 1}, got {neighbours}"
-            )
-        if neighbours is not None and neighbours > len(curves) - 1:
-            raise InputError(
-                ("neighbours",),
-                f"at most {len(curves) - 1} (each curve has {len(curves) - 1} others), got {neighbours}; "
-                "omit it to mix any curve with any other",
-            )
-        prep = self.prepare(curves, frame, spacing, pose)
-        mean = self._encoded(prep)[0].astype(np.float64)
-        n = len(mean)
-        distance = np.linalg.norm(mean[:, None, :] - mean[None, :, :], axis=-1)  # (n, n)
-        np.fill_diagonal(distance, np.inf)  # never one's own partner
-        m = n - 1 if neighbours is None else neighbours
-        pools = np.sort(np.argsort(distance, axis=1, kind="stable")[:, :m], axis=1)
-        return AugmentPlan(prep=prep, mean=mean, k=k, seed=seed, pools=pools)
-
-    def augment_batch(
-        self,
-        plan: AugmentPlan,
-        start: int,
-        stop: int,
-        *,
-        n_points: int | None = None,
-        spacing: Spacing = "parameter",
-        splines: list[Spline] | None = None,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[Frame | None]]:
-        """Items start … stop-1 of the plan's sequence: curves, sources (m, k), weights (m, k), frames."""
-        sources, weights = plan.draw(start, stop)
-        full = np.zeros((len(sources), len(plan.mean)))
-        np.put_along_axis(full, sources, weights, axis=1)
-        out, frames = self._mix(plan.prep, plan.mean, full, n_points, spacing, splines)
-        return out, sources, weights, frames
-
-    def augment_chunks(
-        self,
-        plan: AugmentPlan,
-        start: int,
-        stop: int,
-        *,
-        n_points: int | None = None,
-        spacing: Spacing = "parameter",
-        chunk: int | None = None,
-    ) -> Iterator[np.ndarray]:
-        """The curves of items start … stop-1, `chunk` at a time (default batch_size): bounded memory for any count."""
-        step = chunk or self.batch_size
-        for i in range(start, stop, step):
-            yield self.augment_batch(plan, i, min(i + step, stop), n_points=n_points, spacing=spacing)[0]
-
-
-AugmentMode = Literal["pair", "triplet"]
-SOURCES_PER_MODE: dict[str, int] = {"pair": 2, "triplet": 3}
+def neighbour_pools(mean: np.ndarray, mode: str, neighbours: int | None) -> np.ndarray:
+    """(n, m) the curves each seed curve may be mixed with, ascending: every other curve, or its `neighbours`
+    nearest by Euclidean distance between latent means (interpolating near neighbours gives better curves, paper
+    §4). InputError when the mode needs more curves than there are, or `neighbours` cannot be met."""
+    k = SOURCES_PER_MODE[mode]
+    n = len(mean)
+    if n < k:
+        raise InputError(("curves",), f"mode {mode} needs at least {k} curves, got {n}")
+    if neighbours is not None and neighbours < k - 1:
+        raise InputError(
+            ("neighbours",), f"mode {mode} mixes each curve with {k - 1} others: at least {k - 1}, got {neighbours}"
+        )
+    if neighbours is not None and neighbours > n - 1:
+        raise InputError(
+            ("neighbours",),
+            f"at most {n - 1} (each curve has {n - 1} others), got {neighbours}; omit it to mix any curve with any "
+            "other, or send more seed curves",
+        )
+    distance = np.linalg.norm(mean[:, None, :] - mean[None, :, :], axis=-1)  # (n, n)
+    np.fill_diagonal(distance, np.inf)  # never one's own partner
+    m = n - 1 if neighbours is None else neighbours
+    return np.sort(np.argsort(distance, axis=1, kind="stable")[:, :m], axis=1)
 
 
 @dataclass(frozen=True)

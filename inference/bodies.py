@@ -13,8 +13,8 @@ import numpy as np
 
 from curve_vae.geometry import Frame, fit_bspline, fit_bspline_auto
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.runtime import Spline, curve_metrics
-from curve_vae.inference.sampling import Sampled
+from curve_vae.inference.results import Augmented, Sampled, Spline
+from curve_vae.inference.runtime import curve_metrics
 
 
 def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
@@ -43,11 +43,11 @@ def with_output(body: dict[str, Any], splines: Sequence[Spline] | None, output: 
     return out
 
 
-def sample_body(made: Sampled, seed: int, *, metrics: bool = False) -> dict[str, Any]:
+def sample_body(made: Sampled, *, metrics: bool = False) -> dict[str, Any]:
     body = {
         "latents": made.latents.tolist(),
         "curves": made.curves.tolist(),
-        "seed": seed,
+        "seed": made.seed,
         "prior": made.prior,
         "rejected": made.rejected,
         "invalid": made.invalid,
@@ -55,25 +55,16 @@ def sample_body(made: Sampled, seed: int, *, metrics: bool = False) -> dict[str,
     return with_metrics(body, made.curves, metrics)
 
 
-def augment_body(
-    curves: np.ndarray,
-    sources: np.ndarray,
-    weights: np.ndarray,
-    frames: Sequence[Frame | None],
-    *,
-    seed: int,
-    offset: int,
-    metrics: bool = False,
-) -> dict[str, Any]:
+def augment_body(made: Augmented, *, metrics: bool = False) -> dict[str, Any]:
     body = {
-        "curves": curves.tolist(),
-        "sources": sources.tolist(),
-        "weights": weights.tolist(),
-        "frames": frames_json(frames),
-        "seed": seed,
-        "offset": offset,
+        "curves": made.curves.tolist(),
+        "sources": made.sources.tolist(),
+        "weights": made.weights.tolist(),
+        "frames": frames_json(made.frames),
+        "seed": made.seed,
+        "offset": made.offset,
     }
-    return with_metrics(body, curves, metrics)
+    return with_metrics(body, made.curves, metrics)
 
 
 def fit_body(

@@ -2,7 +2,7 @@
 the caller's points.
 
 The encoder maps a curve to a latent in one pass; the decoder's best latent for that curve is usually nearby but not
-there. `Fitting.refine_latents` takes `steps` Levenberg–Marquardt steps on each latent, minimising the squared distance
+there. `Fitter.refine_latents` takes `steps` Levenberg–Marquardt steps on each latent, minimising the squared distance
 from the curve's own points to the decoded spline, each point measured to its closest point on the spline (foot points,
 `geometry.closest_params`, searched near the previous ones). Because the points are matched to their closest points and
 not to fixed parameters, the distance minimised does not depend on how the caller spaced the points along the curve
@@ -16,17 +16,17 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.interpolate import BSpline
 from scipy.optimize import isotonic_regression
 
 from curve_vae.geometry import arc_fractions, closest_params, params_at_arc_fractions
-from curve_vae.inference.errors import InputError
+from curve_vae.inference.prepared import ReadCurve
 
 if TYPE_CHECKING:
-    from curve_vae.inference.prepared import Prepared
+    from curve_vae.inference.graphs import ModelGraphs
 
 #: Forward-difference step in latent units (the latent prior is a unit Gaussian; the decoder runs in float32).
 FD_STEP = 1e-2
@@ -38,40 +38,53 @@ FOOT_WINDOW = 0.05
 JACOBIAN_EVERY = 5
 
 
-class Fitting:
-    """The latent refinement of CurveRuntime (it needs its graphs' `decode_model_splines`, `knots`,
-    `spline_degree`, `has_splines`, `has_params`, `model_size`, `n_points`, and `_encoded`)."""
+class Fitter:
+    """The latent refinement of `refine`, through a model's decoder graph (its B-spline head)."""
 
-    knots: np.ndarray | None
-    spline_degree: int
-    has_splines: bool
-    has_params: bool
-    model_size: float
-    n_points: int
-    decode_model_splines: Any
-    _encoded: Any
+    def __init__(self, graphs: ModelGraphs) -> None:
+        self.graphs = graphs
+        self.knots = graphs.knots
+        self.spline_degree = graphs.spline_degree
 
-    def _refined(self, prep: Prepared, steps: int) -> Prepared:
-        """`prep` with its latents fitted to the caller's own points by `steps` steps: the latent means become the
-        fitted latents (the log-variances stay the encoder's), and each input point is matched to its closest
-        point on the fitted spline (`Prepared.feet`), starting from where the model's spacing put it."""
-        if not self.has_splines:
-            raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
-        mean, log_var = self._encoded(prep)
+    def refine(self, inputs: Sequence[np.ndarray], rows: Sequence[ReadCurve], steps: int) -> list[ReadCurve]:
+        """The rows with their latents fitted to the caller's own points by `steps` steps: each mean becomes the
+        fitted latent (the log-variance stays the encoder's), decoded, and each caller point is matched to its
+        closest point on the fitted spline (`ReadCurve.feet`), starting from where the reading put it."""
+        g = self.graphs
         targets, around = [], []
-        for pts, f, fraction in zip(prep.inputs, prep.frames, prep.fractions):
-            targets.append(f.to_model(pts, self.model_size) if f is not None else pts)
-            around.append(np.linspace(0.0, 1.0, len(pts)) if fraction is None else fraction)
-        if prep.params is not None or self.has_params:  # the head's own parameters at those positions
-            params = prep.params if prep.params is not None else self.decode_model_splines(mean)[2]
-            own = np.linspace(0.0, 1.0, self.n_points)
-            around = [np.interp(a, own, p) for a, p in zip(around, params)]
-        known = (prep.decoded, prep.ctrl, prep.params) if prep.ctrl is not None else None  # pose "auto" decoded them
+        for pts, r in zip(inputs, rows):
+            targets.append(r.frame.to_model(pts, g.model_size) if r.frame is not None else pts)
+            if r.feet is not None:
+                around.append(r.feet)
+            else:
+                a = np.linspace(0.0, 1.0, len(pts)) if r.fraction is None else r.fraction
+                if r.params is not None:  # the head's own parameters at those positions
+                    a = np.interp(a, np.linspace(0.0, 1.0, g.n_points), r.params)
+                around.append(a)
+        decoded = all(r.decoded_yet for r in rows) and bool(rows)
+        known = (
+            (
+                np.stack([r.decoded for r in rows]),
+                np.stack([r.ctrl for r in rows]),
+                None if rows[0].params is None else np.stack([r.params for r in rows]),
+            )  # fmt: skip
+            if decoded
+            else None
+        )
+        mean = np.stack([r.mean for r in rows]) if rows else np.zeros((0, g.latent_dim))
         with np.errstate(all="ignore"):
             z, (out, ctrl, params), feet = self.refine_latents(mean, targets, around, steps, decoded=known)
-        return dataclasses.replace(
-            prep, mean=z.astype(np.float32), log_var=log_var, decoded=out, ctrl=ctrl, params=params, feet=feet
-        )
+        return [
+            dataclasses.replace(
+                r,
+                mean=z[i].astype(np.float32),
+                decoded=out[i].astype(np.float32),
+                ctrl=ctrl[i].astype(np.float32),
+                params=None if params is None else params[i],
+                feet=feet[i],
+            )
+            for i, r in enumerate(rows)
+        ]
 
     def refine_latents(
         self,
@@ -94,7 +107,7 @@ class Fitting:
         assert self.knots is not None, "refinement needs a B-spline head"
         z = np.array(latents, np.float64)
         count, dim = z.shape
-        decoded = _float64(decoded if decoded is not None else self.decode_model_splines(z))
+        decoded = _float64(decoded if decoded is not None else self.graphs.decode(z))
         # the start: two guesses of where the target's points sit (its positions as given, and the same fractions of
         # the spline's length as of the target's); the closest points searched near the closer guess, or a guess
         # itself where closer still (pooling points into order can cost more than it gains), so that the fit is
@@ -110,7 +123,7 @@ class Fitting:
         for step in range(steps if count else 0):
             if step % JACOBIAN_EVERY == 0:
                 shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
-                moved = self.decode_model_splines(shifted)[1].astype(np.float64)
+                moved = self.graphs.decode(shifted)[1].astype(np.float64)
                 jac = (moved.reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
             trial = z.copy()
             for i in range(count):
@@ -124,7 +137,7 @@ class Fitting:
                 except np.linalg.LinAlgError:  # a Jacobian of non-finite numbers: this curve stays where it is
                     trial[i] = z[i]
             with np.errstate(all="ignore"):
-                tried = _float64(self.decode_model_splines(trial))
+                tried = _float64(self.graphs.decode(trial))
             tried_feet, tried_cost = [], np.full(count, np.inf)
             for i in range(count):
                 c = tried[1][i]

@@ -1,110 +1,78 @@
-"""One exported model's two ONNX graphs as the service runs them: opened, checked and warmed up, then run raw.
+"""One exported model's two ONNX graphs as the runtime runs them: opened, checked and warmed up, then run raw.
 
-`ModelGraphs.load(model_dir)` reads and checks the manifest (`inference.model_files`), opens one encoder/decoder
-session pair per inference thread (`inference.sessions`), checks the graphs' signatures against the manifest, reads
-the learned prior and runs a warm-up. `encode_model` and `decode_model(_splines)` take and return model-plane
-arrays in runs of `batch_size`, through the thread's micro-batcher when it has one. `CurveRuntime`
-(inference.runtime) builds the caller's frames, lengths and poses on top.
+`ModelGraphs.open(model_dir, manifest)` opens one encoder/decoder session pair per inference thread
+(`inference.sessions`), checks the graphs' signatures against the manifest and runs a warm-up. `encode_model` and
+`decode_model` take and return model-plane arrays in runs of `batch_size`, through the thread's micro-batcher when
+it has one, each run a cancellation checkpoint (`inference.cancel`). `CurveRuntime` (inference.runtime) builds the
+caller's frames, lengths and poses on top.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Self
+from typing import Self
 
 import numpy as np
 import onnxruntime as ort
 
 from curve_vae.geometry import clamped_uniform_knots
-from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.inference import batching
-from curve_vae.inference.model_files import ModelLoadError, graph_file, read_manifest, resolve_providers
-from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
-from curve_vae.inference.sessions import SessionConfig, SessionPool, open_pair
+from curve_vae.inference.cancel import checkpoint
+from curve_vae.inference.manifest import Manifest, ModelLoadError
+from curve_vae.inference.sessions import SessionConfig, SessionPool, open_pair, resolve_providers
 
 
 class ModelGraphs:
-    """The encoder and decoder sessions of one exported model, its manifest's dimensions and its prior."""
+    """The encoder and decoder sessions of one exported model, and the dimensions its manifest gives them."""
 
     def __init__(
         self,
-        encoder: ort.InferenceSession,
-        decoder: ort.InferenceSession,
-        manifest: dict[str, Any],
+        pool: SessionPool,
+        manifest: Manifest,
         *,
         batch_size: int = 64,
         requested_providers: str = "cpu",
-        prior: LatentPrior | None = None,
-        pool: SessionPool | None = None,
     ) -> None:
-        self.pool = pool or SessionPool([(encoder, decoder)])  # the pair of each inference thread
+        self.pool = pool  # the pair of each inference thread
         self.manifest = manifest
-        self.prior = prior
         self.batch_size = batch_size
         self.requested_providers = requested_providers
-        self.n_points = int(manifest["n_points"])
-        self.latent_dim = int(manifest["latent_dim"])
-        self.model_size = float(manifest["frame"]["model_size"])
-        spline = manifest.get("spline")
-        self.spline_degree = int(spline["degree"]) if spline else 0
-        self.knots = clamped_uniform_knots(int(spline["n_ctrl"]), self.spline_degree) if spline else None
-        self.learned_params = bool(spline and spline.get("learned_params"))
-        # how a reconstruction's points are placed (training.export.PLACEMENTS): at the input points' closest points on
-        # the decoded spline, or at the head's parameters (manifests written before placements: index)
-        self.closest_placement = bool(spline and spline.get("placement") == "closest")
-        # Where the data lives in the model plane (paper §3.1: a radius-64 disc in the 128×128 plane): the region a
-        # valid sample must stay in.
-        self.disc_center = np.asarray(manifest["frame"].get("center", list(MODEL_CENTER)), np.float64)
-        self.disc_radius = float(manifest.get("training", {}).get("data", {}).get("radius", 64.0))
+        self.n_points = manifest.n_points
+        self.latent_dim = manifest.latent_dim
+        self.model_size = manifest.frame.model_size
+        spline = manifest.spline
+        self.spline_degree = spline.degree if spline else 0
+        self.knots = clamped_uniform_knots(spline.n_ctrl, spline.degree) if spline else None
+        self.n_ctrl = spline.n_ctrl if spline else 0
+        self.has_params = bool(spline and spline.learned_params)
+        encoder, decoder = pool.pairs[0]
         self._enc_in = encoder.get_inputs()[0].name
         self._dec_in = decoder.get_inputs()[0].name
         self._check_signature()
 
     @classmethod
-    def load(
+    def open(
         cls,
         model_dir: str | Path,
+        manifest: Manifest,
         *,
         providers: str = "auto",
-        intra_op_threads: int = 0,
+        sessions: SessionConfig | None = None,
         batch_size: int = 64,
         warm_up: bool = True,
-        sessions: SessionConfig | None = None,
-        placement: str = "model",
     ) -> Self:
-        """Open a model directory; raises ModelLoadError with what to fix when it cannot serve.
-
-        `sessions` sets threads, spinning and the number of session pairs (inference.sessions); without it, one pair
-        of `intra_op_threads` threads. `placement`: "model" places a reconstruction's points as the manifest's
-        spline.placement says; "closest" or "index" whatever it says (CURVE_VAE_PLACEMENT)."""
+        """Open a model directory's graphs; ModelLoadError says what to fix when they cannot serve."""
         root = Path(model_dir)
-        manifest = read_manifest(root)
         provider_list = resolve_providers(providers)
-        config = sessions or SessionConfig(intra_op_threads=intra_op_threads)
-        paths = (root / graph_file(manifest, "encoder"), root / graph_file(manifest, "decoder"))
+        config = sessions or SessionConfig()
+        paths = (root / manifest.graphs.encoder.file, root / manifest.graphs.decoder.file)
         pool = SessionPool(
             [open_pair(paths, provider_list, config, require_cuda=providers == "cuda") for _ in range(config.sessions)]
         )
-        spline = manifest.get("spline")
-        prior = None
-        if manifest.get("prior"):
-            path = root / str(manifest["prior"].get("file", PRIOR_FILE))
-            try:
-                prior = LatentPrior.load(path)
-            except (OSError, ValueError, KeyError) as e:
-                raise ModelLoadError(f"{path}: not a usable latent prior ({e})") from e
-        runtime = cls(
-            *pool.pairs[0], manifest, batch_size=batch_size, requested_providers=providers, prior=prior, pool=pool
-        )
-        if placement not in ("model", "closest", "index"):
-            raise ValueError(f"placement must be model, closest or index, got {placement!r}")
-        if placement == "closest" and not spline:
-            raise ModelLoadError(f"{root}: placement closest needs a model with a B-spline head; this one has none")
-        if placement != "model":
-            runtime.closest_placement = placement == "closest"
+        graphs = cls(pool, manifest, batch_size=batch_size, requested_providers=providers)
         if warm_up:
-            runtime.warm_up()
-        return runtime
+            graphs.warm_up()
+        return graphs
 
     def _check_signature(self) -> None:
         enc_in, dec_in = self.encoder.get_inputs()[0], self.decoder.get_inputs()[0]
@@ -124,8 +92,6 @@ class ModelGraphs:
         expected = ["curves", "control_points", "params"][: 1 + self.has_splines + self.has_params]
         if dec_out[: len(expected)] != expected:
             problems.append(f"decoder outputs {dec_out}, expected {', '.join(expected)} (the manifest's spline)")
-        if self.prior is not None and self.prior.latent_dim != self.latent_dim:
-            problems.append(f"the prior has {self.prior.latent_dim} latent dimensions, the model {self.latent_dim}")
         if problems:
             raise ModelLoadError("graphs do not match the manifest: " + "; ".join(problems))
 
@@ -145,11 +111,6 @@ class ModelGraphs:
         return self.knots is not None
 
     @property
-    def has_params(self) -> bool:
-        """Whether the decoder places its points at spline parameters of its own (output `params`), not evenly."""
-        return self.learned_params  # read from the manifest's spline entry: never without a head
-
-    @property
     def providers(self) -> list[str]:
         """Providers the sessions actually run on (a fallback shows here)."""
         return list(self.encoder.get_providers())
@@ -159,7 +120,7 @@ class ModelGraphs:
         t = np.linspace(0.0, np.pi, self.n_points)
         circle = np.stack([64 + 40 * np.cos(t), 64 + 40 * np.sin(t)], axis=1)[None].astype(np.float32)
         try:
-            mean, log_var = self.encode_model(circle)
+            mean, log_var = self.encode(circle)
             out = self.decode_model(mean)
         except Exception as e:
             raise ModelLoadError(f"warm-up inference failed: {e}") from e
@@ -172,7 +133,7 @@ class ModelGraphs:
 
     # ----------------------------------------------------------------------- raw graphs
 
-    def encode_model(self, curves: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def encode(self, curves: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(B, n_points, 2) in the model plane -> mean, log_var (B, latent_dim); split into runs of batch_size."""
         x = np.ascontiguousarray(curves, dtype=np.float32)
         encoder = self.encoder
@@ -188,7 +149,9 @@ class ModelGraphs:
     def _run_graph(
         self, session: ort.InferenceSession, graph: str, x: np.ndarray, outputs: list[str] | None
     ) -> list[np.ndarray]:
-        """One run of a graph: gathered with other requests' by the thread's micro-batcher, if it has one."""
+        """One run of a graph: gathered with other requests' by the thread's micro-batcher, if it has one; first, a
+        cancelled request stops here."""
+        checkpoint()
         batcher = batching.current()
         if batcher is not None:
             return batcher.run(graph, x, outputs)
@@ -196,9 +159,9 @@ class ModelGraphs:
 
     def decode_model(self, latents: np.ndarray) -> np.ndarray:
         """(B, latent_dim) -> (B, n_points, 2) in the model plane."""
-        return self.decode_model_splines(latents)[0]
+        return self.decode(latents)[0]
 
-    def decode_model_splines(self, latents: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    def decode(self, latents: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
         """(B, latent_dim) -> curves (B, n_points, 2); with a B-spline head, control points (B, n_ctrl, 2); with
         learned parameters (`has_params`), the spline parameter of each point (B, n_points). Absent: None."""
         z = np.ascontiguousarray(latents, dtype=np.float32)
@@ -207,7 +170,6 @@ class ModelGraphs:
         for i in range(0, len(z), self.batch_size):
             for part, out in zip(parts, self._run_graph(decoder, "decoder", z[i : i + self.batch_size], None)):
                 part.append(out)
-        n_ctrl = len(self.knots) - self.spline_degree - 1 if self.knots is not None else 0
-        empty = (np.zeros((0, self.n_points, 2)), np.zeros((0, n_ctrl, 2)), np.zeros((0, self.n_points)))
+        empty = (np.zeros((0, self.n_points, 2)), np.zeros((0, self.n_ctrl, 2)), np.zeros((0, self.n_points)))
         curves, ctrl, params = (np.concatenate(p) if p else e.astype(np.float32) for p, e in zip(parts, empty))
         return curves, ctrl if self.has_splines else None, params if self.has_params else None

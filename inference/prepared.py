@@ -1,10 +1,11 @@
-"""A batch of caller curves brought to the model (`Prepared`), and the candidate readings it is chosen from
-(`Candidates`: each curve in each pose and spacing the request allows, encoded, decoded and measured; the runtime
-keeps each curve's closest)."""
+"""A caller's curve as the model read it (`ReadCurve`: its frame, the model-plane points the encoder saw, its latent,
+the decoded spline and where the caller's points sit on it), and a batch of them (`Prepared`). The encoding cache
+keeps ReadCurves; the runtime fills in what a call needs (the decoding, the placement) and maps results back."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -12,54 +13,65 @@ from curve_vae.geometry import Frame
 
 
 @dataclass(frozen=True)
-class Prepared:
-    """A batch of caller curves brought to the model, and what it takes to bring results back."""
+class ReadCurve:
+    """One caller curve brought to the model and through it."""
 
-    model: np.ndarray  # (B, n_points, 2) float32 in the model plane
-    frames: list[Frame | None]  # the caller's frame of each curve; None for frame "model"
-    fractions: list[
-        np.ndarray | None
-    ]  # where each input point sits along the model's points, in [0, 1]; None: same points
-    inputs: list[np.ndarray]  # the caller's curves, float64
-    # With pose "auto", the curves are already encoded and decoded (that is how the pose is chosen):
-    mean: np.ndarray | None = None  # (B, latent_dim)
-    log_var: np.ndarray | None = None
-    decoded: np.ndarray | None = None  # (B, n_points, 2) model plane
-    ctrl: np.ndarray | None = None  # (B, n_ctrl, 2) with a B-spline head
-    params: np.ndarray | None = None  # (B, n_points) spline parameter of each model point, if the head learns them
-    # With refine, the latents are fitted (inference.fitting) and each input point is matched to its closest point:
-    feet: list[np.ndarray] | None = None  # per curve, the spline parameter (model order) of each input point
+    frame: Frame | None  # the caller's frame and pose; None for frame "model"
+    model: np.ndarray  # (n_points, 2) float32: what the encoder read, in the model plane
+    fraction: np.ndarray | None  # where each caller point sits along `model`'s points, in [0, 1]; None: the same
+    mean: np.ndarray  # (latent_dim,) the latent (with refine, the fitted one)
+    log_var: np.ndarray  # (latent_dim,)
+    decoded: np.ndarray | None = None  # (n_points, 2) the decoding of `mean`, model plane
+    ctrl: np.ndarray | None = None  # (n_ctrl, 2) its control points, with a B-spline head
+    params: np.ndarray | None = None  # (n_points,) its points' spline parameters, with a head that learns them
+    feet: np.ndarray | None = None  # with closest placement or refine: each caller point's spline parameter
+
+    @property
+    def decoded_yet(self) -> bool:
+        return self.decoded is not None
+
+    def nbytes(self) -> int:
+        parts = (self.model, self.fraction, self.mean, self.log_var, self.decoded, self.ctrl, self.params, self.feet)
+        return sum(p.nbytes for p in parts if p is not None) + 200
+
+    def with_decoding(
+        self, decoded: np.ndarray, ctrl: np.ndarray | None, params: np.ndarray | None, feet: np.ndarray | None
+    ) -> ReadCurve:
+        return replace(self, decoded=decoded, ctrl=ctrl, params=params, feet=feet)
 
 
 @dataclass(frozen=True)
-class Candidates:
-    """Readings of caller curves tried on the model (several per curve, in any order): what
-    `CurveRuntime._prepare` chooses from, each measured by how far its reconstruction is from its model-plane points
-    (`err`)."""
+class Prepared:
+    """A batch of caller curves and how the model read each."""
 
-    owner: list[int]  # the curve each candidate reads
-    model: np.ndarray
-    frames: list[Frame | None]
-    fractions: list[np.ndarray | None]
-    mean: np.ndarray
-    log_var: np.ndarray
-    decoded: np.ndarray
-    ctrl: np.ndarray | None
-    params: np.ndarray | None
-    err: np.ndarray
+    inputs: list[np.ndarray]  # the caller's curves, float64
+    rows: list[ReadCurve]
 
-    def closest(self, inputs: list[np.ndarray]) -> Prepared:
-        """Each curve's candidate whose reconstruction came closest."""
-        owner = np.asarray(self.owner, int)
-        best = [int(np.flatnonzero(owner == i)[self.err[owner == i].argmin()]) for i in range(len(inputs))]
-        return Prepared(
-            self.model[best],
-            [self.frames[b] for b in best],
-            [self.fractions[b] for b in best],
-            inputs,
-            self.mean[best],
-            self.log_var[best],
-            self.decoded[best],
-            None if self.ctrl is None else self.ctrl[best],
-            None if self.params is None else self.params[best],
-        )
+    @property
+    def frames(self) -> list[Frame | None]:
+        return [r.frame for r in self.rows]
+
+    @property
+    def mean(self) -> np.ndarray:
+        return _stack([r.mean for r in self.rows])
+
+    @property
+    def log_var(self) -> np.ndarray:
+        return _stack([r.log_var for r in self.rows])
+
+    @property
+    def fractions(self) -> list[np.ndarray | None]:
+        return [r.fraction for r in self.rows]
+
+    @property
+    def feet(self) -> list[np.ndarray | None]:
+        return [r.feet for r in self.rows]
+
+    @property
+    def placed(self) -> bool:
+        """Whether each caller point has a spline parameter (closest placement or refine)."""
+        return bool(self.rows) and all(r.feet is not None for r in self.rows)
+
+
+def _stack(parts: Sequence[np.ndarray]) -> np.ndarray:
+    return np.stack(parts) if parts else np.zeros((0, 0), np.float32)

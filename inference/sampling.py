@@ -1,99 +1,90 @@
-"""New curves from the model's latent distribution (paper §4's generation; `/sample`).
+"""New curves from a latent distribution (paper §4's generation; `/sample`).
 
-`Sampling` gives `CurveRuntime` its `sample` and `plausible` methods (it needs `decode_model_splines`, `_place`,
-the prior, the latent size and the data's disc); `fresh_seed` draws a seed for a request that gave none.
+`Sampler.draw` draws latents from a prior (the learned mixture shipped with the model, or N(0, I)) and decodes
+them in the model plane, rejecting and redrawing curves that cross themselves or leave the region the reference
+curves live in; `CurveRuntime.sample` maps the result to the caller. `fresh_seed` draws a seed for a request that
+gave none.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from curve_vae.geometry import Frame, self_intersects
+from curve_vae.geometry import self_intersects
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.prior import LatentPrior
 
-if TYPE_CHECKING:
-    from curve_vae.inference.runtime import Spacing, Spline
-
-Prior = Literal["learned", "standard"]
 MAX_DRAWS = 10  # per sampled curve: the shipped prior rejects 25% of draws, so 10 fail with probability ~1e-6;
 # and a distribution that rejects almost everything (the standard prior) costs at most 10 decodes a curve
 
 
 @dataclass(frozen=True)
-class Sampled:
-    """What `CurveRuntime.sample` made: latents (count, Z), curves, the prior used and the bookkeeping of rejection."""
+class Drawn:
+    """What `Sampler.draw` made, in the model plane."""
 
-    latents: np.ndarray
-    curves: np.ndarray
+    latents: np.ndarray  # (count, latent_dim)
+    decoded: np.ndarray  # (count, n_points, 2)
+    ctrl: np.ndarray | None
+    params: np.ndarray | None
     prior: str
-    rejected: int  # draws rejected (self-intersecting or outside the disc) and drawn again
-    invalid: int  # curves still not valid after max_draws (0 unless the distribution is far off)
+    rejected: int  # draws rejected and drawn again
+    invalid: int  # curves still not valid after max_draws
 
 
-class Sampling:
-    """The sampling methods of CurveRuntime."""
+class Sampler:
+    """Draws from a model's latent priors through its decoder; valid curves stay inside a disc of the model plane
+    (the paper's curves: their control points' radius-64 disc about the centre) and never cross themselves."""
 
-    prior: LatentPrior | None
-    latent_dim: int
-    n_points: int
-    knots: np.ndarray | None
-    spline_degree: int
-    disc_center: np.ndarray
-    disc_radius: float
-    has_splines: Any
-    decode_model_splines: Any
-    has_params: Any
-    _place: Any
+    def __init__(self, graphs: ModelGraphs, prior: LatentPrior | None, disc_center: np.ndarray, disc_radius: float):
+        self.graphs = graphs
+        self.prior = prior
+        self.disc_center = np.asarray(disc_center, np.float64)
+        self.disc_radius = float(disc_radius)
 
-    def sample(
+    def draw(
         self,
         count: int,
         *,
-        seed: int | None = None,
+        seed: int,
         temperature: float = 1.0,
-        prior: Prior | None = None,
+        prior: str | None = None,
         valid: bool = True,
         max_draws: int = MAX_DRAWS,
-        n_points: int | None = None,
-        spacing: Spacing = "parameter",
-        frame: Frame | None = None,
-        splines: list[Spline] | None = None,
-    ) -> Sampled:
-        """New curves from a latent distribution, decoded into the model plane (or mapped into `frame`).
+    ) -> Drawn:
+        """`count` curves decoded from latents of a distribution.
 
         prior "learned": the Gaussian mixture fitted to the training curves' latent means (the default where the
         model ships one); "standard": the VAE's N(0, I). temperature scales the spread (see inference/prior.py).
-        valid: a draw whose curve crosses itself or leaves the data's disc is rejected and item i draws again, at
-        most max_draws times in all. Item i's draws come from its own generator default_rng([seed, i]), so the
-        seed decides every curve, across rejections too, and the first items of a larger count are the items of
-        a smaller one.
+        valid: a draw whose curve crosses itself or leaves the disc is rejected and item i draws again, at most
+        max_draws times in all. Item i's draws come from its own generator default_rng([seed, i]), so the seed
+        decides every curve, across rejections too, and the first items of a larger count are those of a smaller.
         """
+        g = self.graphs
         chosen = prior or ("learned" if self.prior is not None else "standard")
         if chosen == "learned" and self.prior is None:
             raise InputError(
                 ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
             )
-        root = fresh_seed() if seed is None else seed
-        rngs = [np.random.default_rng([root, i]) for i in range(count)]
+        rngs = [np.random.default_rng([seed, i]) for i in range(count)]
+        learned = self.prior
 
-        def draw(i: int) -> np.ndarray:
+        def one(i: int) -> np.ndarray:
             if chosen == "learned":
-                assert self.prior is not None
-                return self.prior.draw(rngs[i], temperature)
-            return rngs[i].standard_normal(self.latent_dim) * temperature
+                assert learned is not None
+                return learned.draw(rngs[i], temperature)
+            return rngs[i].standard_normal(g.latent_dim) * temperature
 
-        z = np.array([draw(i) for i in range(count)]).reshape(count, self.latent_dim)
+        z = np.array([one(i) for i in range(count)]).reshape(count, g.latent_dim)
         draws, ok, todo = np.ones(count, np.int64), np.zeros(count, bool), np.arange(count)
-        out = np.zeros((count, self.n_points, 2), np.float32)
-        ctrl = np.zeros((count, len(self.knots) - self.spline_degree - 1, 2), np.float32) if self.has_splines else None
-        params = np.zeros((count, self.n_points), np.float32) if self.has_params else None
+        out = np.zeros((count, g.n_points, 2), np.float32)
+        ctrl = np.zeros((count, g.n_ctrl, 2), np.float32) if g.has_splines else None
+        params = np.zeros((count, g.n_points), np.float32) if g.has_params else None
         while len(todo):  # each draw is decoded once; its curve is kept until the item draws again
             with np.errstate(all="ignore"):
-                decoded, points, par = self.decode_model_splines(z[todo])
+                decoded, points, par = g.decode(z[todo])
             out[todo] = decoded
             if ctrl is not None and points is not None:
                 ctrl[todo] = points
@@ -105,15 +96,13 @@ class Sampling:
             ok[todo[good]] = True
             todo = todo[~good & (draws[todo] < max_draws)]
             for i in todo:
-                z[i] = draw(int(i))
+                z[i] = one(int(i))
                 draws[i] += 1
         invalid = int((~ok).sum()) if valid else 0
-        frames = [frame] * count if frame else None
-        curves = self._place(out, ctrl, params, frames=frames, n_points=n_points, spacing=spacing, splines=splines)
-        return Sampled(z, curves, chosen, rejected=int(draws.sum() - count), invalid=invalid)
+        return Drawn(z, out, ctrl, params, chosen, rejected=int(draws.sum() - count), invalid=invalid)
 
     def plausible(self, curves: np.ndarray) -> np.ndarray:
-        """(B, n, 2) model-plane curves -> (B,) bool: finite, free of self-intersections and inside the data's disc."""
+        """(B, n, 2) model-plane curves -> (B,) bool: finite, free of self-intersections and inside the disc."""
         finite = np.isfinite(curves).all(axis=(1, 2))
         inside = np.linalg.norm(np.where(finite[:, None, None], curves, 0) - self.disc_center, axis=-1).max(axis=1)
         ok = finite & (inside <= self.disc_radius)

@@ -18,7 +18,9 @@ from typing import Any
 
 import onnxruntime as ort
 
-from curve_vae.inference.model_files import CUDA, ModelLoadError
+from curve_vae.inference.manifest import ModelLoadError
+
+CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
 
 SPINNING_KEYS = ("session.intra_op.allow_spinning", "session.inter_op.allow_spinning")
 
@@ -87,3 +89,21 @@ class SessionPool:
             "inter_op_threads": opts.inter_op_num_threads,
             "spinning": opts.get_session_config_entry(SPINNING_KEYS[0]) != "0",
         }
+
+
+def resolve_providers(choice: str) -> list[str]:
+    """onnxruntime provider list for "cpu", "cuda" or "auto"; "cuda" fails loudly when unavailable."""
+    available = ort.get_available_providers()
+    if choice == "cpu":
+        return [CPU]
+    if choice == "cuda":
+        if CUDA not in available:
+            raise ModelLoadError(
+                f"providers=cuda, but this onnxruntime ({ort.__version__}) offers only {available}: "
+                "install the GPU build (pip install 'curve-vae[gpu]', i.e. onnxruntime-gpu, in place of "
+                "onnxruntime) with CUDA 12 and cuDNN 9 libraries, or run with --providers cpu or auto"
+            )
+        return [CUDA, CPU]  # CPU takes any node CUDA has no kernel for
+    if choice == "auto":
+        return [CUDA, CPU] if CUDA in available else [CPU]
+    raise ModelLoadError(f"providers must be cpu, cuda or auto, got {choice!r}")

@@ -38,8 +38,8 @@ def gap(model_dir: str, even: np.ndarray, drawn: list[np.ndarray]) -> None:
     rt = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
     rt.closest_placement = True
     params = list(even)
-    own = rt.reconstruct(drawn, n_points=3201)[0]
-    twins = rt.reconstruct(params, n_points=3201)[0]
+    own = rt.reconstruct(drawn, n_points=3201).curves
+    twins = rt.reconstruct(params, n_points=3201).curves
     diag = np.array([np.hypot(*np.ptp(c, axis=0)) for c in even])
 
     def dist(points: list[np.ndarray], lines: list[np.ndarray]) -> float:

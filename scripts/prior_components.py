@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from curve_vae.inference.model_files import file_sha256
+from curve_vae.inference.manifest import file_sha256
 from curve_vae.inference.prior import PRIOR_FILE
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.data import DataConfig, default_cache, generate_curves, load_or_generate
@@ -40,7 +40,7 @@ def main() -> None:
         scratch = Path(tmp) / "model"
         shutil.copytree(a.model_dir, scratch)
         runtime = CurveRuntime.load(scratch, providers="cpu")
-        means, _ = runtime.encode_model(ds.train[:FIT_CURVES])
+        means, _ = runtime.graphs.encode(ds.train[:FIT_CURVES])
         for k in a.components:
             t0 = time.perf_counter()
             prior = fit_prior(means, components=k)

@@ -26,6 +26,7 @@ import numpy as np
 
 from curve_vae.geometry import arc_fractions, closest_params, evaluate_bspline, self_intersects, smoothness
 from curve_vae.inference import fitting
+from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.suite import paper_test_split, relative_rmse, suite_sets
 
@@ -57,7 +58,7 @@ def main() -> None:
         errors[steps], seconds[steps] = {}, 0.0
         for name, curves in sets.items():
             start = time.perf_counter()
-            out, _ = rt.reconstruct(curves, refine=steps)
+            out = rt.reconstruct(curves, Reading(refine=steps)).curves
             seconds[steps] += time.perf_counter() - start
             errors[steps][name] = float(relative_rmse(curves, out).mean())
     base = seconds[a.steps[0]]
@@ -89,7 +90,7 @@ def interpolation(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps
     for n in steps:
         rough, cross, first = [], [], []
         for a, b in pairs:
-            out, _ = rt.interpolate([a, b], w, refine=n)
+            out = rt.interpolate([a, b], w, Reading(refine=n)).curves
             rough += [smoothness(c)["roughness"] for c in out[1:-1]]
             cross += [bool(self_intersects(c)) for c in out[1:-1]]
             first.append(relative_rmse([a], [out[0]])[0])
@@ -121,7 +122,7 @@ def basins(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps: int) 
             u = (1 - alpha) * np.interp(even, arc_fractions(c), even) + alpha * even
             starts.append(np.stack([np.interp(u, even, c[:, 0]), np.interp(u, even, c[:, 1])], 1))
         splines: list = []
-        rt.reconstruct(starts, refine=steps, splines=splines)
+        rt.reconstruct(starts, Reading(refine=steps))
         fits = []
         for sp, points in zip(splines, arc):
             u = closest_params(sp.control_points, points, np.full(len(points), 0.5), window=1.0)
@@ -154,7 +155,7 @@ def plot(rt: Any, sets: dict[str, list], errors: dict[int, dict[str, float]], st
     near = np.abs(curve - edge).max(axis=1) < span
     right.plot(*curve[near].T, "o", color="0.5", ms=3, label="input points")
     for n, colour in ((0, "tab:red"), (max(steps), "tab:blue")):
-        out, _ = rt.reconstruct([curve], refine=n, n_points=2000)
+        out = rt.reconstruct([curve], Reading(refine=n), n_points=2000).curves
         o = out[0][np.abs(out[0] - edge).max(axis=1) < span]
         right.plot(*o.T, "-", color=colour, lw=1.2, label=f"refine {n}")
     right.set(aspect="equal", title="leading edge of a real airfoil (UIUC)" if real else "a superellipse")

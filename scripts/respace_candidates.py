@@ -59,7 +59,7 @@ def main() -> None:
                 rows.append(np.stack([np.interp(grid, u, target[:, 0]), np.interp(grid, u, target[:, 1])], axis=1))
             errors.append(np.array(err))
             batch = np.stack(rows).astype(np.float32)
-            mean, log_var = rt.encode_model(batch)
+            mean, log_var = rt.graphs.encode(batch)
             prep = dataclasses.replace(
                 prep, model=batch, mean=mean, log_var=log_var, decoded=None, ctrl=None, params=None, feet=None
             )

@@ -31,6 +31,7 @@ import onnxruntime as ort
 import torch
 
 from curve_vae.geometry import smoothness, spline_head
+from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.airfoils import load_airfoils
 from curve_vae.training.checkpoint import model_from_checkpoint
@@ -70,7 +71,8 @@ def decoder_ms(model_dir: Path, latent_dim: int, batch: int, repeats: int) -> fl
 
 def airfoil_report(model_dir: Path, airfoils: list[np.ndarray], spline_ctrl: int) -> dict[str, float]:
     runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
-    rec, mse = runtime.reconstruct(airfoils, spacing="arc_length")
+    res = runtime.reconstruct(airfoils, Reading(spacing="arc_length"))
+    rec, mse = res.curves, res.mse
     diag = np.array([np.linalg.norm(np.ptp(c, axis=0)) for c in airfoils])
     rel = np.sqrt(2 * mse) / diag  # mse is per coordinate: RMSE of point distances
     lead = np.array([np.linalg.norm(r[np.argmin(c[:, 0])] - c[np.argmin(c[:, 0])]) for r, c in zip(rec, airfoils)])

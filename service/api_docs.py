@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Annotated, Any
 
+from fastapi import Body
+
+from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 
 ERROR_EXAMPLES = {
@@ -42,7 +45,7 @@ def error_docs(*codes: int) -> dict[int | str, dict[str, Any]]:
         description, detail, loc = ERROR_EXAMPLES[code]
         errors = [{"loc": loc, "msg": detail.split(": ", 1)[1]}] if loc else []
         out[code] = {
-            "model": s.ErrorResponse,
+            "model": r.ErrorResponse,
             "description": description,
             "content": {"application/json": {"example": {"detail": detail, "errors": errors}}},
         }
@@ -62,3 +65,85 @@ def example(summary: str, value: dict[str, Any]) -> dict[str, Any]:
 
 C1, C2, C3 = s.EXAMPLE_CURVE, s.EXAMPLE_CURVE_2, s.EXAMPLE_CURVE_3
 POST_ERRORS = error_docs(401, 413, 422, 503, 504)
+
+ONE_CURVE = '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]]}'
+TWO_CURVES = (
+    '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]], '
+    "[[0,0],[1.5,0.5],[3,2],[4,4],[5,6.5],[6.5,8],[8,8.5]]]}"
+)
+THREE_CURVES = TWO_CURVES[:-2] + ", [[0,4],[2,5],[4,4],[6,2],[8,1],[10,2],[12,4]]]}"
+
+ENCODE = {
+    "one curve": example("A curve in its own frame", {"curves": [C1]}),
+    "model frame": example(
+        "Already in the 128×128 plane",
+        {"curves": [[[14, 64], [40, 100], [64, 110], [90, 95], [114, 64]]], "frame": "model"},
+    ),
+}
+RECONSTRUCT = {
+    "one curve": example("A curve in its own frame, back at its own 7 points", {"curves": [C1]}),
+    "resampled": example("Two curves, returned at 100 points each", {"curves": [C1, C2], "n_points": 100}),
+    "points and spline": example(
+        "The reconstruction as points and as the B-spline they lie on", {"curves": [C1], "output": "both"}
+    ),
+    "the search": example(
+        "Six poses and every natural reading tried, the closest kept",
+        {"curves": [C1], "pose": "search", "spacing": "search"},
+    ),
+}
+INTERPOLATE = {
+    "pair": example("Pair, 5 curves from the first to the second (paper eq. 9)", {"curves": [C1, C2], "steps": 5}),
+    "triplet": example("Triplet, barycentric grid of 6 curves (paper eq. 10)", {"curves": [C1, C2, C3], "steps": 3}),
+    "weights": example("Explicit weights, one entry per curve", {"curves": [C1, C2], "weights": [[0.25, 0.75]]}),
+    "as B-splines": example(
+        "The middle curve as a B-spline: control points, knots, degree and the parameter of each point",
+        {"curves": [C1, C2], "weights": [[0.5, 0.5]], "output": "bspline"},
+    ),
+}
+Decode = Annotated[
+    s.DecodeRequest,
+    Body(
+        openapi_examples={
+            "origin": example("The centre of the latent space, 50 points", {"latents": [[0.0] * 32], "n_points": 50}),
+            "in a frame": example(
+                "Mapped into a frame from /encode",
+                {"latents": [[0.0] * 32], "frames": [{"center": [4.0, 1.75], "size": 8.0}]},
+            ),
+        }
+    ),
+]
+Sample = Annotated[
+    s.SampleRequest,
+    Body(
+        openapi_examples={
+            "seeded": example("Three curves, reproducible", {"count": 3, "seed": 7, "n_points": 50}),
+            "tame": example("Closer to typical shapes", {"count": 2, "seed": 1, "temperature": 0.5}),
+            "standard prior": example(
+                "The VAE's N(0, I), every draw kept", {"count": 2, "seed": 1, "prior": "standard", "valid": False}
+            ),
+            "framed": example(
+                "In a frame of one's own, with smoothness metrics",
+                {"count": 2, "seed": 3, "frame": {"center": [0, 0], "size": 2}, "metrics": True},
+            ),
+        }
+    ),
+]
+Augment = Annotated[
+    s.AugmentRequest,
+    Body(
+        openapi_examples={
+            "pairs": example("Four random pair interpolants", {"curves": [C1, C2, C3], "count": 4, "seed": 1}),
+            "triplets": example(
+                "Two random triplet interpolants", {"curves": [C1, C2, C3], "count": 2, "mode": "triplet"}
+            ),
+            "neighbours, second page": example(
+                "Pairs of near neighbours only; curves 4 and 5 of the seeded sequence",
+                {"curves": [C1, C2, C3], "count": 2, "neighbours": 1, "seed": 1, "offset": 4},
+            ),
+            "npy": example(
+                "1000 curves as a binary .npy file (curl -o batch.npy)",
+                {"curves": [C1, C2, C3], "count": 1000, "seed": 1, "n_points": 64, "format": "npy"},
+            ),
+        }
+    ),
+]

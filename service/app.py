@@ -38,16 +38,17 @@ from curve_vae.inference.batching import GraphBatcher
 from curve_vae.inference.batching import attach as attach_batcher
 from curve_vae.inference.cpus import available_cpus, inference_slots, session_config
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.model_files import ModelLoadError
+from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.access import ApiKeyMiddleware
 from curve_vae.service.errors import on_http_error, on_input_error, on_validation_error
+from curve_vae.service.limits import state_bounds
 from curve_vae.service.metrics import Metrics, MetricsMiddleware
 from curve_vae.service.middleware import BodyLimitMiddleware
 from curve_vae.service.oip import DEFAULT_SIGNATURES, describe, signatures
-from curve_vae.service.openapi import state_bounds
 from curve_vae.service.routes.curves import curves_router
 from curve_vae.service.routes.design import design_router
+from curve_vae.service.routes.generate import generate_router
 from curve_vae.service.routes.oip import oip_router
 from curve_vae.service.routes.ops import ops_router
 from curve_vae.service.settings import Settings, get_settings
@@ -71,10 +72,10 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     app.state.metrics.ready.set(1)
     log.info(
         "serving %s %s from %s on %s",
-        runtime.manifest.get("name"),
-        runtime.manifest.get("version"),
+        runtime.manifest.name,
+        runtime.manifest.version,
         settings.model_dir,
-        runtime.providers,
+        runtime.graphs.providers,
     )
     try:
         yield
@@ -110,6 +111,7 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
                 batch_size=settings.batch_size,
                 sessions=config,
                 placement=settings.placement,
+                cache_bytes=settings.cache_bytes,
             )
         )
     except ModelLoadError as e:
@@ -120,8 +122,11 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
 def _start_batcher(app: FastAPI, settings: Settings, runtime: CurveRuntime) -> GraphBatcher:
     """The micro-batcher over the runtime's sessions, and inference threads whose graph runs go through it."""
     batcher = GraphBatcher(
-        runtime.pool,
-        {"encoder": runtime.encoder.get_inputs()[0].name, "decoder": runtime.decoder.get_inputs()[0].name},
+        runtime.graphs.pool,
+        {
+            "encoder": runtime.graphs.encoder.get_inputs()[0].name,
+            "decoder": runtime.graphs.decoder.get_inputs()[0].name,
+        },
         max_rows=settings.micro_batch_rows,
         max_wait=settings.micro_batch_wait_ms / 1e3,
         runners=app.state.slots,
@@ -188,6 +193,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.state.slots = inference_slots(settings)
     app.state.executor = inference_executor(app.state.slots)
     app.include_router(curves_router)
+    app.include_router(generate_router)
     app.include_router(design_router)
     app.include_router(ops_router)
     app.include_router(oip_router)
@@ -197,7 +203,14 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.add_exception_handler(HTTPException, on_http_error)
     _add_request_middleware(app, settings)
     app.openapi = _openapi_of(app, settings)  # type: ignore[method-assign]
-    routes = (*curves_router.routes, *design_router.routes, *ops_router.routes, *oip_router.routes, *app.routes)
+    routes = (
+        *curves_router.routes,
+        *generate_router.routes,
+        *design_router.routes,
+        *ops_router.routes,
+        *oip_router.routes,
+        *app.routes,
+    )
     paths = [r.path for r in routes if hasattr(r, "path")]
     app.add_middleware(MetricsMiddleware, metrics=app.state.metrics, known_paths=paths)  # last: outermost
     return app

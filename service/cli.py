@@ -16,13 +16,19 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from curve_vae.inference.choices import choices
 from curve_vae.service.settings import Settings
 
 # (flag, settings field, type, help); the default and variable are appended from Settings.
 _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--host", "host", str, "interface to listen on; 0.0.0.0 for every interface"),
     ("--port", "port", int, "TCP port; 0 picks a free one"),
-    ("--model-dir", "model_dir", str, "directory with encoder.onnx, decoder.onnx and manifest.json"),
+    (
+        "--model-dir",
+        "model_dir",
+        str,
+        "directory with encoder.onnx, decoder.onnx and manifest.json, or a shipped model's name: default, paper",
+    ),
     ("--providers", "providers", str, "onnxruntime providers: cpu, cuda (an error where CUDA cannot load) or auto"),
     ("--workers", "workers", int, "worker processes, each loading its own ONNX sessions"),
     ("--log-level", "log_level", str, "uvicorn and service log level"),
@@ -53,9 +59,7 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
 ]
 _CHOICES = {
-    "providers": ["cpu", "cuda", "auto"],
-    "log_level": ["critical", "error", "warning", "info", "debug", "trace"],
-    "placement": ["model", "closest", "index"],
+    name: list(choices(Settings.model_fields[name].annotation)) for name in ("providers", "log_level", "placement")
 }
 
 
@@ -68,7 +72,7 @@ def configure_parser(parser: argparse.ArgumentParser) -> None:
         default_text = ",".join(default) if isinstance(default, list) else default
         default_text = "none" if default_text in ("", None) else default_text
         parser.add_argument(
-            flag,
+            *([flag, "--model"] if name == "model_dir" else [flag]),
             dest=name,
             type=kind,
             default=None,
@@ -126,7 +130,8 @@ def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
 
-    from curve_vae.inference.model_files import ModelLoadError, read_manifest, resolve_providers
+    from curve_vae.inference.manifest import Manifest, ModelLoadError
+    from curve_vae.inference.sessions import resolve_providers
 
     try:
         settings = settings_from_args(args)
@@ -135,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"curve-vae serve: error: {problems}", file=sys.stderr)
         return 2
     try:  # the clear, early form of the errors the workers would hit at startup
-        read_manifest(settings.model_dir)
+        Manifest.read(settings.model_dir)
         resolve_providers(settings.providers)
     except ModelLoadError as e:
         print(f"curve-vae serve: error: {e}", file=sys.stderr)

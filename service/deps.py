@@ -16,8 +16,9 @@ from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
 from curve_vae.geometry import simplex_grid, simplex_grid_size
+from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.runtime import CurveRuntime, Spline
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service import schemas as s
 from curve_vae.service.metrics import Metrics
 from curve_vae.service.settings import Settings
@@ -52,20 +53,6 @@ SettingsDep = Annotated[Settings, Depends(_settings)]
 RuntimeDep = Annotated[CurveRuntime, Depends(_runtime)]
 
 
-def check_curves(curves: list[list[tuple[float, float]]], settings: Settings) -> list[np.ndarray]:
-    if len(curves) > settings.max_curves:
-        raise InputError(("curves",), f"at most {settings.max_curves} curves per request, got {len(curves)}")
-    for i, curve in enumerate(curves):
-        if len(curve) > settings.max_points:
-            raise InputError(("curves", i), f"at most {settings.max_points} points per curve, got {len(curve)}")
-    return [np.asarray(c, dtype=np.float64) for c in curves]
-
-
-def check_n_points(n_points: int | None, settings: Settings) -> None:
-    if n_points is not None and n_points > settings.max_points:
-        raise InputError(("n_points",), f"at most {settings.max_points}, got {n_points}")
-
-
 #: What one curve costs a fitting step beyond its points, in points: its decoder runs (inference/fitting.py) take
 #: about as long as matching 300 points (10 steps: ~86 ms for a 4-point curve, ~130 ms for a 161-point one).
 REFINE_POINTS_PER_CURVE = 300
@@ -96,8 +83,6 @@ def check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
                 f"{steps} steps over {n} curves make {rows} curves; at most {settings.max_curves} per response",
             )
         return simplex_grid(n, steps)
-    if len(req.weights) > settings.max_curves:
-        raise InputError(("weights",), f"at most {settings.max_curves} rows, got {len(req.weights)}")
     for r, row in enumerate(req.weights):
         if len(row) != n:
             raise InputError(("weights", r), f"expected {n} numbers, one per input curve, got {len(row)}")
@@ -110,17 +95,14 @@ def check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
     return np.array(req.weights, dtype=np.float64)
 
 
-def splines_wanted(output: str, runtime: CurveRuntime) -> list[Spline] | None:
-    """A list for the runtime to fill with splines when the request asks for them; None for points only."""
-    if output == "points":
-        return None
-    if not runtime.has_splines:
+def check_output(output: str, runtime: CurveRuntime) -> None:
+    """A spline output needs a model with a B-spline head."""
+    if output != "points" and not runtime.has_splines:
         raise InputError(
             ("output",),
             f'"{output}" needs a model with a B-spline head, and this one has none (GET /model: spline is null); '
             'ask for "points", or fit splines to the points with /fit',
         )
-    return []
 
 
 def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
@@ -131,13 +113,34 @@ def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
         if getattr(request.app.state, "batcher", None) is not None
         else None
     )
-    return {**runtime.pool.applied(), "inference_threads": request.app.state.slots, "micro_batch": batching}
+    return {**runtime.graphs.pool.applied(), "inference_threads": request.app.state.slots, "micro_batch": batching}
 
 
-async def in_executor(request: Request, fn: Callable[..., T], *args: Any) -> T:
+async def in_executor(request: Request, fn: Callable[..., T], *args: Any, token: CancelToken | None = None) -> T:
     """`fn(*args)` on one of the app's inference threads (at most one inference per slot at once, first come
-    first served). Cancelling the caller leaves a running call to finish on its own; a queued one never starts."""
-    return await asyncio.wrap_future(request.app.state.executor.submit(fn, *args))
+    first served), under `token` when given: cancelled, the work stops at its next checkpoint (inference.cancel)."""
+
+    def run() -> T:
+        if token is None:
+            return fn(*args)
+        token.check()  # abandoned while it queued: never starts
+        with cancellable(token):
+            return fn(*args)
+
+    return await asyncio.wrap_future(request.app.state.executor.submit(run))
+
+
+#: How often a running request looks whether its client has gone.
+DISCONNECT_POLL_S = 0.05
+
+
+async def _watch_disconnect(request: Request, token: CancelToken) -> None:
+    """Cancel `token` once the client has disconnected (polling Starlette's receive channel)."""
+    while not token.cancelled:
+        if await request.is_disconnected():
+            token.cancel("the client disconnected")
+            return
+        await asyncio.sleep(DISCONNECT_POLL_S)
 
 
 async def run_inference(request: Request, route: str, batch: int, work: Callable[[], Response]) -> Response:
@@ -146,7 +149,8 @@ async def run_inference(request: Request, route: str, batch: int, work: Callable
 
     Bounded both ways: with `slots + max_queue` requests already in here, a new one is answered 503 with
     Retry-After at once instead of joining an ever longer queue; one that takes longer than `request_timeout`
-    seconds (queueing included) is answered 504 (its thread finishes on its own).
+    seconds (queueing included) is answered 504. Either way, and when the client disconnects, the work is cancelled:
+    its thread stops at the next chunk boundary and the slot is free for the next request.
     """
     settings: Settings = request.app.state.settings
     state = request.app.state
@@ -161,13 +165,21 @@ async def run_inference(request: Request, route: str, batch: int, work: Callable
     metrics.batch_size.labels(route).observe(batch)
     state.pending += 1
     start = time.perf_counter()
+    token = CancelToken()
+    watcher = asyncio.ensure_future(_watch_disconnect(request, token))
     try:
         with anyio.fail_after(settings.request_timeout or None):
-            return await in_executor(request, work)
+            return await in_executor(request, work, token=token)
     except TimeoutError:
+        token.cancel("past CURVE_VAE_REQUEST_TIMEOUT")
         raise HTTPException(
             504, f"the request took longer than {settings.request_timeout:g} s (CURVE_VAE_REQUEST_TIMEOUT); send less"
         ) from None
+    except Cancelled:
+        metrics.cancelled.labels(route).inc()
+        raise HTTPException(499, f"cancelled: {token.reason}") from None
     finally:
+        token.cancel("the request ended")  # a still-running thread (a timeout) stops at its next checkpoint
+        watcher.cancel()
         state.pending -= 1
         metrics.inference.labels(route).observe(time.perf_counter() - start)

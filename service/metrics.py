@@ -49,6 +49,15 @@ class Metrics:
             buckets=LATENCY_BUCKETS,
             registry=self.registry,
         )
+        self.cancelled = Counter(
+            "curve_vae_inference_cancelled",
+            "Requests whose inference stopped early: the client disconnected or the request timed out.",
+            ["route"],
+            registry=self.registry,
+        )
+        self.cache_hits = Gauge("curve_vae_cache_hits", "Curves read from the encoding cache.", registry=self.registry)
+        self.cache_misses = Gauge("curve_vae_cache_misses", "Curves read afresh.", registry=self.registry)
+        self.cache_bytes = Gauge("curve_vae_cache_bytes", "Bytes the encoding cache holds.", registry=self.registry)
         self.ready = Gauge("curve_vae_ready", "1 once the model is loaded and warmed up.", registry=self.registry)
 
     def render(self) -> tuple[bytes, str]:

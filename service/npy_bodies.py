@@ -5,24 +5,26 @@ is the JSON request `{"curves": <the array>, "pose": "as_is"}`: the other fields
 each a JSON value (`n_points=100`, `metrics=true`, `weights=[[0.5,0.5]]`) or else a string (`frame=model`).
 The curves skip JSON parsing and per-number validation: numpy checks them at once, and each refusal is a 422
 naming what is wrong (the header, the dtype, the shape, or the curve and point that is not finite).
-The answer is the same JSON as for a JSON request.
+The answer is the same JSON as for a JSON request: `curve_route` registers one handler for both bodies.
 """
 
 from __future__ import annotations
 
+import inspect
 import io
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 import orjson
-from fastapi import Request
+from fastapi import APIRouter, Body, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
 from pydantic import BaseModel, ValidationError
 
 from curve_vae.inference.errors import InputError
+from curve_vae.service import limits
 from curve_vae.service.settings import Settings
 
 MEDIA_TYPE = "application/x-npy"
@@ -54,14 +56,34 @@ class NpyRoute:
     handler: Handler  # (request, validated request model, curves) -> the response
 
 
-ROUTES: dict[str, NpyRoute] = {}
-
-
-def npy_route(path: str, model: type[BaseModel]) -> Callable[[Handler], Handler]:
-    """Register `handler` for .npy bodies posted to `path` (service.fastjson.FastJSONRoute dispatches to it)."""
+def curve_route(
+    router: APIRouter,
+    path: str,
+    model: type[BaseModel],
+    *,
+    examples: dict[str, Any] | None = None,
+    openapi_extra: dict[str, Any] | None = None,
+    **route: Any,
+) -> Callable[[Handler], Handler]:
+    """Register `handler(request, req, curves)` at POST `path`, once for both bodies: JSON of `model` (validated,
+    its limits checked), or the curves as a .npy body with the other fields in the query (dispatch). The route's
+    OpenAPI operation documents both."""
 
     def register(handler: Handler) -> Handler:
-        ROUTES[path] = NpyRoute(model, handler)
+        async def endpoint(request: Request, req: Any) -> Response:
+            limits.check(req, request.app.state.settings)
+            return await handler(request, req, limits.curves_of(req))
+
+        endpoint.__name__, endpoint.__doc__ = handler.__name__, handler.__doc__
+        body = Annotated[model, Body(openapi_examples=examples)] if examples else model
+        endpoint.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
+            [
+                inspect.Parameter("request", inspect.Parameter.POSITIONAL_OR_KEYWORD, annotation=Request),
+                inspect.Parameter("req", inspect.Parameter.POSITIONAL_OR_KEYWORD, annotation=body),
+            ]
+        )
+        router.post(path, openapi_extra=OPENAPI_BODY | (openapi_extra or {}), **route)(endpoint)
+        router.routes[-1].npy = NpyRoute(model, handler)  # type: ignore[attr-defined]
         return handler
 
     return register
@@ -74,13 +96,14 @@ def is_npy(request: Request) -> bool:
 async def dispatch(request: Request, route: NpyRoute) -> Response:
     """Read and check the curves, check the query fields against the route's schema, run the handler."""
     settings: Settings = request.app.state.settings
-    curves = read_curves(await request.body(), settings)
+    curves = read_curves(await request.body(), route.model.__name__, settings)
     fields: dict[str, Any] = {k: _query_value(v) for k, v in request.query_params.items()}
     try:
         req = route.model.model_validate({**fields, "curves": [_PLACEHOLDER] * len(curves)})
     except ValidationError as e:
         errors = [{**err, "loc": ("query", *err["loc"])} for err in e.errors() if err["loc"][:1] != ("curves",)]
         raise RequestValidationError(errors or e.errors()) from None
+    limits.check(req, settings, skip=("curves",))
     return await route.handler(request, req, curves)
 
 
@@ -91,7 +114,7 @@ def _query_value(text: str) -> Any:
         return text
 
 
-def read_curves(body: bytes, settings: Settings) -> list[np.ndarray]:
+def read_curves(body: bytes, model: str, settings: Settings) -> list[np.ndarray]:
     """The curves of a .npy body, float64, each (n, 2); InputError naming what is wrong."""
     if not body.startswith(MAGIC):
         raise InputError(("body",), f"not a .npy file (Content-Type {MEDIA_TYPE}): it must start with \\x93NUMPY")
@@ -111,12 +134,9 @@ def read_curves(body: bytes, settings: Settings) -> list[np.ndarray]:
     count, points = shape[0], shape[1]
     if count < 1:
         raise InputError(("curves",), "no curves: the array's first axis is 0")
-    if count > settings.max_curves:
-        raise InputError(("curves",), f"at most {settings.max_curves} curves per request, got {count}")
     if points < 4:
         raise InputError(("curves",), f"at least 4 points per curve, got {points}")
-    if points > settings.max_points:
-        raise InputError(("curves",), f"at most {settings.max_points} points per curve, got {points}")
+    limits.check_shape(model, count, points, settings)
     data = body[buf.tell() :]
     expected = count * points * 2 * dtype.itemsize
     if len(data) != expected:

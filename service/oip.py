@@ -84,7 +84,7 @@ def signature(session: ort.InferenceSession) -> Signature:
 
 def signatures(runtime: Any) -> dict[str, Signature]:
     """Each model's tensors, from the loaded runtime's own sessions."""
-    return {"encoder": signature(runtime.encoder), "decoder": signature(runtime.decoder)}
+    return {"encoder": signature(runtime.graphs.encoder), "decoder": signature(runtime.graphs.decoder)}
 
 
 def _t(name: str, *shape: int) -> Tensor:

@@ -13,43 +13,6 @@ from typing import Any
 ROOT_FILE = Path(__file__).resolve().parent.parent / "openapi.yaml"
 
 
-DEFAULT_LATENT_DIM = 32  # openapi.yaml's latent length (the shipped model's); the live schema states the loaded one's
-
-
-def state_bounds(schema: dict[str, Any], settings: Any, latent_dim: int | None) -> dict[str, Any]:
-    """Write into the app's schema the bounds that come from the settings and the model, so that a client generated
-    from it knows them: curves, points and latents per request, latent length, counts, steps, mutually exclusive
-    fields. Rules that combine fields (a triplet's steps, segments × points) stay in the endpoints' 422s."""
-    comps = schema.get("components", {}).get("schemas", {})
-
-    def prop(model: str, field: str) -> dict[str, Any]:
-        p = comps[model]["properties"][field]
-        # `X | None` fields: the bound goes on the non-null branch
-        return next((b for b in p.get("anyOf", []) if b.get("type") != "null"), p)
-
-    curves_of = ["EncodeRequest", "ReconstructRequest", "InterpolateRequest", "AugmentRequest", "FitRequest"]
-    for model in curves_of:
-        curves = prop(model, "curves")
-        curves["maxItems"] = settings.max_curves
-        curves["items"]["maxItems"] = settings.max_points
-    prop("RevolveRequest", "curve")["maxItems"] = settings.max_points
-    for model in ["DecodeRequest", "ReconstructRequest", "InterpolateRequest", "SampleRequest", "AugmentRequest"]:
-        prop(model, "n_points")["maximum"] = settings.max_points
-    prop("FitRequest", "n_points")["maximum"] = settings.max_points
-    latents = prop("DecodeRequest", "latents")
-    latents["maxItems"] = settings.max_curves
-    dim = latent_dim or DEFAULT_LATENT_DIM
-    latents["items"].update(minItems=dim, maxItems=dim)
-    prop("DecodeRequest", "frames")["maxItems"] = settings.max_curves
-    prop("SampleRequest", "count")["maximum"] = settings.max_curves
-    prop("AugmentRequest", "count")["maximum"] = max(settings.max_curves, settings.max_stream_curves)
-    prop("InterpolateRequest", "steps")["maximum"] = settings.max_curves
-    weights = prop("InterpolateRequest", "weights")
-    weights["maxItems"] = settings.max_curves
-    comps["InterpolateRequest"]["not"] = {"required": ["steps", "weights"]}
-    return schema
-
-
 def openapi_spec() -> dict[str, Any]:
     """The schema of an app with default settings; the environment and the model play no part."""
     from curve_vae.service.app import create_app

@@ -14,10 +14,8 @@ from typing import Annotated, Literal
 from pydantic import Field, field_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
-#: The shipped, trained model: `models/` at the repository root.
-DEFAULT_MODEL_DIR = Path(__file__).resolve().parent.parent / "models"
-
-Providers = Literal["cpu", "cuda", "auto"]
+from curve_vae.inference.choices import Placement, Providers
+from curve_vae.inference.models import SHIPPED, model_directory
 
 
 class Settings(BaseSettings):
@@ -29,7 +27,8 @@ class Settings(BaseSettings):
     port: int = Field(8000, ge=0, le=65535)  # 0 picks a free port
     workers: int = Field(1, ge=1)  # uvicorn worker processes, each with its own ONNX sessions
     log_level: Literal["critical", "error", "warning", "info", "debug", "trace"] = "info"
-    model_dir: Path = DEFAULT_MODEL_DIR  # encoder.onnx, decoder.onnx and manifest.json
+    # encoder.onnx, decoder.onnx and manifest.json; or a shipped model's name: "default", "paper" (inference/models.py)
+    model_dir: Path = SHIPPED
     providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
     # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among
     # workers × inference_concurrency (inference/cpus.py), so a container never runs more threads than its quota
@@ -57,17 +56,24 @@ class Settings(BaseSettings):
     # Fitting work of one request, steps × (input points + 300 per curve) (service/deps.py check_refine): about 35 s
     # of one CPU core here, under request_timeout; 256 curves of 161 points may take 10 steps.
     max_refine_work: int = Field(1_200_000, ge=0)
+    # Bytes the encoding cache may hold (inference/cache.py): curves posted again — the page's slider, a pipeline's
+    # seed curves and retries — skip the encoder; 0 turns it off. ~3.4 KB a curve of 161 points.
+    cache_bytes: int = Field(64 << 20, ge=0)
     # Where a reconstruction's points go: "model", as the model's manifest says (spline.placement: the shipped model
-    # "closest", each input point at its closest point on the curve); "index", the model's own points: about half the
-    # CPU of a single-curve /reconstruct posed as is (docs/BENCHMARKS.md), giving up closest's 18–59% lower error
-    # (docs/RESULTS.md); or "closest".
-    placement: Literal["model", "closest", "index"] = "model"
+    # "closest", each input point at its closest point on the curve, kept in order); "index", the model's own points
+    # (docs/RESULTS.md compares the two); or "closest".
+    placement: Placement = "model"
     # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
     cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)
     # API keys (service/access.py), comma-separated or a JSON list; empty = open. Set by environment only,
     # so that keys never show in a process list.
     api_keys: Annotated[list[str], NoDecode] = Field(default_factory=list, repr=False)
     metrics: bool = True  # GET /metrics; false answers 404, to keep the numbers off a public port
+
+    @field_validator("model_dir", mode="before")
+    @classmethod
+    def _named_model(cls, value: object) -> object:
+        return model_directory(value) if isinstance(value, str | Path) else value
 
     @field_validator("cors_origins", "api_keys", mode="before")
     @classmethod

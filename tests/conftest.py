@@ -1,5 +1,8 @@
 """Fixtures of the inference and service tests: real exported ONNX models, loaded runtimes, apps and live servers.
 
+The shared runtimes have no encoding cache (cache_bytes=0), so that a test's answer never depends on which test
+read the same curve before it; the cache's own tests make runtimes with one.
+
 The test model is untrained and small (Table 1's cnn1), committed under tests/fixtures/ by
 tests/fixtures/make_models.py, so these tests run in an install without torch; tests that need a
 model that actually reconstructs use `shipped_runtime` (models/).
@@ -71,29 +74,29 @@ def _copy(src: Path, out: Path) -> Path:
 
 @pytest.fixture(scope="session")
 def runtime(model_dir: Path) -> CurveRuntime:
-    return CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
+    return CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1, cache_bytes=0)
 
 
 @pytest.fixture(scope="session")
 def raw_runtime(raw_model_dir: Path) -> CurveRuntime:
-    return CurveRuntime.load(raw_model_dir, providers="cpu", intra_op_threads=1)
+    return CurveRuntime.load(raw_model_dir, providers="cpu", intra_op_threads=1, cache_bytes=0)
 
 
 @pytest.fixture(scope="session")
 def params_runtime(params_model_dir: Path) -> CurveRuntime:
-    return CurveRuntime.load(params_model_dir, providers="cpu", intra_op_threads=1)
+    return CurveRuntime.load(params_model_dir, providers="cpu", intra_op_threads=1, cache_bytes=0)
 
 
 @pytest.fixture(scope="session")
 def closest_runtime(closest_model_dir: Path) -> CurveRuntime:
-    return CurveRuntime.load(closest_model_dir, providers="cpu", intra_op_threads=1)
+    return CurveRuntime.load(closest_model_dir, providers="cpu", intra_op_threads=1, cache_bytes=0)
 
 
 @pytest.fixture(scope="session")
 def shipped_runtime() -> CurveRuntime:
     if not (SHIPPED / "manifest.json").is_file():
         pytest.skip("no shipped model: models/manifest.json is absent")
-    return CurveRuntime.load(SHIPPED, providers="cpu", intra_op_threads=1)
+    return CurveRuntime.load(SHIPPED, providers="cpu", intra_op_threads=1, cache_bytes=0)
 
 
 @pytest.fixture

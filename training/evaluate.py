@@ -35,7 +35,8 @@ def onnx_codec(model_dir: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]
 
 def runtime_codec(runtime: Any) -> tuple[Encoder, Decoder, dict[str, Any]]:
     """Encoder (latent means) and decoder callables in the model plane over a loaded CurveRuntime, and its manifest."""
-    return (lambda curves: runtime.encode_model(curves)[0]), runtime.decode_model, runtime.manifest
+    graphs = runtime.graphs
+    return (lambda curves: graphs.encode(curves)[0]), graphs.decode_model, runtime.manifest.to_json()
 
 
 def torch_codec(checkpoint: str | Path) -> tuple[Encoder, Decoder, dict[str, Any]]:
@@ -148,7 +149,7 @@ def generation_report(
         out[prior] = {
             "every_draw": {
                 **sample_quality(raw.curves, data, reference),
-                "implausible": float(1 - runtime.plausible(raw.curves).mean()),
+                "implausible": float(1 - runtime.sampler.plausible(raw.curves).mean()),
             },
             "valid": {
                 **sample_quality(kept.curves, data, reference),

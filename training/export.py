@@ -23,14 +23,13 @@ import numpy as np
 import torch
 from torch import nn
 
-from curve_vae.files import atomic_path, atomic_write_text
-from curve_vae.geometry import clamped_uniform_knots
-from curve_vae.inference.model_files import file_sha256
+from curve_vae.files import atomic_path
+from curve_vae.geometry import canonical_frame, clamped_uniform_knots
+from curve_vae.inference.manifest import MANIFEST_VERSION, Manifest, file_entry
 from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
 from curve_vae.training.checkpoint import save_weights
 from curve_vae.training.model import VAE, ModelConfig
 
-MANIFEST_VERSION = 1
 OPSET = 18
 
 
@@ -186,11 +185,13 @@ def export(
     prior: LatentPrior | None = None,
     prior_info: dict[str, Any] | None = None,
     placement: str = "closest",
-) -> dict[str, Any]:
+    reading: tuple[str, str] = ("search", "search"),
+) -> Manifest:
     """Write encoder.onnx, decoder.onnx, (vae.pt, prior.npz) and manifest.json into out_dir; return the manifest.
 
     prior: the learned latent distribution (training/prior.py) the service samples from; prior_info
     says how it was fitted. placement: how the service places a reconstruction's points (`PLACEMENTS`).
+    reading: the pose and spacing the encoder was trained for (what a request's "auto" means; `reading_of`).
     """
     if placement not in PLACEMENTS:
         raise ValueError(f"placement must be one of {', '.join(PLACEMENTS)}, got {placement!r}")
@@ -205,25 +206,28 @@ def export(
     if weights:
         save_weights(model, out / "vae.pt")
         files.append("vae.pt")
-    manifest = {
-        "manifest_version": MANIFEST_VERSION,
-        "name": name,
-        "version": version,
-        "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-        "variant": cfg.variant,
-        "n_points": cfg.n_points,
-        "latent_dim": cfg.latent_dim,
-        "files": {f: {"sha256": file_sha256(out / f), "bytes": (out / f).stat().st_size} for f in files},
-        "graphs": _graphs_manifest(cfg),
-        **({"spline": spline_manifest(cfg, placement)} if cfg.spline_ctrl else {}),
-        **({"prior": _prior_manifest(prior, prior_info)} if prior is not None else {}),
-        "frame": _frame_manifest(cfg, model_size),
-        "model_config": asdict(cfg),
-        "opset": OPSET,
-        "exported_with": {"torch": torch.__version__, "python": platform.python_version()},
-        **(extra or {}),
-    }
-    atomic_write_text(out / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+    manifest = Manifest.model_validate(
+        {
+            "manifest_version": MANIFEST_VERSION,
+            "name": name,
+            "version": version,
+            "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            "variant": cfg.variant,
+            "n_points": cfg.n_points,
+            "latent_dim": cfg.latent_dim,
+            "files": {f: file_entry(out / f) for f in files},
+            "graphs": _graphs_manifest(cfg),
+            **({"spline": spline_manifest(cfg, placement)} if cfg.spline_ctrl else {}),
+            **({"prior": _prior_manifest(prior, prior_info)} if prior is not None else {}),
+            "frame": _frame_manifest(cfg, model_size),
+            "reading": {"pose": reading[0], "spacing": reading[1]},
+            "model_config": asdict(cfg),
+            "opset": OPSET,
+            "exported_with": {"torch": torch.__version__, "python": platform.python_version()},
+            **(extra or {}),
+        }
+    )
+    manifest.write(out)
     return manifest
 
 
@@ -242,7 +246,7 @@ def export_checkpoint(
     training_info: str | Path | None = None,
     prior_components: int = 8,
     say: Any = print,
-) -> tuple[dict[str, Any], Any, np.ndarray]:
+) -> tuple[Manifest, Any, np.ndarray]:
     """Export a training checkpoint (`curve-vae export`): the graphs, the prior (None components: none), the
     manifest with the run's training record; returns the manifest, the data configuration and its test split.
 
@@ -270,9 +274,10 @@ def export_checkpoint(
         head = VAE(replace(model.cfg, spline_ctrl=spline_ctrl))  # the head has no weights: same state dict
         head.load_state_dict(model.state_dict())
         model = head.eval()
+    reading = reading_of(data_cfg)
     prior, prior_info = None, None
     if prior_components:
-        prior, count = _fit_shipped_prior(model, data_cfg, train, prior_components)
+        prior, count = _fit_shipped_prior(model, data_cfg, train, prior_components, canonical=reading[0] == "canonical")
         prior_info = {"fitted_on": f"latent means of the first {count} training curves of the paper's data set"}
         say(f"fitted a {prior_components}-component latent prior to {count} training curves")
     manifest = export(
@@ -285,8 +290,19 @@ def export_checkpoint(
         prior=prior,
         prior_info=prior_info,
         placement=placement,
+        reading=reading,
     )
     return manifest, data_cfg, test
+
+
+def reading_of(data_cfg: Any) -> tuple[str, str]:
+    """The reading a model trained on `data_cfg` expects: one canonical pose and the points as given for the broad mix
+    in geometry.canonical_frame's pose (training.families MixSpec.pose), the search for every other."""
+    from curve_vae.training.families import MIXES
+
+    if data_cfg.mix == "broad" and MIXES[data_cfg.mix_version].pose == "canonical":
+        return ("canonical", "parameter")
+    return ("search", "search")
 
 
 def _training_record(ckpt: dict[str, Any], training_info: str | Path | None) -> dict[str, Any]:
@@ -304,9 +320,11 @@ def _training_record(ckpt: dict[str, Any], training_info: str | Path | None) -> 
     return record
 
 
-def _fit_shipped_prior(model: VAE, data_cfg: Any, train: np.ndarray | None, components: int) -> tuple[LatentPrior, int]:
-    """The latent prior /sample draws from, fitted to the paper's training curves (with the broad mix too), and
-    how many curves it was fitted to."""
+def _fit_shipped_prior(
+    model: VAE, data_cfg: Any, train: np.ndarray | None, components: int, *, canonical: bool = False
+) -> tuple[LatentPrior, int]:
+    """The latent prior /sample draws from, fitted to the paper's training curves (with the broad mix too; read in the
+    canonical pose for a model that reads curves so), and how many curves it was fitted to."""
     from curve_vae.training.data import generate_curves
     from curve_vae.training.prior import FIT_CURVES, fit_prior
 
@@ -315,6 +333,11 @@ def _fit_shipped_prior(model: VAE, data_cfg: Any, train: np.ndarray | None, comp
         if train is not None and data_cfg.mix == "paper"
         else generate_curves(min(FIT_CURVES, data_cfg.n_train), data_cfg.seed, n_points=data_cfg.n_points)[0]
     )
+    if canonical:
+        from curve_vae.training.families import MODEL_SIZE
+
+        fit_on = np.stack([canonical_frame(c).to_model(c, MODEL_SIZE) for c in fit_on.astype(np.float64)])
+        fit_on = fit_on.astype(np.float32)
     with torch.no_grad():
         means = np.concatenate(
             [model.encoder(torch.from_numpy(fit_on[i : i + 500]))[0].numpy() for i in range(0, len(fit_on), 500)]
@@ -323,7 +346,7 @@ def _fit_shipped_prior(model: VAE, data_cfg: Any, train: np.ndarray | None, comp
 
 
 def measure_export(
-    out: str | Path, manifest: dict[str, Any], data_cfg: Any, test: np.ndarray, *, fresh_seed: int, suite_count: int
+    out: str | Path, manifest: Manifest, data_cfg: Any, test: np.ndarray, *, fresh_seed: int, suite_count: int
 ) -> dict[str, Any]:
     """Measure the exported graphs as the service runs them (both test sets, the priors' samples, the family
     suite) and store the report in the manifest's `metrics`, written atomically; returns the report."""
@@ -350,6 +373,6 @@ def measure_export(
         )
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
-    manifest["metrics"] = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
-    atomic_write_text(Path(out) / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+    manifest.metrics = {"measured_with": "onnxruntime CPU on the exported graphs", **report}
+    manifest.write(out)
     return report

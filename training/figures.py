@@ -74,7 +74,7 @@ def plot_suite(runtime: Any, sets: dict[str, tuple[str, list[np.ndarray]]], path
     plt = pyplot()
     fig, axes = plt.subplots(len(sets), n, figsize=(1.7 * n, 1.7 * len(sets)), squeeze=False)
     for row, (name, (kind, curves)) in zip(axes, sets.items()):
-        out, _ = runtime.reconstruct(curves[:n])
+        out = runtime.reconstruct(curves[:n]).curves
         rel = relative_rmse(curves[:n], out)
         for ax, c, o, r in zip(row, curves, out, rel):
             ax.plot(c[:, 0], c[:, 1], color="0.65", lw=2.4)

@@ -82,7 +82,9 @@ def relative_rmse(inputs: list[np.ndarray], outputs: list[np.ndarray]) -> np.nda
 
 def measure(runtime: Any, curves: list[np.ndarray], **options: Any) -> dict[str, float]:
     """One set through `runtime.reconstruct` (options: spacing, pose, …): its row of the suite's table."""
-    out, _ = runtime.reconstruct(curves, **options)
+    from curve_vae.inference.reading import Reading
+
+    out = runtime.reconstruct(curves, Reading(**options)).curves
     rel = relative_rmse(curves, out)
     rough_in = np.array([smoothness(c)["roughness"] for c in curves])
     rough_out = np.array([smoothness(o)["roughness"] for o in out])

@@ -11,6 +11,7 @@ from curve_vae.commands.options import (
     model_runtime,
 )
 from curve_vae.files import refuse_overwrite
+from curve_vae.inference.choices import AugmentMode, Axis, FitParam, FrameMode, MeshFormat, Output, Pose, choices
 from curve_vae.progress import bar, counted, shown
 
 
@@ -22,18 +23,10 @@ def cmd_sample(a: argparse.Namespace) -> int:
     refuse_overwrite(a.output, a.force)
     runtime = model_runtime(a)
     seed = fresh_seed() if a.seed is None else a.seed
-    splines: list | None = [] if a.output_as != "points" else None
     made = runtime.sample(
-        a.count,
-        seed=seed,
-        temperature=a.temperature,
-        prior=a.prior,
-        valid=a.valid,
-        n_points=a.n_points,
-        spacing=a.spacing,
-        splines=splines,
+        a.count, seed=seed, temperature=a.temperature, prior=a.prior, valid=a.valid, n_points=a.n_points
     )
-    body = with_output(sample_body(made, seed, metrics=a.metrics), splines, a.output_as)
+    body = with_output(sample_body(made, metrics=a.metrics), made.splines, a.output_as)
     write_output(a.output, body, array_key="curves" if "curves" in body else None)
     print(
         f"{a.output}: {a.count} curves of {made.curves.shape[1]} points from the {made.prior} prior, seed {seed}; "
@@ -48,41 +41,41 @@ def cmd_augment(a: argparse.Namespace) -> int:
 
     from curve_vae.files import read_curves, write_npy_chunks, write_output
     from curve_vae.inference.bodies import augment_body
+    from curve_vae.inference.reading import Reading
+    from curve_vae.inference.results import Augmented
     from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
     runtime = model_runtime(a)
     seed = fresh_seed() if a.seed is None else a.seed
-    plan = runtime.plan_augment(
-        read_curves(a.input),
-        mode=a.mode,
-        seed=seed,
-        neighbours=a.neighbours,
-        frame=a.frame,
-        spacing=a.spacing,
-        pose=a.pose,
-    )
+    reading = Reading(frame=a.frame, pose=a.pose, spacing=a.spacing)
+    plan = runtime.plan_augment(read_curves(a.input), mode=a.mode, seed=seed, neighbours=a.neighbours, reading=reading)
     start, stop = a.offset, a.offset + a.count
-    step = runtime.batch_size
+    step = runtime.graphs.batch_size
+    spacing = runtime.reading(reading).spacing
     with bar(a.count, "augment", enabled=shown(a.no_progress)) as progress:
         if a.output.endswith(".npy"):  # streamed chunk by chunk: any count in bounded memory
             if a.metrics:
                 raise ValueError("--metrics needs a JSON output: a .npy file holds the curves alone")
             shape = (a.count, runtime.mix_length(plan.prep, a.n_points), 2)
-            chunks = runtime.augment_chunks(plan, start, stop, n_points=a.n_points, spacing=a.spacing, chunk=step)
+            chunks = runtime.augment_chunks(plan, start, stop, n_points=a.n_points, spacing=spacing, chunk=step)
             write_npy_chunks(a.output, shape, counted(chunks, progress))
         else:
             parts = []  # chunk by chunk for the bar; a count of 0 still makes one (empty) chunk of the right shapes
             for i in range(start, stop, step) or [start]:
-                parts.append(
-                    runtime.augment_batch(plan, i, min(i + step, stop), n_points=a.n_points, spacing=a.spacing)
-                )
-                progress.update(len(parts[-1][0]))
-            out, sources, weights = (np.concatenate([p[k] for p in parts]) for k in range(3))
-            frames = [f for p in parts for f in p[3]]
-            shape = out.shape
-            body = augment_body(out, sources, weights, frames, seed=seed, offset=a.offset, metrics=a.metrics)
-            write_output(a.output, body)
+                parts.append(runtime.augment(plan, i, min(i + step, stop), n_points=a.n_points, spacing=spacing))
+                progress.update(len(parts[-1].curves))
+            made = Augmented(
+                np.concatenate([p.curves for p in parts]),
+                [f for p in parts for f in p.frames],
+                None,
+                sources=np.concatenate([p.sources for p in parts]),
+                weights=np.concatenate([p.weights for p in parts]),
+                seed=seed,
+                offset=a.offset,
+            )
+            shape = made.curves.shape
+            write_output(a.output, augment_body(made, metrics=a.metrics))
     print(f"{a.output}: {a.count} new curves of {shape[1]} points ({a.mode}s), seed {seed}", file=sys.stderr)
     return 0
 
@@ -129,9 +122,9 @@ def _add_sample(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument(
         "--prior",
-        choices=["learned", "standard"],
         default=None,
-        help="learned: the latent density shipped with the model; standard: N(0, I) (default: learned if shipped)",
+        help="learned: the latent density shipped with the model; standard: N(0, I); or the name of a prior fitted "
+        "with `curve-vae prior` (in --priors-dir) (default: learned if shipped)",
     )
     s.add_argument(
         "--valid",
@@ -141,7 +134,7 @@ def _add_sample(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument(
         "--output-as",
-        choices=["points", "bspline", "both"],
+        choices=choices(Output),
         default="points",
         help="curves as points, as B-splines (control points, knots, params), or both; JSON only (default: points)",
     )
@@ -153,7 +146,7 @@ def _add_augment(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("augment", help="new curves between given curves, offline (as POST /augment)")
     s.add_argument("input", help="seed curves: .json ([curve, …] or {curves: …}), .npy (N, n, 2), or - (stdin)")
     add_generate_options(s)
-    s.add_argument("--mode", choices=["pair", "triplet"], default="pair", help="sources per new curve (default: pair)")
+    s.add_argument("--mode", choices=choices(AugmentMode), default="pair", help="sources per new curve (default: pair)")
     s.add_argument(
         "--neighbours",
         type=int,
@@ -162,14 +155,14 @@ def _add_augment(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument("--offset", type=int, default=0, help="index of the first curve in the seeded sequence (default: 0)")
     s.add_argument(
-        "--frame", choices=["auto", "model"], default="auto", help="frame of the seed curves (default: auto)"
+        "--frame", choices=choices(FrameMode), default="auto", help="frame of the seed curves (default: auto)"
     )
     s.add_argument(
         "--pose",
-        choices=["auto", "as_is"],
+        choices=choices(Pose),
         default="auto",
-        help="auto: each seed curve is encoded in the pose (turn, mirror, direction) it reconstructs best in, and "
-        "new curves come back in their sources' poses; as_is: as oriented (default: auto)",
+        help="how each seed curve is turned before it is encoded, as the service's `pose` (auto: the model's own "
+        "reading; new curves come back in their sources' poses) (default: auto)",
     )
     add_model_options(s)
     s.set_defaults(func=cmd_augment)
@@ -193,7 +186,7 @@ def _add_fit(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument(
         "--param",
-        choices=["uniform", "chord"],
+        choices=choices(FitParam),
         default="chord",
         help="parameter of each point: chord length (any curve) or uniform (the "
         "data set's sampling; recovers its B-splines exactly) (default: chord)",
@@ -206,10 +199,10 @@ def _add_revolve(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("revolve", help="surface of revolution of a profile curve, as OBJ or STL (paper Fig. 12)")
     s.add_argument("input", help="one profile curve: .json, .npy, or - (stdin)")
     s.add_argument("-o", "--output", required=True, help="mesh file (.obj or .stl)")
-    s.add_argument("--format", choices=["obj", "stl"], default="", help="default: from the file name")
+    s.add_argument("--format", choices=choices(MeshFormat), default="", help="default: from the file name")
     s.add_argument("--segments", type=int, default=64, help="angular resolution (default: 64)")
     s.add_argument(
-        "--axis", choices=["x", "y"], default="y", help="revolve about a vertical (y) or horizontal (x) line"
+        "--axis", choices=choices(Axis), default="y", help="revolve about a vertical (y) or horizontal (x) line"
     )
     s.add_argument(
         "--axis-position",

@@ -39,7 +39,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         training_info=a.training_info or None,
         prior_components=a.prior_components if a.prior else 0,
     )
-    print(f"exported {a.checkpoint} → {a.out}/: {', '.join(manifest['files'])}, manifest.json")
+    print(f"exported {a.checkpoint} → {a.out}/: {', '.join(manifest.files)}, manifest.json")
     if a.evaluate:
         report = measure_export(a.out, manifest, data_cfg, test, fresh_seed=a.fresh_seed, suite_count=a.suite_count)
         for name, r in report["test_sets"].items():
@@ -121,11 +121,11 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
 
 
 def cmd_triton(a: argparse.Namespace) -> int:
-    from curve_vae.service.settings import DEFAULT_MODEL_DIR
+    from curve_vae.inference.models import model_directory
     from curve_vae.triton import smoke_test, write_repository
 
     folders = write_repository(
-        a.model_dir or DEFAULT_MODEL_DIR,
+        model_directory(a.model_dir),
         a.out,
         prefix=a.prefix,
         max_batch_size=a.max_batch_size,

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from curve_vae.inference.choices import Providers, Spacing, choices
 from curve_vae.inference.cpus import available_cpus
 from curve_vae.training.families import MIX_VERSION, MIXES
 
@@ -95,9 +96,14 @@ def add_suite_option(p: argparse.ArgumentParser) -> None:
 
 def add_model_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("model (offline: onnxruntime on the exported graphs, no server)")
-    g.add_argument("--model-dir", default="", help="exported model directory (default: the shipped model, models/)")
     g.add_argument(
-        "--providers", choices=["cpu", "cuda", "auto"], default="cpu", help="onnxruntime providers (default: cpu)"
+        "--model-dir",
+        "--model",
+        default="",
+        help="exported model directory, or a shipped model's name: default, paper (default: the shipped default)",
+    )
+    g.add_argument(
+        "--providers", choices=choices(Providers), default="cpu", help="onnxruntime providers (default: cpu)"
     )
     g.add_argument("--batch-size", type=int, default=64, help="curves per ONNX run and per .npy chunk (default: 64)")
 
@@ -119,10 +125,9 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--spacing",
-        choices=["parameter", "arc_length", "natural", "auto"],
+        choices=choices(Spacing),
         default="auto",
-        help="how the seed curves' points are read, as the service's `spacing` (default: auto, the closer of the "
-        "points as given and their natural spacing)",
+        help="how the seed curves' points are read, as the service's `spacing` (default: auto, the model's own)",
     )
     p.add_argument(
         "--metrics", action="store_true", help="add smoothness, self-intersection and length per curve (JSON only)"
@@ -131,8 +136,8 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
 
 
 def model_runtime(a: argparse.Namespace):
+    from curve_vae.inference.models import model_directory
     from curve_vae.inference.runtime import CurveRuntime
-    from curve_vae.service.settings import DEFAULT_MODEL_DIR
 
-    model_dir = a.model_dir or DEFAULT_MODEL_DIR
+    model_dir = model_directory(a.model_dir)
     return CurveRuntime.load(model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)

@@ -11,22 +11,19 @@ from fastapi.responses import Response
 from curve_vae.geometry import revolve
 from curve_vae.inference.bodies import fit_body
 from curve_vae.inference.errors import InputError
+from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example
-from curve_vae.service.deps import (
-    SettingsDep,
-    check_curves,
-    check_n_points,
-    run_inference,
-)
+from curve_vae.service.deps import SettingsDep, run_inference
 from curve_vae.service.fastjson import JSON, FastJSONRoute
+from curve_vae.service.limits import check, curves_of
 
 design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 
 
 @design_router.post(
     "/fit",
-    response_model=s.FitResponse,
+    response_model=r.FitResponse,
     responses=error_docs(413, 422),
     summary="Least-squares cubic B-spline of each curve",
     openapi_extra=curl_sample(
@@ -51,8 +48,8 @@ async def fit(
 ) -> Response:
     """Clamped uniform cubic B-spline with `n_ctrl` control points (omitted: the fewest within `tolerance`) fitted to
     each curve by least squares: control points, knots, and how far the curve is from the spline."""
-    curves = check_curves(req.curves, settings)
-    check_n_points(req.n_points, settings)
+    check(req, settings)
+    curves = curves_of(req)
 
     def work() -> Response:
         return JSON(fit_body(curves, req.n_ctrl, param=req.param, n_points=req.n_points, tolerance=req.tolerance))
@@ -110,8 +107,7 @@ async def revolve_profile(
 ) -> Response:
     """Revolve a profile about a vertical (or horizontal) line of its plane into a triangle mesh, outward-facing;
     answered as a file (OBJ text by default, or binary STL) with its vertex and triangle counts in headers."""
-    if len(req.curve) > settings.max_points:
-        raise InputError(("curve",), f"at most {settings.max_points} points, got {len(req.curve)}")
+    check(req, settings)
     profile = np.asarray(req.curve, dtype=np.float64)
     triangles = 2 * (len(profile) - 1) * req.segments  # at most: pole bands have half as many
     if triangles > settings.max_mesh_triangles:

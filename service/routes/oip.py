@@ -159,13 +159,13 @@ async def ready(request: Request) -> dict[str, bool]:
 
 def _session(request: Request, model: str) -> Any:
     runtime = runtime_of(request)
-    return runtime, (runtime.encoder if model == "encoder" else runtime.decoder)
+    return runtime, (runtime.graphs.encoder if model == "encoder" else runtime.graphs.decoder)
 
 
 def _metadata_route(model: str) -> Callable[[Request], Awaitable[dict[str, Any]]]:
     async def model_metadata(request: Request) -> dict[str, Any]:
         runtime, session = _session(request, model)
-        return oip.metadata(model, str(runtime.manifest.get("version", "")), oip.signature(session))
+        return oip.metadata(model, runtime.manifest.version, oip.signature(session))
 
     model_metadata.__doc__ = (
         f"The {model}'s inputs and outputs (name, datatype, shape with -1 for the batch axis), read from its ONNX "
@@ -204,11 +204,12 @@ def _infer_route(model: str) -> Callable[[Request], Awaitable[Response]]:
         try:
             runtime, session = _session(request, model)
             req = await _infer_request(request, model, session)
-            version = str(runtime.manifest.get("version", ""))
+            version = runtime.manifest.version
 
             def work() -> Response:
-                own = runtime.encoder if model == "encoder" else runtime.decoder  # this inference thread's session
-                result = oip.infer(own, req, batch_size=runtime.batch_size)
+                graphs = runtime.graphs
+                own = graphs.encoder if model == "encoder" else graphs.decoder  # this inference thread's session
+                result = oip.infer(own, req, batch_size=graphs.batch_size)
                 return JSON(oip.response(model, version, req, result))
 
             return await run_inference(request, f"/v2/models/{model}/infer", req.batch, work)

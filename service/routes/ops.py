@@ -10,7 +10,7 @@ from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
 from curve_vae import __version__
-from curve_vae.service import schemas as s
+from curve_vae.service import responses as r
 from curve_vae.service.api_docs import curl_sample, error_docs
 from curve_vae.service.deps import (
     RuntimeDep,
@@ -22,7 +22,7 @@ from curve_vae.service.deps import (
 ops_router = APIRouter(tags=["operations"])
 
 
-@ops_router.get("/health", response_model=s.StatusResponse, summary="Liveness", openapi_extra=curl_sample("/health"))
+@ops_router.get("/health", response_model=r.StatusResponse, summary="Liveness", openapi_extra=curl_sample("/health"))
 async def health() -> dict[str, str]:
     """200 while the process serves requests, model loaded or not."""
     return {"status": "ok"}
@@ -30,7 +30,7 @@ async def health() -> dict[str, str]:
 
 @ops_router.get(
     "/ready",
-    response_model=s.StatusResponse,
+    response_model=r.StatusResponse,
     responses=error_docs(503),
     summary="Readiness",
     openapi_extra=curl_sample("/ready"),
@@ -43,7 +43,7 @@ async def ready(request: Request) -> dict[str, str]:
 
 @ops_router.get(
     "/model",
-    response_model=s.ModelInfo,
+    response_model=r.ModelInfo,
     responses=error_docs(503),
     summary="The model being served",
     openapi_extra=curl_sample("/model"),
@@ -51,31 +51,34 @@ async def ready(request: Request) -> dict[str, str]:
 async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDep) -> dict[str, Any]:
     """Name, version, dimensions and checksums from the manifest, and the providers the sessions actually use."""
     m = runtime.manifest
+    present = runtime.model_dir
     return {
-        "name": m.get("name", "curve-vae"),
-        "version": str(m.get("version", "")),
+        "name": m.name,
+        "version": m.version,
         "service_version": __version__,
-        "created": m.get("created"),
-        "variant": m.get("variant"),
+        "created": m.created,
+        "variant": m.variant,
         "n_points": runtime.n_points,
         "latent_dim": runtime.latent_dim,
         "model_size": runtime.model_size,
-        "prior": (
-            {k: v for k, v in m["prior"].items() if k in ("kind", "components", "fitted_on")}
-            if m.get("prior")
-            else None
-        ),
+        "reading": m.reading.model_dump(include={"pose", "spacing"}),
+        "prior": m.prior.model_dump(include={"kind", "components", "fitted_on"}) if m.prior else None,
         "spline": (
-            {"n_ctrl": m["spline"]["n_ctrl"], "degree": m["spline"]["degree"], "knots": m["spline"]["knots"]}
-            | {"learned_params": runtime.has_params, "placement": "closest" if runtime.closest_placement else "index"}
-            if m.get("spline")
+            {"n_ctrl": m.spline.n_ctrl, "degree": m.spline.degree, "knots": runtime.graphs.knots.tolist()}
+            | {
+                "learned_params": runtime.graphs.has_params,
+                "placement": "closest" if runtime.closest_placement else "index",
+            }
+            if m.spline is not None and runtime.graphs.knots is not None
             else None
         ),
-        "files": {k: {"sha256": v["sha256"], "bytes": v.get("bytes", 0)} for k, v in m["files"].items()},
-        "providers": runtime.providers,
-        "requested_providers": runtime.requested_providers,
+        # the files this model directory holds (an installed package ships no vae.pt: serving never reads it)
+        "files": {k: v.model_dump(include={"sha256", "bytes"}) for k, v in m.files.items() if (present / k).is_file()},
+        "cache": runtime.cache.stats() if runtime.cache is not None else None,
+        "providers": runtime.graphs.providers,
+        "requested_providers": runtime.graphs.requested_providers,
         "onnxruntime": ort.__version__,
-        "metrics": m.get("metrics"),
+        "metrics": m.metrics,
         "limits": {
             "max_curves": settings.max_curves,
             "max_points": settings.max_points,
@@ -108,5 +111,12 @@ async def metrics(request: Request) -> Response:
     """Request counts by route and status, request and inference latency histograms, batch sizes."""
     if not request.app.state.settings.metrics:
         raise HTTPException(404, "metrics are off on this server (CURVE_VAE_METRICS=false)")
-    body, content_type = request.app.state.metrics.render()
+    metrics = request.app.state.metrics
+    runtime = request.app.state.runtime
+    if runtime is not None and runtime.cache is not None:
+        stats = runtime.cache.stats()
+        metrics.cache_hits.set(stats["hits"])
+        metrics.cache_misses.set(stats["misses"])
+        metrics.cache_bytes.set(stats["bytes"])
+    body, content_type = metrics.render()
     return Response(body, media_type=content_type)

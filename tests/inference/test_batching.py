@@ -24,7 +24,7 @@ def registry():
 @pytest.fixture
 def batcher(runtime, registry):
     b = GraphBatcher(
-        runtime.pool,
+        runtime.graphs.pool,
         {"encoder": "curves", "decoder": "latent"},
         max_rows=16,
         max_wait=0.05,
@@ -54,7 +54,7 @@ def test_each_caller_gets_its_own_rows(batcher, registry, runtime, curves):
     inputs = [curves(k, seed=k).astype(np.float32) for k in (1, 2, 3, 1, 2, 1)]  # 10 rows, different counts
     got = _together(lambda x: batcher.run("encoder", x, ["mean", "log_var"]), inputs)
     for x, (mean, log_var) in zip(inputs, got):
-        alone = runtime.encoder.run(["mean", "log_var"], {"curves": x})
+        alone = runtime.graphs.encoder.run(["mean", "log_var"], {"curves": x})
         np.testing.assert_allclose(mean, alone[0], rtol=1e-4, atol=1e-4)
         np.testing.assert_allclose(log_var, alone[1], rtol=1e-4, atol=1e-4)
     graph = {"graph": "encoder"}

@@ -78,8 +78,8 @@ def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypa
     client = make_client(share_runtime=False, providers="cpu", inference_concurrency=3)
     assert client.get("/ready").status_code == 200
     runtime = client.app.state.runtime
-    assert len(runtime.pool.pairs) == 3  # one session pair per inference at once
-    for pair in runtime.pool.pairs:
+    assert len(runtime.graphs.pool.pairs) == 3  # one session pair per inference at once
+    for pair in runtime.graphs.pool.pairs:
         for session in pair:  # read back from onnxruntime, not from our settings
             opts = session.get_session_options()
             assert opts.intra_op_num_threads == 2  # 6 CPUs for 1 worker × 3 inferences at once
@@ -104,7 +104,7 @@ def test_every_runtime_setting_can_be_overridden(make_client):
     execution = client.get("/model").json()["execution"]
     assert execution["sessions"] == 1 and execution["intra_op_threads"] == 3
     assert execution["inter_op_threads"] == 2 and execution["spinning"] is True
-    opts = client.app.state.runtime.encoder.get_session_options()
+    opts = client.app.state.runtime.graphs.encoder.get_session_options()
     assert opts.get_session_config_entry("session.intra_op.allow_spinning") == "1"
 
 
@@ -114,7 +114,7 @@ def test_each_inference_thread_keeps_its_own_session_pair(make_client, curves):
     import threading
 
     client = make_client(share_runtime=False, providers="cpu", inference_concurrency=2, intra_op_threads=1)
-    pool = client.app.state.runtime.pool
+    pool = client.app.state.runtime.graphs.pool
     used: dict[str, int] = {}
     real = pool.pair
 

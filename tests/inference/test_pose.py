@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from curve_vae.geometry import sample_bspline
+from curve_vae.inference.reading import Reading
 
 
 def _rot(a: float) -> np.ndarray:
@@ -27,35 +28,35 @@ MOVES = {
 def test_reconstruction_does_not_care_about_the_move(shipped_runtime, move):
     c = _stroke()
     there, back = MOVES[move]
-    (own,), _ = shipped_runtime.reconstruct([c])
-    (moved,), _ = shipped_runtime.reconstruct([there(c)])
+    (own,) = shipped_runtime.reconstruct([c]).curves
+    (moved,) = shipped_runtime.reconstruct([there(c)]).curves
     np.testing.assert_allclose(back(moved), own, atol=1e-3 * np.ptp(c))
 
 
 def test_pose_auto_beats_as_is_on_a_stroke_unlike_the_papers_curves(shipped_runtime):
     c = _stroke()
     diag = np.hypot(*np.ptp(c, axis=0))
-    _, auto = shipped_runtime.reconstruct([c])
-    _, as_is = shipped_runtime.reconstruct([c], pose="as_is")
+    auto = shipped_runtime.reconstruct([c]).mse
+    as_is = shipped_runtime.reconstruct([c], Reading(pose="as_is")).mse
     assert np.sqrt(2 * auto[0]) / diag < 0.02  # within 2% of the diagonal (eq. 4 MSE averages both coordinates)
     assert auto[0] < as_is[0] / 4
 
 
 def test_interpolating_a_curve_with_its_reversal_gives_the_curve(shipped_runtime):
     c = _stroke()
-    (own,), _ = shipped_runtime.reconstruct([c])  # at its own points, as a sweep between inputs of its length
+    (own,) = shipped_runtime.reconstruct([c]).curves  # at its own points, as a sweep between inputs of its length
     w = np.array([[1.0, 0.0], [0.7, 0.3], [0.5, 0.5], [0.2, 0.8]])
-    out, frames = shipped_runtime.interpolate([c, c[::-1]], w)
-    mine = shipped_runtime.encode([c])[2][0]
+    res = shipped_runtime.interpolate([c, c[::-1]], w)
+    out, frames = res.curves, res.frames
+    mine = shipped_runtime.encode([c]).frames[0]
     for curve, frame in zip(out, frames):  # in the order of the heavier source
         np.testing.assert_allclose(curve if frame.reverse == mine.reverse else curve[::-1], own, atol=1e-6 * np.ptp(c))
 
 
 def test_spline_output_matches_the_points_in_a_reversed_pose(shipped_runtime):
     c = _stroke()[::-1] * [1.0, -1.0]
-    splines = []
-    (pts,), _ = shipped_runtime.reconstruct([c], splines=splines)
-    s = splines[0]
+    rec = shipped_runtime.reconstruct([c])
+    (pts,), (s,) = rec.curves, rec.splines
     from curve_vae.geometry import evaluate_bspline
 
     np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params, s.degree), pts, atol=1e-9)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from curve_vae.inference.model_files import ModelLoadError
+from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.evaluate import nearest_distances, sample_quality
@@ -77,11 +77,11 @@ def test_rejection_keeps_the_seed_in_charge(runtime, monkeypatch, prior):
     again from the item's own generator, so the same seed gives the same curves and a larger count extends a
     smaller one, rejections and all."""
     decoded: list[int] = []
-    decode = runtime.decode_model_splines
-    monkeypatch.setattr(runtime, "decode_model_splines", lambda z: decoded.append(len(z)) or decode(z))
+    decode = runtime.graphs.decode
+    monkeypatch.setattr(runtime.graphs, "decode", lambda z: decoded.append(len(z)) or decode(z))
     made = runtime.sample(12, seed=7, prior=prior, max_draws=5)
     assert sum(decoded) == 12 + made.rejected and made.rejected > 0  # an untrained decoder scribbles
-    ok = runtime.plausible(runtime.decode_model(made.latents).astype(np.float64))
+    ok = runtime.sampler.plausible(runtime.graphs.decode_model(made.latents).astype(np.float64))
     assert int((~ok).sum()) == made.invalid
     again = runtime.sample(12, seed=7, prior=prior, max_draws=5)
     np.testing.assert_array_equal(again.latents, made.latents)
@@ -97,7 +97,7 @@ def test_plausible_rejects_crossings_and_curves_outside_the_disc(runtime):
     line = np.stack([20 + 80 * t, 64 + 0 * t], axis=1)
     loop = np.stack([64 + 30 * np.cos(8 * t), 64 + 30 * np.sin(8 * t)], axis=1)  # more than a full turn: crosses
     far = line + [0, 60]  # y = 124: beyond radius 64 from (64, 64)
-    assert runtime.plausible(np.stack([line, loop, far])).tolist() == [True, False, False]
+    assert runtime.sampler.plausible(np.stack([line, loop, far])).tolist() == [True, False, False]
 
 
 def test_sample_quality_on_known_inputs(curves):

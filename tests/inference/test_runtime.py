@@ -12,8 +12,10 @@ import pytest
 
 from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve, simplex_grid, simplex_grid_size
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.model_files import ModelLoadError, resolve_providers
+from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
+from curve_vae.inference.sessions import resolve_providers
 
 # ----------------------------------------------------------------------------- loading
 
@@ -25,7 +27,7 @@ def _copy(model_dir: Path, tmp_path: Path) -> Path:
 
 
 def test_load_reports_cpu_provider(runtime):
-    assert runtime.providers[0] == "CPUExecutionProvider"
+    assert runtime.graphs.providers[0] == "CPUExecutionProvider"
     assert (runtime.n_points, runtime.latent_dim, runtime.model_size) == (161, 32, 100.0)
 
 
@@ -125,8 +127,10 @@ def test_reconstruction_follows_scale_and_shift(runtime, curves, scale, shift, n
     """reconstruct(c·s + t) == reconstruct(c)·s + t to float precision, at any length."""
     c = curves(3, n_points, seed=1)
     t = np.asarray(shift)
-    base, base_mse = runtime.reconstruct(list(c), spacing=spacing)
-    moved, moved_mse = runtime.reconstruct(list(c * scale + t), spacing=spacing)
+    res = runtime.reconstruct(list(c), Reading(spacing=spacing))
+    base, base_mse = res.curves, res.mse
+    res = runtime.reconstruct(list(c * scale + t), Reading(spacing=spacing))
+    moved, moved_mse = res.curves, res.mse
     for b, m in zip(base, moved, strict=True):
         assert m.shape == (n_points, 2)
         # float32 inside the graphs: a relative 1e-6 of the curve's size, plus rounding of the shift itself
@@ -137,9 +141,10 @@ def test_reconstruction_follows_scale_and_shift(runtime, curves, scale, shift, n
 
 def test_model_frame_passes_coordinates_untouched(raw_runtime, curves):
     c = curves(2)
-    out, mse = raw_runtime.reconstruct(list(c), frame="model", spacing="parameter")  # the points as given
-    mean, _ = raw_runtime.encode_model(c)
-    direct = raw_runtime.decode_model(mean)
+    res = raw_runtime.reconstruct(list(c), Reading(frame="model", spacing="parameter"))  # the points as given
+    out, mse = res.curves, res.mse
+    mean, _ = raw_runtime.graphs.encode(c)
+    direct = raw_runtime.graphs.decode_model(mean)
     np.testing.assert_array_equal(np.stack(out), direct.astype(np.float64))
     np.testing.assert_allclose(mse, mse_per_curve(c, direct))
 
@@ -148,9 +153,9 @@ def test_spline_head_points_are_the_spline_at_its_params(runtime, curves):
     """With a B-spline head, returned points are the returned spline at the returned parameters (float64), and in
     the model's frame at its 161 points they are the graph's own curves (to float32 rounding)."""
     c = curves(2)
-    splines: list = []
-    out, _ = runtime.reconstruct(list(c), frame="model", spacing="parameter", splines=splines)
-    direct = runtime.decode_model(runtime.encode_model(c)[0])
+    rec = runtime.reconstruct(list(c), Reading(frame="model", spacing="parameter"))
+    out, splines = rec.curves, rec.splines
+    direct = runtime.graphs.decode_model(runtime.graphs.encode(c)[0])
     np.testing.assert_allclose(np.stack(out), direct, rtol=0, atol=1e-4)
     for curve, spline in zip(out, splines, strict=True):
         np.testing.assert_array_equal(spline.params, np.linspace(0, 1, 161))
@@ -160,27 +165,31 @@ def test_spline_head_points_are_the_spline_at_its_params(runtime, curves):
 def test_auto_frame_maps_into_and_out_of_the_model_frame(runtime, curves):
     c = curves(1)[0] * 0.01 + 5.0
     frame = fit_frame(c)
-    mean, _, frames = runtime.encode([c], pose="as_is", spacing="parameter")
+    res = runtime.encode([c], Reading(pose="as_is", spacing="parameter"))
+    mean, frames = res.mean, res.frames
     assert frames == [frame]
-    mean_model, _ = runtime.encode_model(frame.to_model(c, runtime.model_size)[None])
+    mean_model, _ = runtime.graphs.encode(frame.to_model(c, runtime.model_size)[None])
     np.testing.assert_allclose(mean, mean_model, atol=1e-5)
-    out = runtime.decode(mean, frames=frames)
-    np.testing.assert_allclose(out[0], frame.from_model(runtime.decode_model(mean)[0], runtime.model_size))
+    out = runtime.decode(mean, frames=frames).curves
+    np.testing.assert_allclose(out[0], frame.from_model(runtime.graphs.decode_model(mean)[0], runtime.model_size))
 
 
 @pytest.mark.parametrize("n_out", [None, 10, 161, 1000])
 @pytest.mark.parametrize("spacing", ["parameter", "arc_length"])
 def test_lengths_in_and_out(runtime, curves, n_out, spacing):
     inputs = [curves(1, 50)[0], curves(1, 161, seed=2)[0], curves(1, 733, seed=3)[0]]
-    out, mse = runtime.reconstruct(inputs, n_points=n_out, spacing=spacing)
+    res = runtime.reconstruct(inputs, Reading(spacing=spacing), n_points=n_out)
+    out, mse = res.curves, res.mse
     assert [len(o) for o in out] == [n_out or len(c) for c in inputs]
     assert mse.shape == (3,)
 
 
 def test_mse_is_measured_at_the_inputs_own_points(runtime, curves):
     c = [curves(1, 50)[0] * 7.0, curves(1, 300, seed=4)[0] - 40.0]
-    own, mse = runtime.reconstruct(c)
-    resized, mse_again = runtime.reconstruct(c, n_points=20)
+    res = runtime.reconstruct(c)
+    own, mse = res.curves, res.mse
+    res = runtime.reconstruct(c, n_points=20)
+    resized, mse_again = res.curves, res.mse
     np.testing.assert_allclose(mse, [mse_per_curve(a[None], b[None])[0] for a, b in zip(c, own, strict=True)])
     np.testing.assert_array_equal(mse, mse_again)
     assert all(len(r) == 20 for r in resized)
@@ -190,7 +199,7 @@ def _relative_errors(rt: CurveRuntime, ctrl: np.ndarray, n_points: int, spacing:
     from curve_vae.geometry import sample_bspline
 
     c = sample_bspline(ctrl, n_points)
-    out, mse = rt.reconstruct(list(c), spacing=spacing)
+    mse = rt.reconstruct(list(c), Reading(spacing=spacing)).mse
     sizes = np.array([fit_frame(x).size for x in c])
     return np.sqrt(mse) / sizes
 
@@ -218,7 +227,7 @@ def test_neighbouring_lengths_give_the_same_curve(runtime, curves):
     ctrl = __import__("curve_vae.geometry", fromlist=["random_control_points"]).random_control_points(
         np.random.default_rng(3), 1
     )[0]
-    out = {n: runtime.reconstruct([sample_bspline(ctrl, n)], n_points=161)[0][0] for n in (160, 161, 162)}
+    out = {n: runtime.reconstruct([sample_bspline(ctrl, n)], n_points=161).curves[0] for n in (160, 161, 162)}
     size = fit_frame(out[161]).size
     assert np.abs(out[160] - out[161]).max() < 0.02 * size
     assert np.abs(out[162] - out[161]).max() < 0.02 * size
@@ -234,33 +243,35 @@ def test_other_lengths_reconstruct_about_as_well_with_the_shipped_model(shipped_
 
 def test_pair_ends_are_the_reconstructions(runtime, curves):
     a, b = curves(1, 161)[0] * 2 + 9, curves(1, 161, seed=5)[0] / 3
-    out, frames = runtime.interpolate([a, b], simplex_grid(2, 3))
-    rec, _ = runtime.reconstruct([a, b])
+    res = runtime.interpolate([a, b], simplex_grid(2, 3))
+    out, frames = res.curves, res.frames
+    rec = runtime.reconstruct([a, b]).curves
     np.testing.assert_allclose(out[0], rec[0], atol=1e-9)
     np.testing.assert_allclose(out[-1], rec[1], atol=1e-9)
-    fa, fb = runtime.encode([a, b])[2]  # the poses each curve reconstructs best in
+    fa, fb = runtime.encode([a, b]).frames  # the poses each curve reconstructs best in
     assert frames[0] == fa and frames[-1] == fb
     assert frames[1] == blend_frames([fa, fb], np.array([[0.5, 0.5]]))[0]
 
 
 def test_interpolants_keep_a_common_input_length(runtime, curves):
     a, b = curves(1, 60)[0], curves(1, 60, seed=6)[0] + 50
-    out, _ = runtime.interpolate([a, b], simplex_grid(2, 4))
-    rec, _ = runtime.reconstruct([a, b])
+    out = runtime.interpolate([a, b], simplex_grid(2, 4)).curves
+    rec = runtime.reconstruct([a, b]).curves
     assert out.shape == (4, 60, 2)
     np.testing.assert_allclose(out[0], rec[0], atol=1e-9)  # same spacing as the first input's reconstruction
-    mixed, _ = runtime.interpolate([a, curves(1, 70)[0]], simplex_grid(2, 2))
+    mixed = runtime.interpolate([a, curves(1, 70)[0]], simplex_grid(2, 2)).curves
     assert mixed.shape == (2, 161, 2)  # lengths differ: the model's
-    sized, _ = runtime.interpolate([a, b], simplex_grid(2, 2), n_points=33)
+    sized = runtime.interpolate([a, b], simplex_grid(2, 2), n_points=33).curves
     assert sized.shape == (2, 33, 2)
 
 
 def test_n_way_weights_mix_latent_means(runtime, curves):
     c = list(curves(4, 161, seed=7))
     w = np.array([[0.25, 0.25, 0.25, 0.25], [1.5, -0.5, 0.0, 0.0]])
-    out, frames = runtime.interpolate(c, w, frame="model", spacing="parameter")
-    mean, _ = runtime.encode_model(np.stack(c))
-    np.testing.assert_allclose(out, runtime.decode_model(w @ mean.astype(np.float64)), atol=1e-5)
+    res = runtime.interpolate(c, w, Reading(frame="model", spacing="parameter"))
+    out, frames = res.curves, res.frames
+    mean, _ = runtime.graphs.encode(np.stack(c))
+    np.testing.assert_allclose(out, runtime.graphs.decode_model(w @ mean.astype(np.float64)), atol=1e-5)
     assert frames == [None, None]
 
 
@@ -282,8 +293,9 @@ def test_magnitudes_beyond_float64_results_are_input_errors(runtime, curves, mag
 @pytest.mark.parametrize("magnitude", [1e-290, 1e140])
 def test_extreme_but_representable_magnitudes_work(runtime, curves, magnitude):
     c = curves(1)[0]
-    base, _ = runtime.reconstruct([c])
-    out, mse = runtime.reconstruct([c * magnitude])
+    base = runtime.reconstruct([c]).curves
+    res = runtime.reconstruct([c * magnitude])
+    out, mse = res.curves, res.mse
     np.testing.assert_allclose(out[0], base[0] * magnitude, rtol=1e-5, atol=0)
     assert np.isfinite(mse).all()
 
@@ -296,7 +308,7 @@ def test_cuda_that_falls_back_to_cpu_is_a_startup_error(model_dir, monkeypatch):
     with pytest.raises(ModelLoadError, match="CUDA provider failed to load"):
         CurveRuntime.load(model_dir, providers="cuda", warm_up=False)
     auto = CurveRuntime.load(model_dir, providers="auto", warm_up=False)  # auto accepts the fallback ...
-    assert auto.providers == ["CPUExecutionProvider"]  # ... and reports it
+    assert auto.graphs.providers == ["CPUExecutionProvider"]  # ... and reports it
 
 
 @pytest.mark.parametrize(

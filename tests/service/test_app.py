@@ -7,7 +7,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from curve_vae.geometry import fit_frame, mse_per_curve
-from curve_vae.inference.model_files import ModelLoadError
+from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.reading import Reading
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
 
@@ -30,7 +31,7 @@ def test_encode(client, curves, runtime):
         }
         for x in c
     ]
-    mean, _, _ = runtime.encode(list(c), pose="as_is")
+    mean = runtime.encode(list(c), Reading(pose="as_is")).mean
     np.testing.assert_allclose(body["mean"], mean, rtol=1e-6)
 
 
@@ -47,7 +48,7 @@ def test_decode_in_the_model_plane_and_in_a_frame(client, runtime):
     assert r.status_code == 200
     plane = np.array(r.json()["curves"])
     assert plane.shape == (3, 161, 2)
-    np.testing.assert_allclose(plane, runtime.decode_model(z), rtol=1e-6)
+    np.testing.assert_allclose(plane, runtime.graphs.decode_model(z), rtol=1e-6)
     frames = [{"center": [1.0, -2.0], "size": 0.5}] * 3
     r = client.post("/decode", json={"latents": z.tolist(), "frames": frames, "n_points": 40})
     framed = np.array(r.json()["curves"])
@@ -208,7 +209,7 @@ def test_sample_is_reproducible_with_a_seed(client, runtime):
     c = client.post("/sample", json={"count": 3, "seed": 6, "n_points": 50}).json()
     assert a == b and a["latents"] != c["latents"]
     assert np.shape(a["latents"]) == (3, 32) and np.shape(a["curves"]) == (3, 50, 2)
-    np.testing.assert_allclose(a["curves"], runtime.decode(np.array(a["latents"]), n_points=50), rtol=1e-9)
+    np.testing.assert_allclose(a["curves"], runtime.decode(np.array(a["latents"]), n_points=50).curves, rtol=1e-9)
     cold = client.post("/sample", json={"count": 2, "temperature": 0, "prior": "standard", "valid": False}).json()
     assert np.all(np.array(cold["latents"]) == 0)
     cold = client.post("/sample", json={"count": 4, "temperature": 0, "valid": False}).json()  # the learned prior
@@ -229,20 +230,18 @@ def test_augment(client, curves, runtime, mode, k):
     assert (weights >= 0).all()
     full = np.zeros((6, 4))
     np.put_along_axis(full, sources, weights, axis=1)
-    expected, _ = runtime.interpolate(c, full)
+    expected = runtime.interpolate(c, full).curves
     np.testing.assert_allclose(out["curves"], expected, rtol=1e-9, atol=1e-9)
 
 
 def test_the_shipped_model_is_served_by_default(shipped_runtime, curves):
     """Default settings serve models/; its checksums pass and it keeps the frame behaviour of item 3."""
-    from curve_vae.service.settings import DEFAULT_MODEL_DIR
+    from curve_vae.inference.models import SHIPPED
 
     with TestClient(create_app(Settings(providers="cpu"))) as client:
         info = client.get("/model").json()
-        assert (
-            info["name"] == shipped_runtime.manifest["name"] and info["version"] == shipped_runtime.manifest["version"]
-        )
-        assert Settings().model_dir == DEFAULT_MODEL_DIR
+        assert info["name"] == shipped_runtime.manifest.name and info["version"] == shipped_runtime.manifest.version
+        assert Settings().model_dir == SHIPPED
         c = curves(2, 75, seed=4)
         base = client.post("/reconstruct", json={"curves": c.tolist()}).json()
         moved = client.post("/reconstruct", json={"curves": (c * 0.01 - 7).tolist()}).json()

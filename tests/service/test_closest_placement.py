@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from curve_vae.geometry import closest_squared_distances, evaluate_bspline, pose_frames, resample
+from curve_vae.geometry import evaluate_bspline, ordered_closest_params, pose_frames, resample
 from curve_vae.geometry.adapt import to_model_plane
+from curve_vae.inference.reading import Reading
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
 from tests.helpers import bspline_curves
@@ -26,25 +27,27 @@ def test_the_manifest_says_how_points_are_placed(closest_runtime, runtime):
 def test_each_returned_point_is_on_the_spline_and_no_further_than_the_models_own_point(closest_runtime, runtime):
     curves = _user_curves()
     for pose in ("as_is", "auto"):
-        splines: list = []
-        placed, placed_mse = closest_runtime.reconstruct(curves, pose=pose, splines=splines)
+        res = closest_runtime.reconstruct(curves, Reading(pose=pose))
+        placed, placed_mse, splines = res.curves, res.mse, res.splines
         for c, s in zip(placed, splines):
             np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), c, atol=1e-9 * np.abs(c).max())
             assert s.params[0] == 0.0 and s.params[-1] == 1.0 and np.all(np.diff(s.params) >= 0)
         if pose == "as_is":  # the same latents and splines: only where the points sit differs
-            own, own_mse = runtime.reconstruct(curves, pose=pose)
+            res = runtime.reconstruct(curves, Reading(pose=pose))
+            own_mse = res.mse
             assert np.all(placed_mse <= own_mse * (1 + 1e-9))
             assert np.all(placed_mse < 0.99 * own_mse), (placed_mse, own_mse)  # closer points, not the same ones
 
 
 def test_the_pose_kept_is_the_one_whose_spline_passes_closest(closest_runtime):
     c = _user_curves()[4]
-    prep = closest_runtime.prepare([c], placed=False)
+    prep = closest_runtime.prepare([c], Reading(pose="search", spacing="parameter"))
     costs = []
     for f in pose_frames(c, chords=3):
         m, _ = to_model_plane(c, f, model_size=closest_runtime.model_size, n_points=closest_runtime.n_points)
-        mean, _ = closest_runtime.encode_model(m[None].astype(np.float32))
-        costs.append((closest_squared_distances(m, closest_runtime.decode_model_splines(mean)[0][0]).sum(), f))
+        mean, _ = closest_runtime.graphs.encode(m[None].astype(np.float32))
+        ctrl = closest_runtime.graphs.decode(mean)[1]
+        costs.append((ordered_closest_params(ctrl, [f.to_model(c, closest_runtime.model_size)])[1][0], f))
     best = min(costs, key=lambda cost: cost[0])[1]
     assert prep.frames[0] == best
 
@@ -52,16 +55,18 @@ def test_the_pose_kept_is_the_one_whose_spline_passes_closest(closest_runtime):
 def test_encoding_is_not_changed_by_the_placement(closest_runtime, runtime):
     curves = _user_curves()
     # one reading, one pose (spacing "auto" chooses among readings by each placement's own distance)
-    mean, log_var, _ = closest_runtime.encode(curves, pose="as_is", spacing="parameter")
-    want_mean, want_log_var, _ = runtime.encode(curves, pose="as_is", spacing="parameter")
+    res = closest_runtime.encode(curves, Reading(pose="as_is", spacing="parameter"))
+    mean, log_var = res.mean, res.log_var
+    res = runtime.encode(curves, Reading(pose="as_is", spacing="parameter"))
+    want_mean, want_log_var = res.mean, res.log_var
     np.testing.assert_array_equal(mean, want_mean)
     np.testing.assert_array_equal(log_var, want_log_var)
 
 
 def test_an_interpolation_row_of_one_curve_is_its_reconstruction(closest_runtime):
     a, b = _user_curves()[:2]
-    (ra, rb), _ = closest_runtime.reconstruct([a, b])
-    out, _ = closest_runtime.interpolate([a, b], np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]]))
+    ra, rb = closest_runtime.reconstruct([a, b]).curves
+    out = closest_runtime.interpolate([a, b], np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]])).curves
     np.testing.assert_allclose(out[0], ra, atol=1e-6 * np.abs(ra).max())
     np.testing.assert_allclose(out[-1], rb, atol=1e-6 * np.abs(rb).max())
 
@@ -73,8 +78,8 @@ def test_over_http_the_reconstruction_is_the_runtimes(closest_model_dir, closest
         r = client.post("/reconstruct", json={"curves": [c.tolist()], "output": "both"})
         assert r.status_code == 200, r.text
         body = r.json()
-    splines: list = []
-    (want,), mse = closest_runtime.reconstruct([c], splines=splines)
+    rec = closest_runtime.reconstruct([c])
+    (want,), mse, splines = rec.curves, rec.mse, rec.splines
     np.testing.assert_allclose(np.array(body["curves"][0]), want, atol=1e-6 * np.abs(want).max())
     np.testing.assert_allclose(body["splines"][0]["params"], splines[0].params, atol=1e-12)
     assert body["mse"][0] == mse[0] or abs(body["mse"][0] - mse[0]) <= 1e-9 * mse[0]
@@ -87,24 +92,24 @@ def test_the_shipped_model_is_placed_closest_and_comes_back_closer_so(shipped_ru
     paper = [0.1 * c @ rot + [50.0, 20.0] for c in bspline_curves(8, seed=31)]
     sets = {"parameter": paper, "arc length": [resample(c, 120) for c in paper]}
     for name, curves in sets.items():
-        _, closest = shipped_runtime.reconstruct(curves)
+        closest = shipped_runtime.reconstruct(curves).mse
         shipped_runtime.closest_placement = False
         try:
-            _, own = shipped_runtime.reconstruct(curves)
+            own = shipped_runtime.reconstruct(curves).mse
         finally:
             shipped_runtime.closest_placement = True
         assert closest.mean() < 0.8 * own.mean(), (name, closest.mean(), own.mean())
 
 
 def test_the_server_setting_overrides_the_manifest(model_dir, raw_model_dir, closest_runtime):
-    from curve_vae.inference.model_files import ModelLoadError
+    from curve_vae.inference.manifest import ModelLoadError
     from curve_vae.inference.runtime import CurveRuntime
 
     c = _user_curves()[4]
     with TestClient(create_app(Settings(model_dir=model_dir, placement="closest"))) as client:  # an "index" manifest
         assert client.get("/model").json()["spline"]["placement"] == "closest"
         body = client.post("/reconstruct", json={"curves": [c.tolist()]}).json()
-    (want,), _ = closest_runtime.reconstruct([c])
+    (want,) = closest_runtime.reconstruct([c]).curves
     np.testing.assert_allclose(np.array(body["curves"][0]), want, atol=1e-6 * np.abs(want).max())
     assert not CurveRuntime.load(model_dir, providers="cpu", placement="index").closest_placement
     with pytest.raises(ModelLoadError, match="placement closest needs a model with a B-spline head"):

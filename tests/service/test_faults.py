@@ -77,7 +77,7 @@ def test_a_stream_that_fails_midway_is_visibly_short(model_dir, monkeypatch):
     """The .npy answer carries its Content-Length: a failure after the first chunk ends the connection early, and
     the client sees an incomplete body, never a silently short file."""
     runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
-    real, calls = runtime.augment_batch, []
+    real, calls = runtime.augment, []
 
     def failing(*args, **kwargs):
         calls.append(1)
@@ -85,7 +85,7 @@ def test_a_stream_that_fails_midway_is_visibly_short(model_dir, monkeypatch):
             raise RuntimeError("the decoder broke down")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(runtime, "augment_batch", failing)
+    monkeypatch.setattr(runtime, "augment", failing)
     config = uvicorn.Config(create_app(Settings(model_dir=model_dir), runtime=runtime), port=0, log_level="critical")
     server = uvicorn.Server(config)
     thread = threading.Thread(target=server.run, daemon=True)

@@ -11,6 +11,7 @@ from fastapi.testclient import TestClient
 
 from curve_vae.geometry import evaluate_bspline, resample, self_intersects
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.reading import Reading
 from curve_vae.service.app import create_app
 from curve_vae.service.schemas import MAX_REFINE_STEPS
 from curve_vae.service.settings import Settings
@@ -40,9 +41,10 @@ def test_refining_brings_the_shipped_models_reconstructions_much_closer(shipped_
     paper = _in_a_user_frame(bspline_curves(8, seed=11))
     sets = {"parameter": paper, "arc length, 90 points": [resample(c, 90) for c in paper]}
     for name, curves in sets.items():
-        plain, plain_mse = shipped_runtime.reconstruct(curves)
-        splines: list = []
-        fitted, fitted_mse = shipped_runtime.reconstruct(curves, refine=6, splines=splines)
+        res = shipped_runtime.reconstruct(curves)
+        plain, plain_mse = res.curves, res.mse
+        res = shipped_runtime.reconstruct(curves, Reading(refine=6))
+        fitted, fitted_mse, splines = res.curves, res.mse, res.splines
         assert (fitted_mse <= plain_mse * (1 + 1e-9)).all(), name
         before, after = relative_rmse(curves, plain).mean(), relative_rmse(curves, fitted).mean()
         assert after < before / 2, (name, before, after)
@@ -56,7 +58,7 @@ def test_a_refined_curve_does_not_depend_on_how_its_points_are_spaced(shipped_ru
     curves = _in_a_user_frame(bspline_curves(6, seed=12))
     arc = [resample(c, 161) for c in curves]
     for name, cs in {"parameter": curves, "arc": arc}.items():
-        out, _ = shipped_runtime.reconstruct(cs, refine=10)
+        out = shipped_runtime.reconstruct(cs, Reading(refine=10)).curves
         err = relative_rmse(cs, out).mean()
         assert err < 0.0015, (name, err)
 
@@ -64,17 +66,17 @@ def test_a_refined_curve_does_not_depend_on_how_its_points_are_spaced(shipped_ru
 def test_refining_never_raises_the_error_and_each_step_can_only_lower_it(runtime, params_runtime, curves):
     for rt in (runtime, params_runtime):
         c = list(curves(5, seed=2))
-        _, plain = rt.reconstruct(c)
-        _, one = rt.reconstruct(c, refine=1)
-        _, four = rt.reconstruct(c, refine=4)
+        plain = rt.reconstruct(c).mse
+        one = rt.reconstruct(c, Reading(refine=1)).mse
+        four = rt.reconstruct(c, Reading(refine=4)).mse
         assert (one <= plain * (1 + 1e-9)).all() and (four <= one * (1 + 1e-9)).all()
         assert four.sum() < one.sum()  # the steps themselves fit, not only the matching to closest points
 
 
 def test_refined_points_lie_on_the_returned_spline_with_learned_parameters(params_runtime, curves):
     c = [resample(x, 70) for x in curves(3, seed=4)]
-    splines: list = []
-    out, _ = params_runtime.reconstruct(c, refine=2, splines=splines)
+    rec = params_runtime.reconstruct(c, Reading(refine=2))
+    out, splines = rec.curves, rec.splines
     for o, s in zip(out, splines):
         assert len(o) == 70 and len(s.params) == 70
         np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), o, atol=1e-9)
@@ -82,17 +84,18 @@ def test_refined_points_lie_on_the_returned_spline_with_learned_parameters(param
 
 def test_encode_returns_the_refined_latents_that_reconstruct_decodes(runtime, curves):
     c = list(curves(3, seed=5))
-    plain, _, _ = runtime.encode(c)
-    mean, _, frames = runtime.encode(c, refine=3)
+    plain = runtime.encode(c).mean
+    res = runtime.encode(c, Reading(refine=3))
+    mean, frames = res.mean, res.frames
     assert not np.allclose(mean, plain)
-    decoded = runtime.decode(mean, frames=frames, n_points=50)
-    out, _ = runtime.reconstruct(c, refine=3, n_points=50)
+    decoded = runtime.decode(mean, frames=frames, n_points=50).curves
+    out = runtime.reconstruct(c, Reading(refine=3), n_points=50).curves
     np.testing.assert_allclose(decoded, np.stack(out), atol=1e-9)
 
 
 def test_a_model_without_a_head_cannot_refine_and_says_why(raw_runtime, raw_model_dir, curves):
     with pytest.raises(InputError, match="refine: refining needs a model with a B-spline head"):
-        raw_runtime.reconstruct(list(curves(1)), refine=2)
+        raw_runtime.reconstruct(list(curves(1)), Reading(refine=2))
     with TestClient(create_app(Settings(model_dir=raw_model_dir), runtime=raw_runtime)) as client:
         r = client.post("/reconstruct", json={"curves": [curves(1)[0].tolist()], "refine": 2})
         assert r.status_code == 422 and "B-spline head" in r.json()["detail"]
@@ -134,8 +137,9 @@ def test_evaluate_measures_the_family_suite_refined_too(runtime, curves, tmp_pat
 @pytest.mark.parametrize("magnitude", [1e-290, 1e140])
 def test_refining_works_at_extreme_but_representable_magnitudes(runtime, curves, magnitude):
     c = curves(1, seed=8)[0]
-    base, _ = runtime.reconstruct([c], refine=2)
-    out, mse = runtime.reconstruct([c * magnitude], refine=2)
+    base = runtime.reconstruct([c], Reading(refine=2)).curves
+    res = runtime.reconstruct([c * magnitude], Reading(refine=2))
+    out, mse = res.curves, res.mse
     np.testing.assert_allclose(out[0], base[0] * magnitude, rtol=1e-5, atol=0)
     assert np.isfinite(mse).all()
 
@@ -143,14 +147,14 @@ def test_refining_works_at_extreme_but_representable_magnitudes(runtime, curves,
 @pytest.mark.parametrize("magnitude", [1e-320, 1e200])
 def test_refining_beyond_float64_is_an_input_error(runtime, curves, magnitude):
     with pytest.raises(InputError):
-        runtime.reconstruct([curves(1)[0], curves(1)[0] * magnitude], refine=2)
+        runtime.reconstruct([curves(1)[0], curves(1)[0] * magnitude], Reading(refine=2))
 
 
 @pytest.mark.parametrize("refine", [0, 3])
 def test_a_closed_curve_comes_back_closed(shipped_runtime, refine):
     loop = _naca_loop()
-    splines: list = []
-    out, _ = shipped_runtime.reconstruct([loop, loop[:-5]], refine=refine, splines=splines)
+    rec = shipped_runtime.reconstruct([loop, loop[:-5]], Reading(refine=refine))
+    out, splines = rec.curves, rec.splines
     np.testing.assert_array_equal(out[0][0], out[0][-1])
     np.testing.assert_array_equal(splines[0].control_points[0], splines[0].control_points[-1])
     assert np.abs(out[1][0] - out[1][-1]).max() > 1e-3  # an open curve stays open
@@ -165,7 +169,7 @@ def test_refined_points_never_step_back_along_the_curve_at_a_sharp_corner(shippe
     drawn = draw_family(HELD_OUT["superellipse"], 40, np.random.default_rng(0), model_size=None)
     curves = [drawn[8].astype(np.float64), drawn[34].astype(np.float64)]
     splines: list = []
-    out, _ = shipped_runtime.reconstruct(curves, refine=10, splines=splines)
+    out = shipped_runtime.reconstruct(curves, Reading(refine=10)).curves
     for o, s in zip(out, splines):
         assert (np.diff(s.params) >= 0).all()
         assert not self_intersects(o)
@@ -173,9 +177,9 @@ def test_refined_points_never_step_back_along_the_curve_at_a_sharp_corner(shippe
 
 def test_refined_interpolation_ends_are_the_refined_reconstructions(runtime, curves):
     c = [curves(1, seed=9)[0], resample(curves(1, seed=10)[0], 161)]
-    ends, _ = runtime.interpolate(c, np.array([[1.0, 0.0], [0.0, 1.0], [0.5, 0.5]]), refine=3)
-    fitted, _ = runtime.reconstruct(c, refine=3)
-    plain, _ = runtime.reconstruct(c)
+    ends = runtime.interpolate(c, np.array([[1.0, 0.0], [0.0, 1.0], [0.5, 0.5]]), Reading(refine=3)).curves
+    fitted = runtime.reconstruct(c, Reading(refine=3)).curves
+    plain = runtime.reconstruct(c).curves
     for end, f, p in zip(ends[:2], fitted, plain):
         np.testing.assert_allclose(end, f, rtol=0, atol=1e-9 * np.abs(f).max())
         assert np.abs(f - p).max() > 1e-6  # refined, not the plain reconstruction
@@ -207,8 +211,10 @@ def test_a_request_asking_for_too_much_fitting_work_is_refused_before_any(make_c
 def test_closed_curves_interpolate_into_closed_curves_whose_ends_are_their_reconstructions(shipped_runtime):
     loops = [_naca_loop(0.12), _naca_loop(0.2)]
     for refine in (0, 3):
-        sweep, _ = shipped_runtime.interpolate(loops, np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]]), refine=refine)
-        ends, _ = shipped_runtime.reconstruct(loops, refine=refine)
+        sweep = shipped_runtime.interpolate(
+            loops, np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]]), Reading(refine=refine)
+        ).curves
+        ends = shipped_runtime.reconstruct(loops, Reading(refine=refine)).curves
         for curve in sweep:
             np.testing.assert_array_equal(curve[0], curve[-1])
         np.testing.assert_allclose(sweep[0], ends[0], atol=1e-9)

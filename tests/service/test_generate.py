@@ -63,7 +63,7 @@ def test_augment_weights_lie_in_the_simplex_and_are_reported(client, curves, run
     assert len(set(sources[:, 0].tolist())) > 1  # anchors vary
     full = np.zeros((40, len(seeds)))
     np.put_along_axis(full, sources, weights, axis=1)
-    expected, _ = runtime.interpolate([np.array(c) for c in seeds], full)
+    expected = runtime.interpolate([np.array(c) for c in seeds], full).curves
     np.testing.assert_allclose(out["curves"], expected, rtol=1e-9, atol=1e-9)  # each curve is its reported mix
 
 
@@ -89,7 +89,7 @@ def test_pages_are_the_same_whatever_the_page_size(client, curves, page):
 
 def test_neighbours_restricts_partners_to_the_nearest_in_latent_space(client, curves, runtime):
     seeds = _seeds(curves, 8)
-    mean, _, _ = runtime.encode([np.array(c) for c in seeds])
+    mean = runtime.encode([np.array(c) for c in seeds]).mean
     d = np.linalg.norm(mean[:, None] - mean[None], axis=-1)
     np.fill_diagonal(d, np.inf)
     for mode, k in (("pair", 1), ("triplet", 2), ("triplet", 3)):
@@ -140,8 +140,8 @@ def test_the_stream_holds_one_chunk_at_a_time(make_client, runtime, monkeypatch)
     """Decoding is asked for batch_size rows at a time, never the whole count."""
     client = make_client(max_stream_curves=10_000)
     seen: list[int] = []
-    decode = runtime.decode_model_splines
-    monkeypatch.setattr(runtime, "decode_model_splines", lambda z: seen.append(len(z)) or decode(z))
+    decode = runtime.graphs.decode
+    monkeypatch.setattr(runtime.graphs, "decode", lambda z: seen.append(len(z)) or decode(z))
     r = client.post(
         "/augment",
         # one reading of each seed in one pose: no decoding before the stream's (spacing "auto" decodes to choose)
@@ -155,7 +155,7 @@ def test_the_stream_holds_one_chunk_at_a_time(make_client, runtime, monkeypatch)
         },
     )
     assert r.status_code == 200 and len(r.content) == 128 + 1000 * 7 * 2 * 4
-    assert max(seen) == runtime.batch_size and sum(seen) == 1000
+    assert max(seen) == runtime.graphs.batch_size and sum(seen) == 1000
 
 
 # ----------------------------------------------------------------------------- metrics on request

@@ -72,7 +72,7 @@ def test_not_ready_before_the_model_is_loaded(model_dir):
 def test_metadata_is_the_graphs_own(client, model_dir, runtime, model):
     meta = client.get(f"/v2/models/{model}").json()
     assert meta["name"] == model and meta["platform"] == "onnxruntime_onnx"
-    assert meta["versions"] == [str(runtime.manifest["version"])]
+    assert meta["versions"] == [runtime.manifest.version]
     graph = graph_tensors(model_dir / f"{model}.onnx")
     assert {"inputs": meta["inputs"], "outputs": meta["outputs"]} == graph
     assert all(t["shape"][0] == -1 for t in graph["inputs"] + graph["outputs"])  # the batch axis
@@ -111,14 +111,14 @@ def test_encoder_then_decoder_equals_the_runtime(client, runtime):
     r = client.post("/v2/models/encoder/infer", json={"id": "a-1", "inputs": [tensor("curves", curves)]})
     assert r.status_code == 200, r.text
     body = r.json()
-    assert body["model_name"] == "encoder" and body["model_version"] == str(runtime.manifest["version"])
+    assert body["model_name"] == "encoder" and body["model_version"] == runtime.manifest.version
     assert body["id"] == "a-1"
     assert [(o["name"], o["datatype"], o["shape"]) for o in body["outputs"]] == [
         ("mean", "FP32", [3, runtime.latent_dim]),
         ("log_var", "FP32", [3, runtime.latent_dim]),
     ]
     got = outputs_of(body)
-    mean, log_var = runtime.encode_model(curves)
+    mean, log_var = runtime.graphs.encode(curves)
     np.testing.assert_allclose(got["mean"], mean, atol=1e-5)
     np.testing.assert_allclose(got["log_var"], log_var, atol=1e-5)
 
@@ -126,7 +126,7 @@ def test_encoder_then_decoder_equals_the_runtime(client, runtime):
     assert r.status_code == 200, r.text
     assert "id" not in r.json()
     decoded = outputs_of(r.json())
-    want_curves, want_ctrl, _ = runtime.decode_model_splines(mean)
+    want_curves, want_ctrl, _ = runtime.graphs.decode(mean)
     np.testing.assert_allclose(decoded["curves"], want_curves, atol=1e-5)
     np.testing.assert_allclose(decoded["control_points"], want_ctrl, atol=1e-5)
 
@@ -160,12 +160,12 @@ def test_nested_data_is_the_same_tensor_as_flat(client):
 
 def test_a_batch_is_run_in_parts_of_batch_size(client, runtime):
     curves = bspline_curves(30, seed=2).astype(np.float32)
-    want = runtime.encode_model(curves)[0]
+    want = runtime.graphs.encode(curves)[0]
     r = client.post("/v2/models/encoder/infer", json={"inputs": [tensor("curves", curves)]})
     np.testing.assert_allclose(outputs_of(r.json())["mean"], want, atol=1e-5)
-    sig = oip.signature(runtime.encoder)
+    sig = oip.signature(runtime.graphs.encoder)
     req = oip.parse_request({"inputs": [tensor("curves", curves)]}, "encoder", sig, max_batch=40)
-    parts = oip.infer(runtime.encoder, req, batch_size=7)  # 7 + 7 + 7 + 7 + 2 rows
+    parts = oip.infer(runtime.graphs.encoder, req, batch_size=7)  # 7 + 7 + 7 + 7 + 2 rows
     np.testing.assert_allclose(parts["mean"], want, atol=1e-5)
 
 

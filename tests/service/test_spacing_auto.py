@@ -7,7 +7,9 @@ import numpy as np
 import pytest
 
 from curve_vae.geometry import natural_params, natural_readings, resample
-from curve_vae.inference import runtime as runtime_module
+from curve_vae.inference import reader as reader_module
+from curve_vae.inference.reading import Reading
+from curve_vae.inference.results import Reconstruction
 from curve_vae.service.schemas import ReconstructRequest
 from tests.helpers import bspline_curves
 
@@ -22,20 +24,20 @@ def _rel(curves: list[np.ndarray], out: list[np.ndarray]) -> np.ndarray:
     )
 
 
-def _each_reading(runtime, curves, monkeypatch, **options) -> dict[str, tuple]:
+def _each_reading(runtime, curves, monkeypatch, **options) -> dict[str, Reconstruction]:
     """What /reconstruct gives each reading spacing "auto" tries alone: the points as given, the closest natural
     fit's reading, and the reading of the fit from the arc-length fractions (where it ends elsewhere)."""
-    out = {sp: runtime.reconstruct(curves, spacing=sp, **options) for sp in ("parameter", "natural")}
+    out = {sp: runtime.reconstruct(curves, Reading(spacing=sp, **options)) for sp in ("parameter", "natural")}
     with monkeypatch.context() as m:
-        m.setattr(runtime_module, "natural_params", lambda pts: natural_readings(pts)[-1])
-        out["natural, from arc length"] = runtime.reconstruct(curves, spacing="natural", **options)
+        m.setattr(reader_module, "natural_params", lambda pts: natural_readings(pts)[-1])
+        out["natural, from arc length"] = runtime.reconstruct(curves, Reading(spacing="natural", **options))
     return out
 
 
 def test_auto_keeps_the_closest_reading_and_brings_curves_drawn_by_arc_length_closer(shipped_runtime, monkeypatch):
     curves = _drawn_by_arc_length(10, seed=31)
-    errors = {sp: _rel(curves, out[0]) for sp, out in _each_reading(shipped_runtime, curves, monkeypatch).items()}
-    auto = _rel(curves, shipped_runtime.reconstruct(curves, spacing="auto")[0])
+    errors = {sp: _rel(curves, out.curves) for sp, out in _each_reading(shipped_runtime, curves, monkeypatch).items()}
+    auto = _rel(curves, shipped_runtime.reconstruct(curves, Reading(spacing="search")).curves)
     picked = np.any([np.isclose(auto, e, rtol=1e-9) for e in errors.values()], axis=0)
     assert picked.all(), (auto, errors)  # each curve's answer is one of the readings'
     assert (auto <= np.max(list(errors.values()), axis=0) * (1 + 1e-9)).all()
@@ -46,31 +48,33 @@ def test_auto_answers_a_curve_reversed_or_mirrored_alike(shipped_runtime):
     # (a turned curve's bounding box, and so its scale in the model plane, changes with the angle: within a few
     # percent, with every spacing)
     curves = _drawn_by_arc_length(3, seed=32)
-    want = _rel(curves, shipped_runtime.reconstruct(curves, spacing="auto")[0])
+    want = _rel(curves, shipped_runtime.reconstruct(curves, Reading(spacing="search")).curves)
     for move in (lambda c: c[::-1], lambda c: c * [-1.0, 1.0], lambda c: c[::-1] * [-1.0, 1.0]):
         moved = [move(c) for c in curves]
-        np.testing.assert_allclose(_rel(moved, shipped_runtime.reconstruct(moved, spacing="auto")[0]), want, rtol=1e-9)
+        np.testing.assert_allclose(
+            _rel(moved, shipped_runtime.reconstruct(moved, Reading(spacing="search")).curves), want, rtol=1e-9
+        )
 
 
 def test_without_pose_candidates_the_readings_still_compete(runtime, monkeypatch):
     curves = [c for c in bspline_curves(3, seed=33)] + [resample(c, 90) for c in bspline_curves(2, seed=34)]
-    for frame, pose in (("model", "auto"), ("auto", "as_is")):
-        out, mse = runtime.reconstruct(curves, frame=frame, pose=pose, spacing="auto")
+    for frame, pose in (("model", "search"), ("auto", "as_is")):
+        res = runtime.reconstruct(curves, Reading(frame=frame, pose=pose, spacing="search"))
+        out, mse = res.curves, res.mse
         one = _each_reading(runtime, curves, monkeypatch, frame=frame, pose=pose)
         assert [len(o) for o in out] == [len(c) for c in curves]
-        assert np.any([np.isclose(mse, m) for _, m in one.values()], axis=0).all()
+        assert np.any([np.isclose(mse, rec.mse) for rec in one.values()], axis=0).all()
 
 
 def test_the_natural_reading_puts_the_callers_points_at_their_natural_parameters(runtime):
     c = resample(bspline_curves(1, seed=35)[0], 120)
-    splines: list = []
-    runtime.reconstruct([c], spacing="natural", pose="as_is", splines=splines)
+    splines = runtime.reconstruct([c], Reading(spacing="natural", pose="as_is")).splines
     np.testing.assert_allclose(splines[0].params, natural_params(c), atol=1e-9)  # index placement: at their params
 
 
 def test_http_takes_both_readings_and_names_a_bad_one(client):
     c = resample(bspline_curves(1, seed=36)[0], 100).tolist()
-    for sp in ("natural", "auto"):
+    for sp in ("natural", "search"):
         r = client.post("/reconstruct", json={"curves": [c], "spacing": sp, "n_points": 50})
         assert r.status_code == 200, r.text
         assert np.array(r.json()["curves"][0]).shape == (50, 2)
@@ -82,16 +86,16 @@ def test_http_takes_both_readings_and_names_a_bad_one(client):
 
 def test_a_natural_reading_that_puts_the_points_where_they_are_is_not_tried_again(runtime, monkeypatch):
     """A curve at the paper's own spacing: its closest natural fit gives its points their index fractions
-    (runtime.SAME_READING), so "auto" does not try that reading beside "parameter"; a curve drawn by arc length gets
+    (reader.SAME_READING), so "search" does not try that reading beside "parameter"; a curve drawn by arc length gets
     every natural reading in every pose."""
     even = bspline_curves(1, seed=37)[0]
     drawn = resample(even, len(even))
-    assert np.abs(natural_params(even) - np.linspace(0, 1, len(even))).max() <= runtime_module.SAME_READING
+    assert np.abs(natural_params(even) - np.linspace(0, 1, len(even))).max() <= reader_module.SAME_READING
     rows: list[int] = []
-    encode = runtime.encode_model
-    monkeypatch.setattr(runtime, "encode_model", lambda x: rows.append(len(x)) or encode(x))
-    runtime.reconstruct([even], spacing="auto")
-    runtime.reconstruct([drawn], spacing="auto")
-    poses = 2 * runtime_module.POSE_CHORD_COUNT
+    encode = runtime.graphs.encode
+    monkeypatch.setattr(runtime.graphs, "encode", lambda x: rows.append(len(x)) or encode(x))
+    runtime.reconstruct([even], Reading(spacing="search"))
+    runtime.reconstruct([drawn], Reading(spacing="search"))
+    poses = 2 * reader_module.POSE_CHORD_COUNT
     assert rows[0] == poses * len(natural_readings(even))  # "parameter", and the readings but the closest
     assert rows[1] == poses * (1 + len(natural_readings(drawn)))

@@ -7,6 +7,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from curve_vae.geometry import arc_length_params, clamped_uniform_knots, evaluate_bspline
+from curve_vae.inference.reading import Reading
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
 
@@ -92,23 +93,19 @@ def test_a_learned_head_places_the_points_at_its_own_parameters(params_runtime):
     them; the returned spline at the returned parameters is the returned curve."""
     rt = params_runtime
     z = np.random.default_rng(4).normal(size=(1, 32))
-    _, ctrl, params = rt.decode_model_splines(z)
+    _, ctrl, params = rt.graphs.decode(z)
     assert params.shape == (1, 161) and params[0, 0] == 0 and params[0, -1] == pytest.approx(1)
     assert np.all(np.diff(params[0]) > 0) and np.ptp(np.diff(params[0])) > 1e-4  # uneven: not i/160
     for ask in ({}, {"n_points": 161}):
-        splines: list = []
-        rt.decode(z, splines=splines, **ask)
+        splines = rt.decode(z, **ask).splines
         np.testing.assert_allclose(splines[0].params, params[0], atol=1e-7)
-    splines = []
-    rt.decode(z, n_points=81, splines=splines)
+    splines = rt.decode(z, n_points=81).splines
     np.testing.assert_allclose(splines[0].params, params[0, ::2], atol=1e-7)  # "parameter": the model's spacing
-    splines = []
-    rt.decode(z, n_points=60, spacing="arc_length", splines=splines)  # evenly in length, whatever the head's params
+    splines = rt.decode(z, n_points=60, spacing="arc_length").splines  # evenly in length, whatever the head's params
     np.testing.assert_allclose(splines[0].params, arc_length_params(ctrl[0].astype(np.float64), 60), atol=1e-12)
     t = np.linspace(0, 1, 41) ** 1.3
     drawn = np.stack([10 * t, np.sin(3 * t)], axis=1)
-    splines = []
-    out, _ = rt.reconstruct([drawn], splines=splines, pose="as_is")
-    s = splines[0]
+    rec = rt.reconstruct([drawn], Reading(pose="as_is"))
+    out, s = rec.curves, rec.splines[0]
     assert len(s.params) == 41 and np.all(np.diff(s.params) > 0)
     np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), out[0], atol=1e-9)

@@ -12,7 +12,7 @@ import pytest
 import torch
 
 from curve_vae.cli import main
-from curve_vae.inference.model_files import file_sha256
+from curve_vae.inference.manifest import file_sha256
 from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
 
 pytestmark = pytest.mark.slow
@@ -289,8 +289,8 @@ def test_export_with_spline_head(trained):
 
     runtime = CurveRuntime.load(out, providers="cpu")
     assert runtime.has_splines
-    splines: list = []
-    points = runtime.decode(z, n_points=40, spacing="arc_length", splines=splines)
+    made = runtime.decode(z, n_points=40, spacing="arc_length")
+    points, splines = made.curves, made.splines
     from curve_vae.geometry import evaluate_bspline
 
     for p, s in zip(points, splines):

@@ -3,6 +3,7 @@
 import torch
 from fastapi.testclient import TestClient
 
+from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
@@ -33,11 +34,11 @@ def test_an_exported_head_is_placed_closest_unless_asked_otherwise(tmp_path):
     for placement in ("closest", "index"):
         export(model, tmp_path / placement, model_size=92.6, weights=False, placement=placement)
         runtime = CurveRuntime.load(tmp_path / placement, providers="cpu")
-        assert runtime.manifest["spline"]["placement"] == placement
+        assert runtime.manifest.spline.placement == placement
         assert runtime.closest_placement == (placement == "closest")
-        errors[placement] = runtime.reconstruct(curves, pose="as_is")[1]
+        errors[placement] = runtime.reconstruct(curves, Reading(pose="as_is")).mse
     assert np.all(errors["closest"] <= errors["index"] * (1 + 1e-9)) and np.any(errors["closest"] < errors["index"])
     default = export(model, tmp_path / "default", model_size=92.6, weights=False)
-    assert default["spline"]["placement"] == "closest"
+    assert default.spline.placement == "closest"
     with pytest.raises(ValueError, match="placement must be one of"):
         export(model, tmp_path / "bad", model_size=92.6, weights=False, placement="nearest")

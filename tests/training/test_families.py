@@ -1,6 +1,7 @@
 """The broad training mix and the evaluation suite: spacing, validity, pose, bookkeeping."""
 
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -61,8 +62,8 @@ def test_broad_mix_is_the_same_however_many_processes_draw_it():
 
 def test_suite_bookkeeping_with_a_perfect_reconstructor():
     class Echo:  # returns the input: every error is 0
-        def reconstruct(self, curves, **_):
-            return [np.asarray(c, np.float64) for c in curves], None
+        def reconstruct(self, curves, reading=None):
+            return SimpleNamespace(curves=[np.asarray(c, np.float64) for c in curves])
 
     test = F.draw_family(F.paper, 12, np.random.default_rng(0), model_size=None)
     sets = suite_sets(test, 6)

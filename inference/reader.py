@@ -1,0 +1,197 @@
+"""Reading caller curves into the model: their frames and poses, their points at the model's count, the encoder, and
+— for a model placed "closest" — the decoded spline and where each caller point sits on it.
+
+    caller's curve (n, 2) --frame + pose (geometry.frame)--> --spacing (geometry.adapt)--> (161, 2) model plane
+        --encoder--> latent --decoder--> spline --geometry.ordered_closest_params--> each caller point's parameter
+
+A model trained in geometry.canonical_frame's pose reads each curve once: the canonical pose, the points as given.
+The search (pose or spacing "search") makes several candidates per curve — six poses, the points as given and their
+natural readings — encodes and decodes them all, and keeps each curve's closest reconstruction. Curves read before
+with the same reading come from the encoding cache. `refine` fits each latent closer afterwards (inference.fitting).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from curve_vae.geometry import (
+    BeyondFloat32,
+    Frame,
+    canonical_frame,
+    fit_frame,
+    natural_params,
+    natural_readings,
+    ordered_closest_params,
+    pose_frames,
+    to_model_plane,
+)
+from curve_vae.inference.cache import EncodingCache
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.fitting import Fitter
+from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.prepared import Prepared, ReadCurve
+from curve_vae.inference.reading import Reading
+
+#: A natural reading whose parameters are all within this of the points' index fractions reads the curve as given:
+#: spacing "search" does not try it beside "parameter".
+SAME_READING = 1e-4
+#: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
+POSE_CHORD_COUNT = 3
+ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
+
+Candidate = tuple[int, Frame | None, str, np.ndarray | None]  # (curve, frame, spacing, natural parameters)
+
+
+class Reader:
+    """Brings caller curves to a model's graphs and through them (see the module docstring)."""
+
+    def __init__(
+        self, graphs: ModelGraphs, *, closest: bool, fitter: Fitter | None = None, cache: EncodingCache | None = None
+    ) -> None:
+        self.graphs = graphs
+        self.closest = closest  # each caller point placed at its closest point on the decoded spline
+        self.fitter = fitter
+        self.cache = cache
+
+    def read(self, curves: Sequence[np.ndarray], reading: Reading, *, decoded: bool = True) -> Prepared:
+        """Each curve read as `reading` (resolved: no "auto") says. decoded: also decode each latent and, for a model
+        placed closest, place the caller's points on the spline (an encoding alone needs neither)."""
+        inputs = [np.asarray(c, np.float64) for c in curves]
+        key = f"{reading.key}/{'closest' if self.closest else 'index'}"
+        keys = [EncodingCache.key(c, key) for c in inputs] if self.cache is not None else []
+        rows: list[ReadCurve | None] = (
+            [self.cache.get(k) for k in keys] if self.cache is not None else [None] * len(inputs)
+        )
+        todo = [i for i, r in enumerate(rows) if r is None]
+        for i, row in zip(todo, self._fresh([inputs[i] for i in todo], todo, reading)):
+            rows[i] = row
+        if reading.refine > 0 and todo:  # cached rows were cached refined: the reading's key counts the steps
+            if self.fitter is None or not self.graphs.has_splines:
+                raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
+            for i, row in zip(
+                todo, self.fitter.refine([inputs[i] for i in todo], [rows[i] for i in todo], reading.refine)
+            ):
+                rows[i] = row
+        if decoded or self.closest:
+            missing = [i for i, r in enumerate(rows) if r is not None and not r.decoded_yet]
+            for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [rows[i] for i in missing])[0]):
+                rows[i] = row
+        if self.cache is not None:
+            for k, row in zip(keys, rows):
+                self.cache.put(k, row)  # type: ignore[arg-type]
+        return Prepared(inputs, rows)  # type: ignore[arg-type]
+
+    # ----------------------------------------------------------------------------------- candidates
+
+    def _fresh(self, inputs: list[np.ndarray], index: list[int], reading: Reading) -> list[ReadCurve]:
+        """Curves not in the cache: their candidates, encoded; with several per curve, decoded and the closest kept."""
+        stage = self._candidates(inputs, index, reading)
+        models, fractions = self._model_points(inputs, index, stage)
+        if not stage:
+            return []
+        with np.errstate(all="ignore"):
+            mean, log_var = self.graphs.encode(models)
+        _check_finite(mean, log_var, [index[c[0]] for c in stage])
+        if len(stage) == len(inputs):  # one candidate each: nothing to choose
+            return [
+                ReadCurve(f, m, fr, mu, lv)
+                for (_, f, _, _), m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)
+            ]
+        rows = [
+            ReadCurve(f, m, fr, mu, lv) for (_, f, _, _), m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)
+        ]
+        owners = [c[0] for c in stage]
+        rows, err = self._decoded([inputs[o] for o in owners], rows)
+        owner = np.asarray(owners)
+        best = [int(np.flatnonzero(owner == i)[err[owner == i].argmin()]) for i in range(len(inputs))]
+        return [rows[b] for b in best]
+
+    def _candidates(self, inputs: list[np.ndarray], index: list[int], reading: Reading) -> list[Candidate]:
+        """Every curve in every pose, read as the reading says; spacing "search": its points as given and each of
+        its natural readings that does not put them where they are (a curve at the paper's own spacing is read so)."""
+        stage: list[Candidate] = []
+        with np.errstate(all="ignore"):
+            for c, (i, pts) in enumerate(zip(index, inputs)):
+                try:
+                    if reading.frame == "model":
+                        frames: list[Frame | None] = [None]
+                    elif reading.pose == "canonical":
+                        frames = [canonical_frame(pts)]
+                    elif reading.pose == "search":
+                        frames = list(pose_frames(pts, chords=POSE_CHORD_COUNT))
+                    else:
+                        frames = [fit_frame(pts)]
+                    if reading.spacing == "search":
+                        spaced = [("parameter", None)] + [
+                            ("natural", n)
+                            for n in natural_readings(pts)
+                            if np.abs(n - np.linspace(0.0, 1.0, len(n))).max() > SAME_READING
+                        ]
+                    elif reading.spacing == "natural":
+                        spaced = [("natural", natural_params(pts))]  # it does not depend on the pose: fitted once
+                    else:
+                        spaced = [(reading.spacing, None)]
+                except ValueError as e:  # all points coincide
+                    raise InputError(("curves", i), str(e)) from e
+                stage += [(c, f, s, n) for f in frames for s, n in spaced]
+        return stage
+
+    def _model_points(
+        self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
+    ) -> tuple[np.ndarray, list[np.ndarray | None]]:
+        """Each candidate's model-plane points (k, n_points, 2) float32 and where its curve's points sit along them."""
+        g = self.graphs
+        rows, fractions = [], []
+        with np.errstate(all="ignore"):
+            for c, f, spacing, natural in stage:
+                try:
+                    m, fraction = to_model_plane(
+                        inputs[c], f, model_size=g.model_size, n_points=g.n_points, spacing=spacing, natural=natural
+                    )
+                except BeyondFloat32:
+                    raise InputError(
+                        ("curves", index[c]),
+                        "its extent is too small or too large to map to the model's frame"
+                        if f is not None
+                        else 'coordinates beyond float32 range; use frame "auto"',
+                    ) from None
+                rows.append(m)
+                fractions.append(fraction)
+        batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, g.n_points, 2), np.float32)
+        return batch, fractions
+
+    # ----------------------------------------------------------------------------------- decoding, placement
+
+    def _decoded(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], np.ndarray]:
+        """Rows with their latents decoded and, placed closest, each caller point's parameter on the spline; and each
+        row's squared distance from its model-plane points (by which the search keeps the closest candidate)."""
+        if not rows:
+            return [], np.zeros(0)
+        g = self.graphs
+        with np.errstate(all="ignore"):
+            decoded, ctrl, params = g.decode(np.stack([r.mean for r in rows]))
+            feet: list[np.ndarray | None] = [None] * len(rows)
+            if self.closest and ctrl is not None:
+                targets = [
+                    r.frame.to_model(p, g.model_size) if r.frame is not None else p for r, p in zip(rows, inputs)
+                ]
+                placed, err = ordered_closest_params(ctrl, targets, degree=g.spline_degree)
+                feet = list(placed)
+            else:
+                model = np.stack([r.model for r in rows]).astype(np.float64)
+                err = ((decoded.astype(np.float64) - model) ** 2).sum(axis=(1, 2))
+        out = [
+            r.with_decoding(
+                decoded[i], None if ctrl is None else ctrl[i], None if params is None else params[i], feet[i]
+            )
+            for i, r in enumerate(rows)
+        ]
+        return out, np.where(np.isfinite(err), err, np.inf)
+
+
+def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:
+    bad = ~(np.isfinite(mean).all(axis=1) & np.isfinite(log_var).all(axis=1))
+    if bad.any():
+        raise InputError(("curves", owners[int(np.argmax(bad))]), ENCODE_OVERFLOW)

@@ -1,0 +1,91 @@
+"""What the runtime returns: one result object per call, its parts named (curves, latents, frames, splines, errors),
+as scipy.optimize returns an OptimizeResult. Arrays are numpy; curves are in the caller's frame unless the call was
+in the model's plane (frames None)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from curve_vae.geometry import Frame
+
+
+@dataclass(frozen=True)
+class Spline:
+    """A returned curve as a clamped cubic B-spline in the caller's frame: the curve's points are the spline at
+    `params` exactly (the model's B-spline head; a similarity keeps B-splines)."""
+
+    control_points: np.ndarray  # (n_ctrl, 2)
+    knots: np.ndarray  # (n_ctrl + degree + 1,)
+    degree: int
+    params: np.ndarray  # (n,) parameter of each returned point, in [0, 1]
+
+    def json(self) -> dict[str, Any]:
+        return {
+            "control_points": self.control_points.tolist(),
+            "knots": self.knots.tolist(),
+            "degree": self.degree,
+            "params": self.params.tolist(),
+        }
+
+
+@dataclass(frozen=True)
+class Encoding:
+    """Latent means and log-variances (B, latent_dim) of the curves, and the frame (with its pose) each was mapped
+    from (None for frame "model"); with refine, the means are the fitted latents."""
+
+    mean: np.ndarray
+    log_var: np.ndarray
+    frames: list[Frame | None]
+
+
+@dataclass(frozen=True)
+class Curves:
+    """Decoded curves (B, n, 2), the frame each is in (None: the model's plane) and, from a model with a B-spline
+    head, each as a spline (None without one)."""
+
+    curves: np.ndarray
+    frames: list[Frame | None]
+    splines: list[Spline] | None = None
+
+
+@dataclass(frozen=True)
+class Reconstruction:
+    """Each curve encoded and decoded, at its own points (curves of different lengths: a list), with its error
+    (paper eq. 4 at the input's points, in the caller's frame) and the latent it was decoded from."""
+
+    curves: list[np.ndarray]
+    mse: np.ndarray  # (B,)
+    latents: np.ndarray  # (B, latent_dim)
+    frames: list[Frame | None]
+    splines: list[Spline] | None = None
+
+
+@dataclass(frozen=True)
+class Interpolation(Curves):
+    """Curves decoded from affine mixes of the inputs' latents (paper eqs. 9, 10), one per weight row."""
+
+    weights: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # (rows, inputs)
+
+
+@dataclass(frozen=True)
+class Sampled(Curves):
+    """New curves from a latent distribution: the latents drawn and the bookkeeping of rejection."""
+
+    latents: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    prior: str = "learned"
+    seed: int = 0
+    rejected: int = 0  # draws rejected (self-intersecting or outside the reference region) and drawn again
+    invalid: int = 0  # curves still not valid after the last draw (0 unless the distribution is far off)
+
+
+@dataclass(frozen=True)
+class Augmented(Curves):
+    """Items start … stop-1 of a seeded augmentation sequence: each a mix of its sources (anchor first)."""
+
+    sources: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), np.int64))  # (m, k)
+    weights: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # (m, k)
+    seed: int = 0
+    offset: int = 0
