@@ -16,7 +16,7 @@ import numpy as np
 
 def read_curves(path: str) -> list[np.ndarray]:
     """Curves from a .npy array (n, 2) or (N, n, 2), an airfoil .dat file, CSV (x,y rows; a blank line between
-    curves), or JSON: [[x, y], …], [curve, …] or {"curves": […]}.
+    curves), or JSON: [[x, y], …], [curve, …], {"curves": […]} or {"curve": […]} (a /revolve body).
 
     "-" reads JSON from standard input.
     """
@@ -31,9 +31,12 @@ def read_curves(path: str) -> list[np.ndarray]:
         text = sys.stdin.read() if path == "-" else Path(path).read_text()
         data = json.loads(text)
         if isinstance(data, dict):
-            if "curves" not in data:
-                raise ValueError(f"{path}: a JSON object needs a 'curves' field")
-            data = data["curves"]
+            if "curves" in data:
+                data = data["curves"]
+            elif "curve" in data:
+                data = [data["curve"]]
+            else:
+                raise ValueError(f"{path}: a JSON object needs a 'curves' field (or 'curve', as /revolve takes it)")
         if data and isinstance(data[0], list | tuple) and data[0] and not isinstance(data[0][0], list | tuple):
             data = [data]  # a single curve
     curves = [np.asarray(c, dtype=np.float64) for c in data]

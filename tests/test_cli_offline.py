@@ -97,3 +97,25 @@ def test_airfoil_dat_files_selig_and_lednicer(tmp_path, capsys):
         read_curves(str(bad))
     assert main(["fit", str(bad)]) == 2
     assert "bad.dat:3" in capsys.readouterr().err
+
+
+def test_revolve_takes_the_body_the_endpoint_takes(tmp_path):
+    """`curve-vae revolve` reads the JSON POST /revolve takes: {"curve": […], …}."""
+    body = tmp_path / "revolve.json"
+    body.write_text(json.dumps({"curve": [[0, 0], [2, 0], [3, 1], [2, 3]], "segments": 10}))
+    out = tmp_path / "vase.obj"
+    assert main(["revolve", str(body), "-o", str(out), "--segments", "10", "--axis-position", "0"]) == 0
+    assert sum(line.startswith("v ") for line in out.read_text().splitlines()) == 1 + 3 * 10
+
+
+def test_the_papers_model_is_reachable_by_name_from_anywhere(tmp_path, monkeypatch):
+    """`--model paper` names the model shipped inside the package, whatever the working directory."""
+    from curve_vae.inference.models import NAMED, model_directory
+    from curve_vae.service.settings import Settings
+
+    monkeypatch.chdir(tmp_path)
+    assert model_directory("paper") == NAMED["paper"] and (NAMED["paper"] / "manifest.json").is_file()
+    assert Settings(model_dir="paper").model_dir == NAMED["paper"]
+    out = tmp_path / "s.json"
+    assert main(["sample", "--model", "paper", "--count", "2", "--seed", "1", "-o", str(out)]) == 0
+    assert len(json.loads(out.read_text())["curves"]) == 2

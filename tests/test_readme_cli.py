@@ -29,7 +29,8 @@ ORDER = ["dataset", "train", "average", "export", "evaluate", "sample", "augment
 
 def readme_commands() -> list[list[str]]:
     """The `.venv/bin/curve-vae …` lines of the README's bash blocks (comments dropped; `serve` runs elsewhere)."""
-    blocks = re.findall(r"```bash\n(.*?)```", (ROOT / "README.md").read_text(), flags=re.S)
+    text = "\n".join((ROOT / page).read_text() for page in ("README.md", "docs/TRAINING.md", "docs/API.md"))
+    blocks = re.findall(r"```bash\n(.*?)```", text, flags=re.S)
     commands = []
     for block in blocks:
         for line in block.splitlines():

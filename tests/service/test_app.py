@@ -248,3 +248,19 @@ def test_the_shipped_model_is_served_by_default(shipped_runtime, curves):
         np.testing.assert_allclose(
             np.array(moved["curves"]), np.array(base["curves"]) * 0.01 - 7, atol=1e-6 * 128 * 0.01
         )
+
+
+def test_model_lists_only_the_files_the_directory_holds(model_dir, tmp_path):
+    """An installed package ships no vae.pt (serving never reads it): GET /model lists what is there to read."""
+    import json
+    import shutil
+
+    copy = tmp_path / "model"
+    shutil.copytree(model_dir, copy)
+    manifest = json.loads((copy / "manifest.json").read_text())
+    manifest["files"]["vae.pt"] = {"sha256": "0" * 64, "bytes": 123}  # listed at export, left out of the wheel
+    (copy / "manifest.json").write_text(json.dumps(manifest))
+    with TestClient(create_app(Settings(model_dir=copy, providers="cpu"))) as client:
+        info = client.get("/model").json()
+    assert set(info["files"]) == {"encoder.onnx", "decoder.onnx", "prior.npz"}
+    assert info["reading"] == {"pose": "search", "spacing": "search"}  # exported before readings were recorded

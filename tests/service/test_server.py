@@ -51,8 +51,12 @@ def test_concurrent_requests(live_server, curves):
         assert all(f.result().status_code == 200 for f in futures)
 
 
+#: The pages whose curl examples must work as pasted.
+DOCUMENTED = ("README.md", "docs/API.md")
+
+
 def _curl_blocks() -> list[str]:
-    text = (ROOT / "README.md").read_text()
+    text = "\n".join((ROOT / page).read_text() for page in DOCUMENTED)
     return re.findall(r"```sh\n(.*?)```", text, flags=re.S)
 
 
