@@ -30,7 +30,7 @@ def ordered_closest_params(
     *,
     degree: int = 3,
     dense: int = DENSE,
-    newton: int = 2,
+    newton: int = 3,
 ) -> tuple[list[np.ndarray], np.ndarray]:
     """For each clamped uniform B-spline (B, n_ctrl, 2) and its curve's points (n_i, 2): the parameter in [0, 1] of
     each point's match, non-decreasing, the first point at 0 and the last at 1 (the ends are the ends); and (B,)

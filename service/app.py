@@ -45,7 +45,8 @@ from curve_vae.service.errors import on_http_error, on_input_error, on_validatio
 from curve_vae.service.limits import state_bounds
 from curve_vae.service.metrics import Metrics, MetricsMiddleware
 from curve_vae.service.middleware import BodyLimitMiddleware
-from curve_vae.service.oip import DEFAULT_SIGNATURES, describe, signatures
+from curve_vae.service.oip import DEFAULT_SIGNATURES, signatures
+from curve_vae.service.oip_docs import describe
 from curve_vae.service.routes.curves import curves_router
 from curve_vae.service.routes.design import design_router
 from curve_vae.service.routes.generate import generate_router

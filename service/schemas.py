@@ -132,11 +132,6 @@ OutputMode = Annotated[
     ),
 ]
 
-# A quarter-ellipse-like arc; any frame, any length ≥ 4: the examples work as pasted.
-EXAMPLE_CURVE = [[0.0, 0.0], [1.0, 2.0], [2.5, 3.2], [4.0, 3.5], [5.5, 3.0], [7.0, 1.5], [8.0, 0.0]]
-EXAMPLE_CURVE_2 = [[0.0, 0.0], [1.5, 0.5], [3.0, 2.0], [4.0, 4.0], [5.0, 6.5], [6.5, 8.0], [8.0, 8.5]]
-EXAMPLE_CURVE_3 = [[0.0, 4.0], [2.0, 5.0], [4.0, 4.0], [6.0, 2.0], [8.0, 1.0], [10.0, 2.0], [12.0, 4.0]]
-
 
 #: 2^53 - 1: the largest integer every JSON parser (JavaScript's included) holds exactly; seeds and offsets stay below.
 MAX_SAFE_INTEGER = 2**53 - 1

@@ -3,9 +3,6 @@ docker/Dockerfile.cuda, docker/compose.yaml and deploy/k8s/*.yaml against the ap
 multi-stage builds, a non-root user, health checks and probes on routes the app has, ports, the files an image
 copies, the entry point, and settings that are Settings fields; and the commands docs/DEPLOYMENT.md shows.
 hadolint and kubernetes-validate (the `test` extra) lint them too where they are installed.
-
-Length (~440 lines): the parsers of Dockerfiles, compose and manifests that every check here shares, then one test
-per promise the deployment docs make.
 """
 
 from __future__ import annotations

@@ -16,15 +16,20 @@ no pickled code runs on load. Writes are atomic: a crash never leaves half a fil
 
 from __future__ import annotations
 
+import json
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+import numpy as np
 import torch
 
 from curve_vae.files import atomic_path
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.model import VAE
+
+if TYPE_CHECKING:
+    from curve_vae.training.data import DataConfig
 
 CHECKPOINT_VERSION = 1
 WEIGHTS_FORMAT = "curve-vae weights"
@@ -112,3 +117,31 @@ def save_weights(model: VAE, path: str | Path) -> None:
 def without_resume_state(ckpt: dict[str, Any]) -> dict[str, Any]:
     """A training checkpoint less its optimiser, schedule and RNG state: a snapshot (a third of the size)."""
     return {k: v for k, v in ckpt.items() if k not in RESUME_ONLY}
+
+
+def keep_snapshot(run_dir: Path, ckpt: dict[str, Any], epoch: int, keep: int) -> None:
+    """Save this epoch's weights (no optimiser state) and drop snapshots older than the latest `keep`."""
+    atomic_save(without_resume_state(ckpt), run_dir / f"epoch-{epoch:04d}.pt")
+    for old in sorted(run_dir.glob("epoch-[0-9][0-9][0-9][0-9].pt"))[:-keep]:
+        old.unlink()
+
+
+def rng_state(gen: np.random.Generator) -> dict[str, Any]:
+    return {"torch": torch.get_rng_state(), "numpy": json.dumps(gen.bit_generator.state)}
+
+
+def check_resumed_data(last: Path, data_cfg: DataConfig, resume: bool) -> None:
+    """On resume, refuse to go on from `last` on other data than it was trained on (another mix version, size or
+    seed), before any data is drawn."""
+    if not resume or not last.exists():
+        return
+    stored = dict(load_checkpoint(last).get("data_config") or {})
+    stored.setdefault("mix_version", 1 if stored.get("mix") == "broad" else 0)  # written before mix versions
+    asked = asdict(data_cfg)
+    differ = {k: (stored[k], v) for k, v in asked.items() if k in stored and stored[k] != v}
+    if differ:
+        said = ", ".join(f"{k} {old!r} (run) vs {new!r} (asked)" for k, (old, new) in differ.items())
+        raise ValueError(
+            f"{last} was trained on other data: {said}; resume it with the same data options "
+            "(e.g. --mix-version, --n-train, --data-seed), or start a new run directory (--init-from for its weights)"
+        )

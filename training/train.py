@@ -5,17 +5,14 @@ twin: (N, 2, n_points, 2)): the model owns the architecture, `losses` owns the o
 picks. Run under `torchrun --nproc-per-node K` for data-parallel training (gloo on CPU, nccl on GPU); a single
 process needs no launcher. Checkpoint files are training/checkpoint.py's.
 
-Length (~550 lines): the step (and its four objectives), the schedules, the clock of a time budget and the
-run's named steps share RunState, _Parts (model, optimiser, schedule, clock, generator) and the DDP process;
-`train()` itself (~60 lines) reads top to bottom: set-up, then each epoch's pass, validation, record and stop
-rules.
+The schedules and the clock of a time budget are training.schedule's, the process (device, DDP rank) is
+training.process'; `train()` reads top to bottom: set-up, then each epoch's pass, validation, record and stop rules.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import os
 import random
 import time
 from contextlib import nullcontext
@@ -32,18 +29,22 @@ from tqdm import tqdm
 from curve_vae.training.checkpoint import (
     CHECKPOINT_VERSION,
     atomic_save,
+    check_resumed_data,
+    keep_snapshot,
     load_checkpoint,
     load_weights,
+    rng_state,
     widen,
-    without_resume_state,
 )
 from curve_vae.training.config import SCHEDULES, TWIN_MATCHES, ModelConfig, TrainConfig
 from curve_vae.training.data import DataConfig, load_or_generate
 from curve_vae.training.losses import closest_loss, mixed_loss, vae_loss
 from curve_vae.training.model import SAMPLES_PER_INTERVAL, VAE
+from curve_vae.training.process import Process, agree, autocast, start_process, wrap
+from curve_vae.training.schedule import Clock, make_schedule, schedule_factor
 from curve_vae.training.validation import validation_measure
 
-__all__ = ["SCHEDULES", "TrainConfig", "train", "train_one_epoch"]
+__all__ = ["SCHEDULES", "TrainConfig", "schedule_factor", "train", "train_one_epoch"]
 
 
 @dataclass
@@ -55,55 +56,6 @@ class RunState:
     best_epoch: int = -1
     trained_seconds: float = 0.0  # time spent in training steps, across resumes
     history: list[dict[str, float]] = field(default_factory=list)
-
-
-def pick_device(name: str) -> torch.device:
-    if name == "auto":
-        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
-    if name == "cuda" and not torch.cuda.is_available():
-        raise RuntimeError("--device cuda asked for, but torch sees no CUDA device")
-    return torch.device(name)
-
-
-def autocast(device: torch.device, bf16: bool):
-    return torch.autocast(device.type, dtype=torch.bfloat16) if bf16 else nullcontext()
-
-
-class Clock:
-    """Training time spent so far (across resumes) and the fraction of a time budget it is."""
-
-    def __init__(self, budget: float, spent: float) -> None:
-        self.budget, self.spent, self._since = budget, spent, 0.0
-
-    def __enter__(self) -> Clock:
-        self._since = time.perf_counter()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.spent = self.elapsed()
-        self._since = 0.0
-
-    def elapsed(self) -> float:
-        return self.spent + (time.perf_counter() - self._since if self._since else 0.0)
-
-    def progress(self) -> float:
-        return min(1.0, self.elapsed() / self.budget) if self.budget > 0 else 0.0
-
-    def over(self) -> bool:
-        return self.budget > 0 and self.elapsed() >= self.budget
-
-
-def schedule_factor(schedule: str, progress: float, warmup: float) -> float:
-    """Learning-rate multiplier at a fraction of the run, the shape of torch's OneCycleLR/cosine."""
-    if schedule == "onecycle":
-        start, end = 1 / 25, 1 / 25 / 1e3
-        if progress < warmup:
-            return start + (1 - start) * (1 - math.cos(math.pi * progress / warmup)) / 2
-        q = (progress - warmup) / max(1e-12, 1 - warmup)
-        return end + (1 - end) * (1 + math.cos(math.pi * q)) / 2
-    if schedule == "cosine":
-        return 1e-3 + (1 - 1e-3) * (1 + math.cos(math.pi * progress)) / 2
-    return 1.0
 
 
 def train_one_epoch(
@@ -130,7 +82,7 @@ def train_one_epoch(
     n_batches = 0
     per_step = cfg.batch_size // max(1, dist.get_world_size() if dist.is_initialized() else 1)
     for i in range(0, len(order) - per_step + 1, per_step):  # drop the ragged last batch
-        if clock is not None and clock.budget > 0 and _agree(clock.over()):
+        if clock is not None and clock.budget > 0 and agree(clock.over()):
             break
         x = data[order[i : i + per_step]].to(device, non_blocking=True)
         terms = _batch_terms(model, x, cfg, device)
@@ -169,85 +121,8 @@ def _batch_terms(model: nn.Module, x: torch.Tensor, cfg: TrainConfig, device: to
     return vae_loss(x, pred, mean, log_var, beta=cfg.beta, lap_weight=cfg.lap_weight)
 
 
-def _agree(flag: bool) -> bool:
-    """Rank 0's flag on every process (a no-op without DDP)."""
-    if not dist.is_initialized():
-        return flag
-    t = torch.tensor([int(flag)])
-    dist.broadcast(t, 0)
-    return bool(t.item())
-
-
-def _make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch: int, clock: Clock):
-    if cfg.time_budget > 0:  # the schedule's clock is training time, whatever the throughput
-        for g in opt.param_groups:
-            g["initial_lr"] = cfg.lr
-        return torch.optim.lr_scheduler.LambdaLR(
-            opt, lambda _step: schedule_factor(cfg.schedule, clock.progress(), cfg.warmup)
-        )
-    total = cfg.epochs * steps_per_epoch
-    if cfg.schedule == "onecycle":
-        return torch.optim.lr_scheduler.OneCycleLR(
-            opt,
-            max_lr=cfg.lr,
-            total_steps=total,
-            pct_start=cfg.warmup,
-            div_factor=25.0,
-            final_div_factor=1e3,
-        )
-    if cfg.schedule == "cosine":
-        return torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=total, eta_min=cfg.lr * 1e-3)
-    if cfg.schedule == "plateau":
-        return torch.optim.lr_scheduler.ReduceLROnPlateau(opt, factor=0.5, patience=5)
-    return None
-
-
-def _keep_snapshot(run_dir: Path, ckpt: dict[str, Any], epoch: int, keep: int) -> None:
-    """Save this epoch's weights (no optimiser state) and drop snapshots older than the latest `keep`."""
-    atomic_save(without_resume_state(ckpt), run_dir / f"epoch-{epoch:04d}.pt")
-    for old in sorted(run_dir.glob("epoch-[0-9][0-9][0-9][0-9].pt"))[:-keep]:
-        old.unlink()
-
-
-def _rng_state(gen: np.random.Generator) -> dict[str, Any]:
-    return {"torch": torch.get_rng_state(), "numpy": json.dumps(gen.bit_generator.state)}
-
-
-@dataclass
-class _Process:
-    """Where this process trains: its device, and its place among the DDP processes (rank 0 alone writes)."""
-
-    device: torch.device
-    rank: int = 0
-    world: int = 1
-
-    @property
-    def distributed(self) -> bool:
-        return self.world > 1
-
-    def say(self, message: str) -> None:
-        if self.rank == 0:
-            print(message, flush=True)
-
-
-def _start_process(cfg: TrainConfig) -> _Process:
-    device = pick_device(cfg.device)
-    if int(os.environ.get("WORLD_SIZE", "1")) > 1:
-        if device.type == "cuda":
-            device = torch.device("cuda", int(os.environ.get("LOCAL_RANK", "0")))
-            torch.cuda.set_device(device)
-        dist.init_process_group("nccl" if device.type == "cuda" else "gloo")
-    if cfg.threads > 0:
-        torch.set_num_threads(cfg.threads)
-    if device.type == "cuda":
-        torch.backends.cudnn.benchmark = True  # every batch has the same shape: pick the fastest kernels once
-    if dist.is_initialized():
-        return _Process(device, dist.get_rank(), dist.get_world_size())
-    return _Process(device)
-
-
 def _load_splits(
-    proc: _Process, data_cfg: DataConfig, cfg: TrainConfig, cache: str | Path | None, workers: int
+    proc: Process, data_cfg: DataConfig, cfg: TrainConfig, cache: str | Path | None, workers: int
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Training and validation curves as tensors; rank 0 generates or loads (and writes the cache) first."""
     ds = load_or_generate(data_cfg, cache, workers=workers) if proc.rank == 0 else None
@@ -276,7 +151,7 @@ class _Parts:
     gen: np.random.Generator
 
 
-def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_per_epoch: int) -> _Parts:
+def _new_parts(proc: Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_per_epoch: int) -> _Parts:
     model = VAE(model_cfg).to(proc.device)
     trained = (
         model.learn_only_params()
@@ -287,28 +162,11 @@ def _new_parts(proc: _Process, model_cfg: ModelConfig, cfg: TrainConfig, steps_p
     )
     opt = torch.optim.Adam(trained, lr=cfg.lr)
     clock = Clock(cfg.time_budget, 0.0)
-    return _Parts(model, opt, _make_schedule(opt, cfg, steps_per_epoch, clock), clock, np.random.default_rng(cfg.seed))
-
-
-def _check_resumed_data(last: Path, data_cfg: DataConfig, resume: bool) -> None:
-    """On resume, refuse to go on from `last` on other data than it was trained on (another mix version, size or
-    seed), before any data is drawn."""
-    if not resume or not last.exists():
-        return
-    stored = dict(load_checkpoint(last).get("data_config") or {})
-    stored.setdefault("mix_version", 1 if stored.get("mix") == "broad" else 0)  # written before mix versions
-    asked = asdict(data_cfg)
-    differ = {k: (stored[k], v) for k, v in asked.items() if k in stored and stored[k] != v}
-    if differ:
-        said = ", ".join(f"{k} {old!r} (run) vs {new!r} (asked)" for k, (old, new) in differ.items())
-        raise ValueError(
-            f"{last} was trained on other data: {said}; resume it with the same data options "
-            "(e.g. --mix-version, --n-train, --data-seed), or start a new run directory (--init-from for its weights)"
-        )
+    return _Parts(model, opt, make_schedule(opt, cfg, steps_per_epoch, clock), clock, np.random.default_rng(cfg.seed))
 
 
 def _restore(
-    proc: _Process, last: Path, parts: _Parts, cfg: TrainConfig, *, resume: bool, init_from: str | Path | None
+    proc: Process, last: Path, parts: _Parts, cfg: TrainConfig, *, resume: bool, init_from: str | Path | None
 ) -> RunState:
     """Resume from `last` (weights, optimiser, schedule, RNG, run state) or start anew, from `init_from`'s weights
     if given; the state the run starts from."""
@@ -325,7 +183,7 @@ def _restore(
         parts.opt.load_state_dict(ckpt["optimizer"])
         if sched is not None and ckpt.get("scheduler") is not None:
             sched.load_state_dict(ckpt["scheduler"])
-        torch.set_rng_state(ckpt["rng"]["torch"])
+        torch.setrng_state(ckpt["rng"]["torch"])
         parts.gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
         state = RunState(**ckpt["state"])
         proc.say(f"resumed {last} at epoch {state.epoch}/{cfg.epochs}")
@@ -341,16 +199,6 @@ def _restore(
         model.load_state_dict(weights)
         proc.say(f"initialised from {init_from}")
     return RunState()
-
-
-def _wrap(proc: _Process, model: VAE, cfg: TrainConfig) -> nn.Module:
-    """The module the steps run: DDP across processes, compiled if asked."""
-    net: nn.Module = model
-    if proc.distributed:
-        net = nn.parallel.DistributedDataParallel(
-            model, device_ids=[proc.device.index] if proc.device.type == "cuda" else None
-        )
-    return torch.compile(net) if cfg.compile else net
 
 
 def _budget_bar(cfg: TrainConfig, state: RunState, shown: bool) -> tqdm | None:
@@ -369,7 +217,7 @@ def _budget_bar(cfg: TrainConfig, state: RunState, shown: bool) -> tqdm | None:
     )
 
 
-def _validate(proc: _Process, parts: _Parts, val: torch.Tensor, cfg: TrainConfig) -> float:
+def _validate(proc: Process, parts: _Parts, val: torch.Tensor, cfg: TrainConfig) -> float:
     """The validation MSE, rank 0's on every process, so that all stop together; a plateau schedule steps on it."""
     val_mse = validation_measure(cfg.match)(parts.model, val, device=proc.device)
     if proc.distributed:
@@ -387,7 +235,7 @@ def _record_epoch(run_dir: Path, ckpt: dict[str, Any], row: dict[str, float], im
         atomic_save(ckpt, run_dir / "best.pt")
     atomic_save(ckpt, run_dir / "last.pt")
     if cfg.snapshots:
-        _keep_snapshot(run_dir, ckpt, row["epoch"], cfg.snapshots)
+        keep_snapshot(run_dir, ckpt, row["epoch"], cfg.snapshots)
     with open(run_dir / "log.jsonl", "a") as f:
         f.write(json.dumps(row) + "\n")
     print(  # one line per epoch, with or without the progress bar
@@ -398,7 +246,7 @@ def _record_epoch(run_dir: Path, ckpt: dict[str, Any], row: dict[str, float], im
     )
 
 
-def _steps_per_epoch(n_curves: int, proc: _Process, cfg: TrainConfig) -> int:
+def _steps_per_epoch(n_curves: int, proc: Process, cfg: TrainConfig) -> int:
     """Full batches per epoch on each process (the ragged last batch is dropped)."""
     steps = n_curves // proc.world // (cfg.batch_size // proc.world)
     if steps < 1:
@@ -411,7 +259,7 @@ def _write_config(run_dir: Path, configs: dict[str, Any]) -> None:
     (run_dir / "config.json").write_text(json.dumps(configs, indent=2))
 
 
-def _epoch_order(gen: np.random.Generator, n_curves: int, proc: _Process, per_epoch: int) -> torch.Tensor:
+def _epoch_order(gen: np.random.Generator, n_curves: int, proc: Process, per_epoch: int) -> torch.Tensor:
     """This process's share of a fresh permutation (the same on every rank), `per_epoch` curves."""
     perm = torch.from_numpy(gen.permutation(n_curves))
     return perm[proc.rank :: proc.world][:per_epoch]
@@ -466,7 +314,7 @@ def _checkpoint(configs: dict[str, Any], parts: _Parts, state: RunState) -> dict
         "optimizer": parts.opt.state_dict(),
         "scheduler": parts.sched.state_dict() if parts.sched is not None else None,
         "state": asdict(state),
-        "rng": _rng_state(parts.gen),
+        "rng": rng_state(parts.gen),
     }
 
 
@@ -475,7 +323,7 @@ def _stop_reason(cfg: TrainConfig, state: RunState, clock: Clock) -> str | None:
     and gets rank 0's answer, so all stop at the same epoch."""
     if cfg.patience and state.epoch - state.best_epoch >= cfg.patience:
         return f"early stop: no better validation MSE for {cfg.patience} epochs"
-    if _agree(clock.over()):
+    if agree(clock.over()):
         return f"time budget of {cfg.time_budget:.0f} s spent after {state.epoch} epochs"
     return None
 
@@ -506,17 +354,17 @@ def train(
     if cfg.match == "mixed" and model_cfg.spline_params:
         # its index half measures the decoder's even parameters, which learned parameters would not serve
         raise ValueError('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
-    proc = _start_process(cfg)
+    proc = start_process(cfg)
     try:
         torch.manual_seed(cfg.seed)
         random.seed(cfg.seed)
-        _check_resumed_data(run_dir / "last.pt", data_cfg, resume)
+        check_resumed_data(run_dir / "last.pt", data_cfg, resume)
         data, val = _load_splits(proc, data_cfg, cfg, data_cache, data_workers)
         steps_per_epoch = _steps_per_epoch(len(data), proc, cfg)
         parts = _new_parts(proc, model_cfg, cfg, steps_per_epoch)
         state = _restore(proc, run_dir / "last.pt", parts, cfg, resume=resume, init_from=init_from)
         parts.clock.spent = state.trained_seconds
-        net = _wrap(proc, parts.model, cfg)  # after the restore: DDP starts every process from rank 0's weights
+        net = wrap(proc, parts.model, cfg)  # after the restore: DDP starts every process from rank 0's weights
         configs = {"model": asdict(model_cfg), "data": asdict(data_cfg), "train": asdict(cfg)}
         if proc.rank == 0:
             _write_config(run_dir, configs)

@@ -255,7 +255,7 @@ def _model_routes(model: str) -> None:
         responses=oip_errors(400, 401, 413, 503, 504),
         summary=f"{model.capitalize()} inference on raw tensors",
         name=f"oip_{model}_infer",
-        # the request body's schema and examples are the model's tensors: service.oip.describe states them
+        # the request body's schema and examples are the model's tensors: service.oip_docs.describe states them
         openapi_extra=curl_sample(f"/v2/models/{model}/infer", "@request.json"),
     )
 

@@ -78,3 +78,30 @@ def test_rotations_blend_the_short_way_round_within_a_mirror_parity():
     assert abs(blend_frames([a, b], np.array([[0.5, 0.5]]))[0].rotation) == pytest.approx(np.pi)
     m = Frame((0.0, 0.0), 1.0, rotation=1.0, mirror=True)
     assert blend_frames([a, m], np.array([[0.6, 0.4]]))[0].rotation == pytest.approx(a.rotation)
+
+
+def _moves(c: np.ndarray, rng: np.random.Generator) -> list[np.ndarray]:
+    a = rng.uniform(0, 2 * np.pi)
+    turn = np.array([[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]])
+    return [c[::-1], c * [-1.0, 1.0], c @ turn * 3.7 + 100, (c * [-1.0, 1.0])[::-1] @ turn * 0.01]
+
+
+def test_the_canonical_pose_is_the_same_for_a_curve_its_reversal_mirror_image_and_rotations():
+    """Open curves, closed-looking loops (an airfoil's trailing edge), S-bends: every move comes to the same posed
+    points, to rounding."""
+    from curve_vae.geometry import canonical_frame
+
+    rng = np.random.default_rng(5)
+    t = np.linspace(0, 1, 120)
+    curves = [
+        *sample_bspline(random_control_points(rng, 20), 161),  # the paper's curves, many nearly closed
+        np.stack([np.cos(6 * t), 0.2 * np.sin(6 * t) + t], 1),  # a loop
+        np.stack([t, 0.3 * np.sin(2 * np.pi * t * 1.3)], 1),  # an S-bend
+    ]
+    for c in curves:
+        base = canonical_frame(c).to_model(c, 92.6)
+        for moved in _moves(c, rng):
+            np.testing.assert_allclose(canonical_frame(moved).to_model(moved, 92.6), base, atol=1e-9)
+        f = canonical_frame(c)
+        posed = f.to_model(c, 92.6)
+        assert signed_turning(posed) >= 0 and np.ptp(posed, axis=0).max() == pytest.approx(92.6)

@@ -1,9 +1,6 @@
 """Every validation rule gets the bad input it exists for: a 4xx whose message names field, curve and point.
 
 No input may produce a 5xx: the last tests throw malformed and extreme bodies at every endpoint.
-
-Length (~520 lines): one short test per refusal the API documents, across every endpoint; they share the
-fixtures and helpers above them, and splitting by endpoint would repeat those.
 """
 
 from __future__ import annotations
