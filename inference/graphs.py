@@ -45,6 +45,7 @@ class ModelGraphs:
         self.knots = clamped_uniform_knots(spline.n_ctrl, spline.degree) if spline else None
         self.n_ctrl = spline.n_ctrl if spline else 0
         self.has_params = bool(spline and spline.learned_params)
+        self.rows = {"encoder": 0, "decoder": 0}  # rows each graph has run: what requests cost, for /metrics
         encoder, decoder = pool.pairs[0]
         self._enc_in = encoder.get_inputs()[0].name
         self._dec_in = decoder.get_inputs()[0].name
@@ -152,6 +153,7 @@ class ModelGraphs:
         """One run of a graph: gathered with other requests' by the thread's micro-batcher, if it has one; first, a
         cancelled request stops here."""
         checkpoint()
+        self.rows[graph] += len(x)
         batcher = batching.current()
         if batcher is not None:
             return batcher.run(graph, x, outputs)

@@ -55,6 +55,12 @@ class Metrics:
             ["route"],
             registry=self.registry,
         )
+        self.graph_rows = Gauge(
+            "curve_vae_graph_rows",
+            "Rows (curves or latents) each ONNX graph has run since the start: what the requests cost.",
+            ["graph"],
+            registry=self.registry,
+        )
         self.cache_hits = Gauge("curve_vae_cache_hits", "Curves read from the encoding cache.", registry=self.registry)
         self.cache_misses = Gauge("curve_vae_cache_misses", "Curves read afresh.", registry=self.registry)
         self.cache_bytes = Gauge("curve_vae_cache_bytes", "Bytes the encoding cache holds.", registry=self.registry)

@@ -113,6 +113,9 @@ async def metrics(request: Request) -> Response:
         raise HTTPException(404, "metrics are off on this server (CURVE_VAE_METRICS=false)")
     metrics = request.app.state.metrics
     runtime = request.app.state.runtime
+    if runtime is not None:
+        for graph, rows in runtime.graphs.rows.items():
+            metrics.graph_rows.labels(graph).set(rows)
     if runtime is not None and runtime.cache is not None:
         stats = runtime.cache.stats()
         metrics.cache_hits.set(stats["hits"])

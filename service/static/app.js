@@ -186,7 +186,7 @@ function finishStroke() {
 
 async function reconstructAll() {
   if (!state.curves.length) return;
-  const body = { curves: state.curves, spacing: "auto", n_points: N_POINTS, output: "both", refine: refine() };
+  const body = { curves: state.curves, n_points: N_POINTS, output: "both", refine: refine() };
   const r = await api("/reconstruct", body, $("board-error"));
   state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i], refine: body.refine }));
 }
@@ -199,7 +199,9 @@ function mixWeights() {
 
 async function updateMix() {
   if (state.curves.length < needed()) { state.result = null; render(); return; }
-  const body = { curves: state.curves.slice(0, needed()), weights: mixWeights(), spacing: "auto",
+  // the same curves as every move before: the server reads them from its encoding cache, so a move costs one
+  // decode of the mixed latent (GET /metrics: curve_vae_graph_rows)
+  const body = { curves: state.curves.slice(0, needed()), weights: mixWeights(),
     n_points: N_POINTS, output: "both", metrics: true, refine: refine() };
   const r = await api("/interpolate", body, $("mix-error"));
   state.result = { points: r.curves[0], spline: r.splines[0], metrics: r.metrics[0], weights: r.weights[0], body };
@@ -209,7 +211,7 @@ async function updateMix() {
 async function updateStrip() {
   if (state.curves.length < needed()) { state.strip = []; return; }
   const steps = state.mode === "triplet" ? 4 : 5;  // pair: 5 evenly spaced; triplet: the grid of paper Fig. 8
-  const body = { curves: state.curves.slice(0, needed()), steps, spacing: "auto", n_points: 60, refine: refine() };
+  const body = { curves: state.curves.slice(0, needed()), steps, n_points: 60, refine: refine() };
   const r = await api("/interpolate", body, $("strip-error"));
   state.strip = r.curves;
 }

@@ -7,6 +7,7 @@ Every test fails on a JavaScript error or a console error. A screenshot of the p
 from __future__ import annotations
 
 import json
+import re
 import os
 import shutil
 from collections.abc import Iterator
@@ -107,6 +108,12 @@ def test_draw_interpolate_triplet_download_vase(browser, server, tmp_path):
     assert errors == []
 
 
+def _graph_rows(url: str) -> dict[str, float]:
+    """Rows each graph has run on the server (GET /metrics: curve_vae_graph_rows)."""
+    text = httpx.get(url + "/metrics", timeout=10).text
+    return {g: float(re.search(rf'curve_vae_graph_rows{{graph="{g}"}} (\S+)', text)[1]) for g in ("encoder", "decoder")}
+
+
 def _check_pair(page: Page, url: str) -> None:
     """Two drawn curves: their reconstructions, the mix at the slider's weight and the strip are the API's answers."""
     draw(page, arc(500, 420, 250, np.pi, 2 * np.pi))  # a bowl, drawn left to right
@@ -114,8 +121,15 @@ def _check_pair(page: Page, url: str) -> None:
     page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 5")
     page.wait_for_function("document.querySelectorAll('path.reconstruction').length === 2")
 
+    posted: list[str] = []
+    page.on("request", lambda r: posted.append(r.url.rsplit("/", 1)[-1]) if r.method == "POST" else None)
+    before = _graph_rows(url)
     page.locator("#weight").fill("0.25")  # the slider
     page.wait_for_function("window.curveVae.result && window.curveVae.result.weights[1] === 0.25")
+    after = _graph_rows(url)
+    # a move: one request, and the server reads its curves from the encoding cache: no encoding, one decoded row
+    assert posted == ["interpolate"], posted
+    assert after["encoder"] == before["encoder"] and after["decoder"] - before["decoder"] == 1, (before, after)
     s = state(page)
     answer = httpx.post(url + "/interpolate", json=s["result"]["body"], timeout=30).json()
     np.testing.assert_allclose(drawn(page, "#interpolant"), answer["curves"][0], atol=2e-3)  # drawn = API's answer
