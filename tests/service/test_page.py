@@ -7,8 +7,8 @@ Every test fails on a JavaScript error or a console error. A screenshot of the p
 from __future__ import annotations
 
 import json
-import re
 import os
+import re
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
