@@ -28,6 +28,7 @@ from curve_vae.geometry import (
     to_model_plane,
 )
 from curve_vae.inference.cache import EncodingCache
+from curve_vae.inference.cancel import checkpoint
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
@@ -114,6 +115,7 @@ class Reader:
         stage: list[Candidate] = []
         with np.errstate(all="ignore"):
             for c, (i, pts) in enumerate(zip(index, inputs)):
+                checkpoint()  # a natural fit per curve: an abandoned request stops between curves
                 try:
                     if reading.frame == "model":
                         frames: list[Frame | None] = [None]

@@ -105,3 +105,30 @@ def test_a_stream_that_fails_midway_is_visibly_short(model_dir, monkeypatch):
         server.should_exit = True
         thread.join(timeout=30)
     assert len(calls) == 3
+
+
+def _cpu(server) -> float:
+    return sum(server.cpu_seconds().values())
+
+
+def test_a_request_whose_client_disconnects_stops_and_frees_its_slot(server_factory, model_dir, curves):
+    """The client gives up mid-request: the server stops at its next graph run or curve, its one inference slot is
+    free for the next request at once, and it goes idle instead of computing the abandoned answer to the end."""
+    server = server_factory(
+        "--model-dir", str(model_dir), "--providers", "cpu", "--inference-concurrency", "1", "--batch-size", "8"
+    )
+    server.wait_ready()
+    body = {**heavy(curves), "pose": "search", "spacing": "search"}  # seconds of work on one slot
+    start = _cpu(server)
+    with pytest.raises(httpx.ReadTimeout):
+        httpx.post(server.url + "/reconstruct", json=body, timeout=0.5)  # gives up and closes the connection
+    time.sleep(0.5)  # the poll notices, the next checkpoint stops the thread
+    idle = _cpu(server)
+    time.sleep(1.0)
+    assert _cpu(server) - idle < 0.25, "the server kept computing the abandoned request"
+    t = time.perf_counter()
+    assert httpx.post(server.url + "/reconstruct", json={"curves": [CURVE]}, timeout=10).status_code == 200
+    assert time.perf_counter() - t < 2.0  # the slot was free: no waiting behind the abandoned request
+    assert idle - start < 3.0  # stopped well before the whole request's work
+    metrics = httpx.get(server.url + "/metrics").text
+    assert 'curve_vae_inference_cancelled_total{route="/reconstruct"} 1.0' in metrics
