@@ -10,14 +10,16 @@ def _f(x: float | None, digits: int = 2) -> str:
 
 
 ROW_LABELS = {
-    "A": "A: /reconstruct, 128 curves JSON, 2 connections",
-    "B": "B: /reconstruct, 1 curve JSON, 16 connections",
-    "B_npy": "B with .npy bodies",
-    "latency_1": "/reconstruct, 1 curve, 1 connection",
-    "latency_1_pose_auto": '/reconstruct, 1 curve, pose "auto" (6 poses), 1 connection',
-    "latency_1_default": '/reconstruct, 1 curve, the defaults (pose, spacing "auto": 12 readings), 1 connection',
-    "interpolate": "/interpolate, pair, 5 steps, 16 connections",
-    "interpolate_pose_auto": '/interpolate, pair, 5 steps, pose "auto", 16 connections',
+    "A": "**A: /reconstruct, 128 curves, the default request**, 2 connections",
+    "A_fast": "A, the fast path (pose as_is, spacing parameter)",
+    "B": "**B: /reconstruct, 1 curve, the default request**, 16 connections",
+    "B_fast": "B, the fast path (pose as_is, spacing parameter)",
+    "B_npy": "B with a .npy body",
+    "B_cached": "B with the encoding cache on (the same curve every time)",
+    "latency_1": "/reconstruct, 1 curve, the default request, 1 connection",
+    "latency_1_fast": "/reconstruct, 1 curve, the fast path, 1 connection",
+    "latency_1_search": "/reconstruct, 1 curve, the search (pose, spacing search), 1 connection",
+    "interpolate": "/interpolate, pair, 5 steps, the default request, 16 connections",
     "spinning": "B, spinning on (`--spinning true`)",
     "access_log": "B, access log on (`--access-log true`)",
     "workers": "B, `--workers 2 --inference-concurrency 1`",
@@ -53,7 +55,7 @@ def _table(r: dict[str, Any]) -> list[str]:
         "| other CPU s | non-2xx |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    single = ("B", "B_npy", "spinning", "access_log", "workers", "one_session", "micro_batch")
+    single = ("B", "B_fast", "B_npy", "B_cached", "spinning", "access_log", "workers", "one_session", "micro_batch")
     for key, label in ROW_LABELS.items():
         if key not in r:
             continue
@@ -77,7 +79,7 @@ def _notes(r: dict[str, Any]) -> list[str]:
         g = r["augment"]
         lines += [
             "",
-            f"/augment, {g['count']:,} curves (8 seeds, pose as_is): JSON in pages of 256 "
+            f"/augment, {g['count']:,} curves (8 seeds, the default request): JSON in pages of 256 "
             f"{g['json_s']:.2f} s ({g['json_cps']:.0f} curves/s); one .npy stream {g['npy_s']:.2f} s "
             f"({g['npy_cps']:.0f} curves/s).",
         ]
@@ -91,26 +93,21 @@ def _breakdown(r: dict[str, Any]) -> list[str]:
         return []
     lines = [
         "",
-        "In-process, one 1-thread session, ms per request: "
-        f"encoder + decoder {b['onnx_b1_ms']:.2f} (1 curve) / {b['onnx_b128_ms']:.0f} (128 curves); "
-        f"`CurveRuntime.reconstruct` pose as_is, spacing parameter {b['reconstruct_b1_ms']:.2f} / "
-        f"{b['reconstruct_b128_ms']:.0f}; "
+        "In-process, one 1-thread session, no cache, ms per request (1 curve / 128 curves): "
+        f"encoder + decoder {b['onnx_b1_ms']:.2f} / {b['onnx_b128_ms']:.0f}; "
+        f"`CurveRuntime.reconstruct` with the default reading {b['reconstruct_default_b1_ms']:.2f} / "
+        f"{b['reconstruct_default_b128_ms']:.0f}, the fast path {b['reconstruct_fast_b1_ms']:.2f} / "
+        f"{b['reconstruct_fast_b128_ms']:.0f}, the search {b['reconstruct_search_b1_ms']:.1f} (1 curve); "
         f"JSON parse + validation {b['parse_validate_b1_ms']:.2f} / {b['parse_validate_b128_ms']:.1f}; "
         f"rendering the answer {b['render_b1_ms']:.2f} / {b['render_b128_ms']:.1f}.",
     ]
-    if "reconstruct_spacing_auto_b1_ms" in b:
-        auto, pose = b["reconstruct_spacing_auto_b1_ms"], b["reconstruct_pose_auto_b1_ms"]
-        lines.append(
-            f"One curve drawn by arc length, `CurveRuntime.reconstruct` with pose auto: its points as given (spacing "
-            f"parameter) {pose:.2f} ms, the default request (spacing auto) {auto:.2f} ms ({auto / pose:.2f}×)."
-        )
     if "B" in r:
-        rest = r["B"]["server_cpu_ms_per_request"] - b["reconstruct_b1_ms"] - b["parse_validate_b1_ms"]
+        own = b["reconstruct_default_b1_ms"]
+        rest = r["B"]["server_cpu_ms_per_request"] - own - b["parse_validate_b1_ms"]
         lines.append(
-            f"Of B's {r['B']['server_cpu_ms_per_request']:.2f} ms of server CPU per request, "
-            f"{b['reconstruct_b1_ms']:.2f} are the runtime's work in isolation and "
-            f"{b['parse_validate_b1_ms']:.2f} JSON; the other {rest:.2f} ms are HTTP, the framework, the thread "
-            "hand-offs and inference slowed by sharing the cores (caches) with the event loop and wrk."
+            f"Of B's {r['B']['server_cpu_ms_per_request']:.2f} ms of server CPU per request, {own:.2f} are the "
+            f"runtime's work in isolation and {b['parse_validate_b1_ms']:.2f} JSON; the other {rest:.2f} ms are HTTP, "
+            "the framework, the thread hand-offs and inference slowed by sharing the cores with the event loop and wrk."
         )
     return lines
 

@@ -1,16 +1,17 @@
-"""Serving benchmark: the real server under wrk, as ratios to the in-process onnxruntime ceiling (issue 16).
+"""Serving benchmark: the real server under wrk, as ratios to the in-process onnxruntime ceiling.
 
     apt-get install -y wrk                       # once: the load generator (Debian package)
-    .venv/bin/python -m bench.serve              # ~4 minutes on 2 cores; --seconds 10 per load run
+    .venv/bin/python -m bench.serve              # ~5 minutes on 2 cores; --seconds 10 per load run
     .venv/bin/python -m bench.serve --seconds 1 --runs B   # the test suite's smoke run
 
 It starts `python -m curve_vae.service.cli` (uvicorn, the service's defaults unless a run says otherwise) on a
-loopback port for each configuration, drives it with wrk (POST bodies from a small Lua script, tests/bench run through
-`bench/post.lua`), and reads the server's CPU time from /proc (all its processes), so the server's cost per
-request shows apart from wrk's. Requests use pose "as_is" and spacing "parameter" (one encoder and one decoder run
-per curve: the ceiling's unit of work); the default pose "auto" tries six poses, 6x the inference, and the default
-spacing "auto" two readings of each (the breakdown's last line: one curve, in-process). The report is a
-Markdown section (`bench.report`; printed, and written with --markdown FILE) and JSON (--json FILE).
+loopback port for each configuration, drives it with wrk (POST bodies from a small Lua script, bench/post.lua), and
+reads the server's CPU time from /proc (all its processes), so the server's cost per request shows apart from wrk's.
+The headline rows A and B are the request a user sends: no pose or spacing fields, the paper's curves as a caller
+posts them (turned, mirrored or reversed, in pixels, spaced by arc length); beside them the fast path (pose "as_is",
+spacing "parameter") and, one connection at a time, the search. wrk posts one body again and again, so those
+servers run without the encoding cache (every request read afresh); B_cached shows what a re-posted curve costs.
+The report is a Markdown section (`bench.report`; printed, and written with --markdown FILE) and JSON (--json FILE).
 """
 
 from __future__ import annotations
@@ -140,13 +141,11 @@ def augment(server: Server, seeds: np.ndarray, count: int) -> dict[str, float]:
     got = 0
     for offset in range(0, count, page):
         n = min(page, count - offset)
-        body = json_body(seeds, count=n, offset=offset, seed=1, pose="as_is", spacing="parameter")
+        body = json_body(seeds, count=n, offset=offset, seed=1)
         got += len(json.loads(post(f"{server.url}/augment", body))["curves"])
     json_s = time.perf_counter() - start
     start = time.perf_counter()
-    data = post(
-        f"{server.url}/augment", json_body(seeds, count=count, seed=1, pose="as_is", spacing="parameter", format="npy")
-    )
+    data = post(f"{server.url}/augment", json_body(seeds, count=count, seed=1, format="npy"))
     npy_s = time.perf_counter() - start
     assert got == count and np.load(io.BytesIO(data)).shape[0] == count
     return {"count": count, "json_s": json_s, "npy_s": npy_s, "json_cps": count / json_s, "npy_cps": count / npy_s}
@@ -170,7 +169,7 @@ def machine() -> dict[str, Any]:
     }
 
 
-VARIANTS = {  # run as B, each against a server started with these flags
+VARIANTS = {  # run as B (the default request), each against a server started with these flags, no cache
     "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
     "access_log": (["--access-log", "true"], "B with the access log on"),
     "workers": (["--workers", "2", "--inference-concurrency", "1"], "B over 2 worker processes"),
@@ -212,48 +211,60 @@ def _load(
     return report[name]
 
 
-def _single() -> bytes:
-    """B's body: one curve, JSON, pose as_is."""
-    return json_body(ceiling.curves(1, seed=1), pose="as_is", spacing="parameter")
+FAST = {"pose": "as_is", "spacing": "parameter"}  # the fast path: the curve read as it is listed
+SEARCH = {"pose": "search", "spacing": "search"}  # every pose and spacing candidate, the closest kept
+NO_CACHE = {"CURVE_VAE_CACHE_BYTES": "0"}  # wrk posts one body again and again: without this, every curve is a hit
+
+
+def _callers(count: int, seed: int) -> np.ndarray:
+    """`count` of the paper's curves as a caller posts them (bench.ceiling.callers_curves: turned, mirrored or
+    reversed at random, in pixel coordinates with y down, spaced by arc length)."""
+    return np.stack(ceiling.callers_curves(ceiling.curves(count, seed=seed), seed=seed))
 
 
 def _default_server_runs(
     load: Callable[..., dict[str, Any]], report: dict[str, Any], model_dir: Path, runs: set[str], augment_count: int
 ) -> None:
-    """The runs against one server with the service's defaults: A, B, B_npy, latency, interpolate, augment."""
-    one = ceiling.curves(1, seed=1)
-    many = ceiling.curves(128, seed=2)
-    single = _single()
-    server = Server(model_dir)
+    """The runs against a server with the service's defaults but no encoding cache (every request read afresh: the
+    headline A and B are the default request, no pose or spacing fields, curves in a caller's frame, beside the fast
+    path), then B against one with its cache (the same curve every time: what a re-posted curve costs)."""
+    one, many = _callers(1, seed=1), _callers(128, seed=2)
+    server = Server(model_dir, env=NO_CACHE)
     try:
         if "A" in runs:
-            r = load("A", server, "/reconstruct", json_body(many, pose="as_is", spacing="parameter"), c=2)
-            r["curves_per_s"] = r["rps"] * 128
+            for name, fields in (("A", {}), ("A_fast", FAST)):
+                r = load(name, server, "/reconstruct", json_body(many, **fields), c=2)
+                r["curves_per_s"] = r["rps"] * 128
         if "B" in runs:
-            load("B", server, "/reconstruct", single)
+            load("B", server, "/reconstruct", json_body(one))
+            load("B_fast", server, "/reconstruct", json_body(one, **FAST))
         if "B_npy" in runs:
-            load("B_npy", server, "/reconstruct?pose=as_is&spacing=parameter", npy_body(one), "application/x-npy")
+            load("B_npy", server, "/reconstruct", npy_body(one), "application/x-npy")
         if "latency" in runs:
-            load("latency_1", server, "/reconstruct", single, c=1)
-            load("latency_1_pose_auto", server, "/reconstruct", json_body(one, spacing="parameter"), c=1)
-            load("latency_1_default", server, "/reconstruct", json_body(one), c=1)
+            load("latency_1", server, "/reconstruct", json_body(one), c=1)
+            load("latency_1_fast", server, "/reconstruct", json_body(one, **FAST), c=1)
+            load("latency_1_search", server, "/reconstruct", json_body(one, **SEARCH), c=1)
         if "interpolate" in runs:
-            pair = ceiling.curves(2, seed=3)
-            load("interpolate", server, "/interpolate", json_body(pair, steps=5, pose="as_is", spacing="parameter"))
-            load("interpolate_pose_auto", server, "/interpolate", json_body(pair, steps=5, spacing="parameter"))
+            load("interpolate", server, "/interpolate", json_body(_callers(2, seed=3), steps=5))
         if "augment" in runs:
             print("augment ...", file=sys.stderr)
-            report["augment"] = augment(server, ceiling.curves(8, seed=4), augment_count)
+            report["augment"] = augment(server, _callers(8, seed=4), augment_count)
     finally:
         server.stop()
+    if "B" in runs:
+        cached = Server(model_dir)
+        try:
+            load("B_cached", cached, "/reconstruct", json_body(one))
+        finally:
+            cached.stop()
 
 
 def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: set[str]) -> None:
     """B against a server of each asked-for variant (VARIANTS), one server each."""
-    single = _single()
+    single = json_body(_callers(1, seed=1))
     for name, (flags, _) in VARIANTS.items():
         if name in runs:
-            server = Server(model_dir, *flags)
+            server = Server(model_dir, *flags, env=NO_CACHE)
             try:
                 load(name, server, "/reconstruct", single)
             finally:
@@ -271,7 +282,7 @@ def _ceiling_again(report: dict[str, Any], model_dir: Path, secs: float) -> None
         inproc[key] = max(inproc[key], again[key])
     inproc["ceiling"] = top = max(inproc["ceiling"], again["ceiling"])
     for name, x in report.items():
-        if name in ("A", "B", "B_npy", *VARIANTS):
+        if name in ("A", "A_fast", "B", "B_fast", "B_npy", "B_cached", *VARIANTS):
             x["ratio"] = x.get("curves_per_s", x["rps"]) / top
 
 

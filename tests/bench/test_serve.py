@@ -32,4 +32,4 @@ def test_the_benchmark_runs_for_a_second(tmp_path):
     for run in ("B", "B_npy"):
         assert report[run]["requests"] > 0 and report[run]["non_2xx"] == 0 and report[run]["errors"] == 0
         assert report[run]["server_cpu_ms_per_request"] > 0
-    assert "| B: /reconstruct, 1 curve JSON, 16 connections |" in done.stdout
+    assert "| **B: /reconstruct, 1 curve, the default request**, 16 connections |" in done.stdout
