@@ -48,6 +48,7 @@ def sample_body(made: Sampled, *, metrics: bool = False) -> dict[str, Any]:
         "latents": made.latents.tolist(),
         "curves": made.curves.tolist(),
         "seed": made.seed,
+        "offset": made.offset,
         "prior": made.prior,
         "rejected": made.rejected,
         "invalid": made.invalid,

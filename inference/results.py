@@ -77,6 +77,7 @@ class Sampled(Curves):
     latents: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     prior: str = "learned"
     seed: int = 0
+    offset: int = 0  # index of the first curve in the seeded sequence
     rejected: int = 0  # draws rejected (self-intersecting or outside the reference region) and drawn again
     invalid: int = 0  # curves still not valid after the last draw (0 unless the distribution is far off)
 

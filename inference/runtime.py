@@ -288,6 +288,7 @@ class CurveRuntime:
         prior: str | None = None,
         valid: bool = True,
         max_draws: int = MAX_DRAWS,
+        offset: int = 0,
         n_points: int | None = None,
         spacing: str = "parameter",
         frame: Frame | None = None,
@@ -295,7 +296,7 @@ class CurveRuntime:
         """New curves from a latent distribution (inference.sampling), in the model plane or mapped into `frame`."""
         root = fresh_seed() if seed is None else seed
         drawn = self.sampler.draw(
-            count, seed=root, temperature=temperature, prior=prior, valid=valid, max_draws=max_draws
+            count, seed=root, temperature=temperature, prior=prior, valid=valid, max_draws=max_draws, offset=offset
         )
         frames = [frame] * count if frame else None
         placed = decoded_to_caller(
@@ -308,6 +309,7 @@ class CurveRuntime:
             latents=drawn.latents,
             prior=drawn.prior,
             seed=root,
+            offset=offset,
             rejected=drawn.rejected,
             invalid=drawn.invalid,
         )

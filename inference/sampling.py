@@ -53,6 +53,7 @@ class Sampler:
         prior: str | None = None,
         valid: bool = True,
         max_draws: int = MAX_DRAWS,
+        offset: int = 0,
     ) -> Drawn:
         """`count` curves decoded from latents of a distribution.
 
@@ -60,7 +61,8 @@ class Sampler:
         model ships one); "standard": the VAE's N(0, I). temperature scales the spread (see inference/prior.py).
         valid: a draw whose curve crosses itself or leaves the disc is rejected and item i draws again, at most
         max_draws times in all. Item i's draws come from its own generator default_rng([seed, i]), so the seed
-        decides every curve, across rejections too, and the first items of a larger count are those of a smaller.
+        decides every curve, across rejections too, and the first items of a larger count are those of a smaller;
+        `offset` starts the sequence at item offset, so pages of it are the curves of one larger request.
         """
         g = self.graphs
         chosen = prior or ("learned" if self.prior is not None else "standard")
@@ -68,7 +70,7 @@ class Sampler:
             raise InputError(
                 ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
             )
-        rngs = [np.random.default_rng([seed, i]) for i in range(count)]
+        rngs = [np.random.default_rng([seed, i]) for i in range(offset, offset + count)]
         learned = self.prior
 
         def one(i: int) -> np.ndarray:

@@ -84,6 +84,7 @@ class InterpolateResponse(CurvesResponse):
 class SampleResponse(CurvesResponse):
     latents: list[list[float]] = Field(description="The latent vector each curve was decoded from.")
     seed: int = Field(description="The seed used: the request's, or the one drawn for it.")
+    offset: int = Field(0, description="Index of the first returned curve in the seeded sequence.")
     prior: str = Field(description="The distribution the latents were drawn from: learned, standard or a named prior.")
     rejected: int = Field(description="Draws rejected (self-intersecting or outside the disc) and drawn again.")
     invalid: int = Field(description="Curves still invalid after 10 draws each (returned as drawn; normally 0).")

@@ -54,6 +54,7 @@ async def sample(request: Request, runtime: RuntimeDep, settings: SettingsDep, r
             temperature=req.temperature,
             prior=req.prior,
             valid=req.valid,
+            offset=req.offset,
             n_points=req.n_points,
             spacing=req.spacing,
             frame=frame,
