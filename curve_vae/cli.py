@@ -1,4 +1,5 @@
-"""`curve-vae` command line: dataset, train, average, export, evaluate, triton, sample, augment, fit, revolve, serve.
+"""`curve-vae` command line: dataset, train, average, export, evaluate, triton, reconstruct, encode, sample, augment,
+fit, revolve, prior, serve.
 
 The commands live in `curve_vae/commands/`, one module per group; this module assembles the parser.
 Each subcommand imports what it needs when it runs, so `curve-vae serve` and the offline
@@ -11,7 +12,7 @@ import argparse
 import sys
 
 from curve_vae import __version__
-from curve_vae.commands import data, generate, model, train
+from curve_vae.commands import curves, data, design, generate, model, train
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -20,7 +21,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"curve-vae {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for group in (data, train, model, generate):
+    for group in (data, train, model, curves, generate, design):
         group.register(sub)
 
     s = sub.add_parser("serve", help="run the REST service on a model directory")
@@ -40,6 +41,8 @@ def build_parser() -> argparse.ArgumentParser:
         ("augment", "the output file"),
         ("fit", "the output file"),
         ("revolve", "the output file"),
+        ("reconstruct", "the output file"),
+        ("encode", "the output file"),
     ]:
         sub.choices[name].add_argument("--force", action="store_true", help=f"replace {what} if it exists")
     return p

@@ -118,3 +118,13 @@ def _unfittable(n_ctrl: int | None, error: Exception | None = None) -> str:
         f"no unique least-squares spline with {count} control points{why}: some knot span holds too few of the "
         'curve\'s points; use fewer control points, more points, or param "uniform"'
     )
+
+
+def mesh_file(mesh: Any, *, points: int, segments: int, axis: str, fmt: str) -> bytes:
+    """A surface of revolution as the file /revolve answers and `curve-vae revolve` writes: binary STL, or OBJ text
+    that says what it is."""
+    if fmt == "stl":
+        with np.errstate(all="ignore"):  # normals of huge triangles: STL readers recompute them
+            return mesh.to_stl()
+    comment = f"curve-vae surface of revolution: {points}-point profile, {segments} segments about the {axis} axis"
+    return mesh.to_obj(comment=comment).encode()

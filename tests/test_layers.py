@@ -21,6 +21,7 @@ ALLOWED: dict[str, set[str]] = {
     "curve_vae.service": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
     "curve_vae.training": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
     "curve_vae.triton": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
+    "curve_vae.distributed": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
     "curve_vae.commands": {
         "curve_vae.geometry",
         "curve_vae.base",
@@ -28,6 +29,7 @@ ALLOWED: dict[str, set[str]] = {
         "curve_vae.client",
         "curve_vae.training",
         "curve_vae.triton",
+        "curve_vae.distributed",
     },
 }
 #: `curve-vae serve` is the one command that starts the HTTP layer.

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 
-class ApiError(Exception):
+class ApiError(RuntimeError):
     """An answer that is not a success: `status` (HTTP), `loc` (the field, curve and point, e.g. "curves[2][17][1]";
     "" where the service named none), `msg` (what is wrong there), `detail` (the service's one line) and `errors`
     (every problem it found). A 4xx is never retried: the same request gets the same answer."""

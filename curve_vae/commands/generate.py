@@ -1,17 +1,23 @@
-"""`curve-vae sample`, `augment`, `fit` and `revolve`: offline and torch-free, through the service's runtime."""
+"""`curve-vae sample` and `augment`: torch-free, through the local model's runtime or, with --server, a deployment;
+the same output either way (the JSON the endpoints answer, or a .npy file of the curves)."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from typing import Any
+
+import numpy as np
 
 from curve_vae.commands.options import (
     add_generate_options,
     add_model_options,
+    add_server_option,
     model_runtime,
+    server_client,
 )
 from curve_vae.files import refuse_overwrite
-from curve_vae.inference.choices import AugmentMode, Axis, FitParam, FrameMode, MeshFormat, Output, Pose, choices
+from curve_vae.inference.choices import AugmentMode, FrameMode, Output, Pose, choices
 from curve_vae.progress import bar, counted, shown
 
 
@@ -21,97 +27,151 @@ def cmd_sample(a: argparse.Namespace) -> int:
     from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
-    runtime = model_runtime(a)
     seed = fresh_seed() if a.seed is None else a.seed
-    made = runtime.sample(
-        a.count, seed=seed, temperature=a.temperature, prior=a.prior, valid=a.valid, n_points=a.n_points
-    )
-    body = with_output(sample_body(made, metrics=a.metrics), made.splines, a.output_as)
+    if a.server:  # the same request to a deployment: its body is what this command writes
+        with server_client(a) as c:
+            kw = {"temperature": a.temperature, "prior": a.prior, "valid": a.valid, "n_points": a.n_points}
+            made = c.sample(a.count, seed=seed, **kw, output=a.output_as, metrics=a.metrics or None)
+            body = _sample_body_of(made, a.output_as, a.metrics)
+            prior, rejected, points = made.prior, made.rejected, np.shape(made.curves)[1]
+    else:
+        runtime = model_runtime(a)
+        made = runtime.sample(
+            a.count, seed=seed, temperature=a.temperature, prior=a.prior, valid=a.valid, n_points=a.n_points
+        )
+        body = with_output(sample_body(made, metrics=a.metrics), made.splines, a.output_as)
+        prior, rejected, points = made.prior, made.rejected, made.curves.shape[1]
     write_output(a.output, body, array_key="curves" if "curves" in body else None)
     print(
-        f"{a.output}: {a.count} curves of {made.curves.shape[1]} points from the {made.prior} prior, seed {seed}; "
-        f"{made.rejected} draws rejected and drawn again",
+        f"{a.output}: {a.count} curves of {points} points from the {prior} prior, seed {seed}; "
+        f"{rejected} draws rejected and drawn again",
         file=sys.stderr,
     )
     return 0
 
 
-def cmd_augment(a: argparse.Namespace) -> int:
-    import numpy as np
+def _sample_body_of(made: Any, output: str, metrics: bool) -> dict[str, Any]:
+    """A client's Sampled as the JSON body the endpoint answered (and the local command writes)."""
+    body: dict[str, Any] = {"latents": made.latents.tolist()}
+    if output != "bspline":
+        body["curves"] = np.asarray(made.curves).tolist()
+    body.update(seed=made.seed, offset=0, prior=made.prior, rejected=made.rejected, invalid=made.invalid)
+    if metrics:
+        body["metrics"] = made.metrics
+    if output != "points":
+        body["splines"] = made.splines
+    return body
 
+
+def cmd_augment(a: argparse.Namespace) -> int:
     from curve_vae.files import read_curves, write_npy_chunks, write_output
-    from curve_vae.inference.bodies import augment_body
-    from curve_vae.inference.reading import Reading
-    from curve_vae.inference.results import Augmented
     from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
-    runtime = model_runtime(a)
+    seeds = read_curves(a.input)
     seed = fresh_seed() if a.seed is None else a.seed
-    reading = Reading(frame=a.frame, pose=a.pose, spacing=a.spacing)
-    plan = runtime.plan_augment(read_curves(a.input), mode=a.mode, seed=seed, neighbours=a.neighbours, reading=reading)
-    start, stop = a.offset, a.offset + a.count
-    step = runtime.graphs.batch_size
-    spacing = runtime.reading(reading).spacing
+    if a.output.endswith(".npy") and a.metrics:
+        raise ValueError("--metrics needs a JSON output: a .npy file holds the curves alone")
     with bar(a.count, "augment", enabled=shown(a.no_progress)) as progress:
-        if a.output.endswith(".npy"):  # streamed chunk by chunk: any count in bounded memory
-            if a.metrics:
-                raise ValueError("--metrics needs a JSON output: a .npy file holds the curves alone")
-            shape = (a.count, runtime.mix_length(plan.prep, a.n_points), 2)
-            chunks = runtime.augment_chunks(plan, start, stop, n_points=a.n_points, spacing=spacing, chunk=step)
-            write_npy_chunks(a.output, shape, counted(chunks, progress))
+        if a.server:
+            with server_client(a) as c:
+                chunks = _remote_chunks(a, c, seeds, seed)
+                shape, body = _write_augment(a, chunks, progress, seed, write_npy_chunks)
         else:
-            parts = []  # chunk by chunk for the bar; a count of 0 still makes one (empty) chunk of the right shapes
-            for i in range(start, stop, step) or [start]:
-                parts.append(runtime.augment(plan, i, min(i + step, stop), n_points=a.n_points, spacing=spacing))
-                progress.update(len(parts[-1].curves))
-            made = Augmented(
-                np.concatenate([p.curves for p in parts]),
-                [f for p in parts for f in p.frames],
-                None,
-                sources=np.concatenate([p.sources for p in parts]),
-                weights=np.concatenate([p.weights for p in parts]),
-                seed=seed,
-                offset=a.offset,
-            )
-            shape = made.curves.shape
-            write_output(a.output, augment_body(made, metrics=a.metrics))
+            chunks = _local_chunks(a, model_runtime(a), seeds, seed)
+            shape, body = _write_augment(a, chunks, progress, seed, write_npy_chunks)
+    if body is not None:
+        write_output(a.output, body)
     print(f"{a.output}: {a.count} new curves of {shape[1]} points ({a.mode}s), seed {seed}", file=sys.stderr)
     return 0
 
 
-def cmd_fit(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curves, write_output
-    from curve_vae.inference.bodies import fit_body
+def _local_chunks(a: argparse.Namespace, runtime: Any, seeds: list, seed: int) -> Any:
+    """(count, chunks of Augmented): the local model's sequence, batch_size items a chunk."""
+    from curve_vae.inference.reading import Reading
 
-    refuse_overwrite(a.output, a.force)
-    body = fit_body(read_curves(a.input), a.n_ctrl, param=a.param, n_points=a.n_points, tolerance=a.tolerance)
-    write_output(a.output, body)
-    for i, f in enumerate(body["fits"]):
-        print(
-            f"curve {i}: {f['n_ctrl']} control points, rms error {f['rms_error']:.4g}, max {f['max_error']:.4g}",
-            file=sys.stderr,
+    reading = Reading(frame=a.frame, pose=a.pose, spacing=a.spacing)
+    plan = runtime.plan_augment(seeds, mode=a.mode, seed=seed, neighbours=a.neighbours, reading=reading)
+    spacing, step = runtime.reading(reading).spacing, runtime.graphs.batch_size
+    length = runtime.mix_length(plan.prep, a.n_points)
+    stop = a.offset + a.count
+    made = (
+        runtime.augment(plan, i, min(i + step, stop), n_points=a.n_points, spacing=spacing)
+        for i in range(a.offset, stop, step)
+    )
+    return length, made
+
+
+def _remote_chunks(a: argparse.Namespace, c: Any, seeds: list, seed: int) -> Any:
+    """The same sequence from a server: .npy chunks for a .npy file, JSON pages (with sources and weights) else."""
+    fields = {
+        "mode": a.mode,
+        "neighbours": a.neighbours,
+        "frame": a.frame,
+        "pose": a.pose,
+        "spacing": a.spacing,
+        "n_points": a.n_points,
+    }
+    if a.output.endswith(".npy"):
+        made = c.augment_chunks(seeds, a.count, seed=seed, offset=a.offset, chunk=4096, **fields)
+    else:
+        page = int(c.model()["limits"]["max_curves"])
+        made = (
+            c.augment(
+                seeds, min(page, a.offset + a.count - o), seed=seed, offset=o, metrics=a.metrics or None, **fields
+            )
+            for o in range(a.offset, a.offset + a.count, page)
         )
-    return 0
+    first = next(made, None)
+    length = int(np.shape(first.curves)[1]) if first is not None else a.n_points or 161
+
+    def chained() -> Any:
+        if first is not None:
+            yield first
+            yield from made
+
+    return length, chained()
 
 
-def cmd_revolve(a: argparse.Namespace) -> int:
-    from curve_vae.files import atomic_path, read_curves
-    from curve_vae.geometry import revolve
+def _write_augment(a: argparse.Namespace, chunks: Any, progress: Any, seed: int, write_npy: Any) -> tuple:
+    """Write the chunks: streamed into a .npy file, or gathered into the JSON body /augment answers."""
+    from curve_vae.inference.bodies import frames_json
 
-    refuse_overwrite(a.output, a.force)
-    curves = read_curves(a.input)
-    if len(curves) != 1:
-        raise ValueError(f"{a.input}: revolve takes one profile curve, got {len(curves)}")
-    mesh = revolve(curves[0], segments=a.segments, axis=a.axis, axis_position=a.axis_position)
-    fmt = a.format or ("stl" if a.output.endswith(".stl") else "obj")
-    with atomic_path(a.output) as tmp:
-        if fmt == "stl":
-            tmp.write_bytes(mesh.to_stl())
-        else:
-            tmp.write_text(mesh.to_obj(comment=f"curve-vae revolve: {len(curves[0])}-point profile"))
-    print(f"{a.output}: {len(mesh.vertices)} vertices, {len(mesh.faces)} triangles ({fmt})", file=sys.stderr)
-    return 0
+    length, made = chunks
+    shape = (a.count, length, 2)
+    if a.output.endswith(".npy"):  # streamed chunk by chunk: any count in bounded memory
+        write_npy(a.output, shape, counted((np.asarray(m.curves) for m in made), progress))
+        return shape, None
+    parts = []
+    for m in made:
+        parts.append(m)
+        progress.update(len(m.curves))
+    body: dict[str, Any] = {
+        "curves": [c for m in parts for c in np.asarray(m.curves).tolist()],
+        "sources": [s for m in parts for s in np.asarray(m.sources).tolist()],
+        "weights": [w for m in parts for w in np.asarray(m.weights).tolist()],
+        "frames": _frames(parts, frames_json),
+        "seed": seed,
+        "offset": a.offset,
+    }
+    if a.metrics:
+        body["metrics"] = [x for m in parts for x in (m.metrics or _metrics(m))]
+    return shape, body
+
+
+def _frames(parts: list, frames_json: Any) -> Any:
+    """The frames of every part: the runtime's Frames, or a server's JSON frames."""
+    if not parts or parts[0].frames is None or parts[0].frames == [] or parts[0].frames[0] is None:
+        return None
+    if isinstance(parts[0].frames[0], dict):
+        return [f for m in parts for f in m.frames]
+    return frames_json([f for m in parts for f in m.frames])
+
+
+def _metrics(made: Any) -> list:
+    from curve_vae.inference.runtime import curve_metrics
+
+    return curve_metrics(made.curves)
 
 
 def _add_sample(sub: argparse._SubParsersAction) -> None:
@@ -139,6 +199,7 @@ def _add_sample(sub: argparse._SubParsersAction) -> None:
         help="curves as points, as B-splines (control points, knots, params), or both; JSON only (default: points)",
     )
     add_model_options(s)
+    add_server_option(s)
     s.set_defaults(func=cmd_sample)
 
 
@@ -165,56 +226,10 @@ def _add_augment(sub: argparse._SubParsersAction) -> None:
         "reading; new curves come back in their sources' poses) (default: auto)",
     )
     add_model_options(s)
+    add_server_option(s)
     s.set_defaults(func=cmd_augment)
-
-
-def _add_fit(sub: argparse._SubParsersAction) -> None:
-    s = sub.add_parser("fit", help="least-squares cubic B-spline of each curve (no model needed)")
-    s.add_argument("input", help="curves: .json ([[x, y], …], a list of curves, or {curves: …}), .npy, or - (stdin)")
-    s.add_argument("-o", "--output", default="-", help="JSON output file (default: - = stdout)")
-    s.add_argument(
-        "--n-ctrl",
-        type=int,
-        default=None,
-        help="control points (default: the fewest, from 4 up, whose RMS error is within --tolerance)",
-    )
-    s.add_argument(
-        "--tolerance",
-        type=float,
-        default=1e-3,
-        help="without --n-ctrl: RMS fit error to reach, as a fraction of the bounding-box diagonal (default: 0.001)",
-    )
-    s.add_argument(
-        "--param",
-        choices=choices(FitParam),
-        default="chord",
-        help="parameter of each point: chord length (any curve) or uniform (the "
-        "data set's sampling; recovers its B-splines exactly) (default: chord)",
-    )
-    s.add_argument("--n-points", type=int, default=None, help="also write each fitted spline at this many points")
-    s.set_defaults(func=cmd_fit)
-
-
-def _add_revolve(sub: argparse._SubParsersAction) -> None:
-    s = sub.add_parser("revolve", help="surface of revolution of a profile curve, as OBJ or STL (paper Fig. 12)")
-    s.add_argument("input", help="one profile curve: .json, .npy, or - (stdin)")
-    s.add_argument("-o", "--output", required=True, help="mesh file (.obj or .stl)")
-    s.add_argument("--format", choices=choices(MeshFormat), default="", help="default: from the file name")
-    s.add_argument("--segments", type=int, default=64, help="angular resolution (default: 64)")
-    s.add_argument(
-        "--axis", choices=choices(Axis), default="y", help="revolve about a vertical (y) or horizontal (x) line"
-    )
-    s.add_argument(
-        "--axis-position",
-        type=float,
-        default=None,
-        help="where that line is (default: through the profile's nearest point)",
-    )
-    s.set_defaults(func=cmd_revolve)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     _add_sample(sub)
     _add_augment(sub)
-    _add_fit(sub)
-    _add_revolve(sub)

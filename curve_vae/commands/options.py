@@ -141,3 +141,22 @@ def model_runtime(a: argparse.Namespace):
 
     model_dir = model_directory(a.model_dir)
     return CurveRuntime.load(model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)
+
+
+def add_server_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--server",
+        default="",
+        metavar="URL",
+        help="run against a curve-vae service at URL instead of the local model (the same output; an API key from "
+        "CURVE_VAE_API_KEY) (default: the local model)",
+    )
+
+
+def server_client(a: argparse.Namespace):
+    """A client of --server, with the key of CURVE_VAE_API_KEY."""
+    import os
+
+    from curve_vae.client import Client
+
+    return Client(a.server, api_key=os.environ.get("CURVE_VAE_API_KEY") or None)

@@ -9,7 +9,7 @@ from fastapi import APIRouter, Body, Request
 from fastapi.responses import Response
 
 from curve_vae.geometry import revolve
-from curve_vae.inference.bodies import fit_body
+from curve_vae.inference.bodies import fit_body, mesh_file
 from curve_vae.inference.errors import InputError
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
@@ -128,14 +128,7 @@ async def revolve_profile(
         if req.format == "stl" and not (np.abs(mesh.vertices) <= np.finfo(np.float32).max).all():
             raise InputError(("curve",), "the mesh does not fit in STL's float32: scale the profile down")
         closed = all(uses == 2 for uses in mesh.edge_use().values())
-        if req.format == "stl":
-            with np.errstate(all="ignore"):  # normals of huge triangles: STL readers recompute them
-                content: bytes | str = mesh.to_stl()
-        else:
-            content = mesh.to_obj(
-                comment=f"curve-vae surface of revolution: {len(profile)}-point profile, "
-                f"{req.segments} segments about the {req.axis} axis"
-            )
+        content = mesh_file(mesh, points=len(profile), segments=req.segments, axis=req.axis, fmt=req.format)
         headers = {
             "X-Mesh-Vertices": str(len(mesh.vertices)),
             "X-Mesh-Faces": str(len(mesh.faces)),
