@@ -81,7 +81,9 @@ def _notes(r: dict[str, Any]) -> list[str]:
             "",
             f"/augment, {g['count']:,} curves (8 seeds, the default request): JSON in pages of 256 "
             f"{g['json_s']:.2f} s ({g['json_cps']:.0f} curves/s); one .npy stream {g['npy_s']:.2f} s "
-            f"({g['npy_cps']:.0f} curves/s).",
+            f"({g['npy_cps']:.0f} curves/s); the client's iterator (`Client.augment_chunks`, .npy chunks of 4096) "
+            f"{g['client_s']:.2f} s ({g['client_cps']:.0f} curves/s, {g['client_cps'] / g['npy_cps']:.2f}× the "
+            "stream).",
         ]
     return lines
 

@@ -135,7 +135,10 @@ def post(url: str, body: bytes) -> bytes:
 
 
 def augment(server: Server, seeds: np.ndarray, count: int) -> dict[str, float]:
-    """Seconds for `count` curves from /augment: JSON paged by offset (max_curves a page), and one .npy stream."""
+    """Seconds for `count` curves from /augment: JSON paged by offset (max_curves a page), one .npy stream, and the
+    client's iterator (curve_vae.client.Client.augment_chunks: .npy chunks of 4096, parsed into arrays)."""
+    from curve_vae.client import Client
+
     page = 256
     start = time.perf_counter()
     got = 0
@@ -146,9 +149,24 @@ def augment(server: Server, seeds: np.ndarray, count: int) -> dict[str, float]:
     json_s = time.perf_counter() - start
     start = time.perf_counter()
     data = post(f"{server.url}/augment", json_body(seeds, count=count, seed=1, format="npy"))
+    streamed = np.load(io.BytesIO(data))
     npy_s = time.perf_counter() - start
-    assert got == count and np.load(io.BytesIO(data)).shape[0] == count
-    return {"count": count, "json_s": json_s, "npy_s": npy_s, "json_cps": count / json_s, "npy_cps": count / npy_s}
+    with Client(server.url) as c:
+        c.model()
+        start = time.perf_counter()
+        chunks = [a.curves for a in c.augment_chunks(list(seeds), count, seed=1, chunk=4096)]
+        client_s = time.perf_counter() - start
+    assert got == count and streamed.shape[0] == count
+    assert np.array_equal(np.concatenate(chunks), streamed)  # the same curves, whatever the chunks
+    return {
+        "count": count,
+        "json_s": json_s,
+        "npy_s": npy_s,
+        "client_s": client_s,
+        "json_cps": count / json_s,
+        "npy_cps": count / npy_s,
+        "client_cps": count / client_s,
+    }
 
 
 # --------------------------------------------------------------------------- the report

@@ -12,7 +12,7 @@ import argparse
 import sys
 
 from curve_vae import __version__
-from curve_vae.commands import curves, data, design, generate, model, train
+from curve_vae.commands import curves, data, design, generate, model, priors, train
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -21,7 +21,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"curve-vae {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for group in (data, train, model, curves, generate, design):
+    for group in (data, train, model, curves, generate, design, priors):
         group.register(sub)
 
     s = sub.add_parser("serve", help="run the REST service on a model directory")
@@ -43,6 +43,8 @@ def build_parser() -> argparse.ArgumentParser:
         ("revolve", "the output file"),
         ("reconstruct", "the output file"),
         ("encode", "the output file"),
+        ("prior", "the prior's file"),
+        ("evaluate-prior", "the --out report"),
     ]:
         sub.choices[name].add_argument("--force", action="store_true", help=f"replace {what} if it exists")
     return p

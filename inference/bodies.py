@@ -52,6 +52,8 @@ def sample_body(made: Sampled, *, metrics: bool = False) -> dict[str, Any]:
         "prior": made.prior,
         "rejected": made.rejected,
         "invalid": made.invalid,
+        # a prior of users' curves places each curve in the frame of its nearest reference curve: say which
+        **({"frames": frames_json(made.frames)} if made.prior not in ("learned", "standard") else {}),
     }
     return with_metrics(body, made.curves, metrics)
 

@@ -38,6 +38,7 @@ from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.placing import check_finite, check_range, decoded_to_caller, joined, to_caller
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.priors import NamedPrior, load_priors
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import Augmented, Curves, Encoding, Interpolation, Reconstruction, Sampled
@@ -58,6 +59,7 @@ class CurveRuntime:
         closest: bool | None = None,
         cache: EncodingCache | None = None,
         model_dir: str | Path | None = None,
+        priors: dict[str, NamedPrior] | None = None,
     ) -> None:
         self.graphs = graphs
         self.manifest: Manifest = graphs.manifest
@@ -69,7 +71,8 @@ class CurveRuntime:
         self.cache = cache
         self.reader = Reader(graphs, closest=placed and graphs.has_splines, fitter=self.fitter, cache=cache)
         disc = np.asarray(self.manifest.frame.center, np.float64)
-        self.sampler = Sampler(graphs, prior, disc, self.manifest.disc_radius)
+        self.priors = priors or {}
+        self.sampler = Sampler(graphs, prior, disc, self.manifest.disc_radius, self.priors)
 
     @classmethod
     def load(
@@ -83,13 +86,15 @@ class CurveRuntime:
         sessions: SessionConfig | None = None,
         placement: str = "model",
         cache_bytes: int = DEFAULT_CACHE_BYTES,
+        priors_dir: str | Path | None = None,
     ) -> CurveRuntime:
         """Open a model directory; ModelLoadError says what to fix when it cannot serve.
 
         `sessions` sets threads, spinning and the number of session pairs (inference.sessions); without it, one
         pair of `intra_op_threads` threads. `placement`: "model" places a reconstruction's points as the manifest's
         spline.placement says; "closest" or "index" whatever it says (CURVE_VAE_PLACEMENT). `cache_bytes`: the
-        encoding cache's bound (0: no cache)."""
+        encoding cache's bound (0: no cache). `priors_dir`: priors fitted to users' curves (`curve-vae prior`), by
+        their files' stems; one fitted to another model is a ModelLoadError."""
         root = Path(model_dir)
         manifest = Manifest.read(root)
         if placement not in ("model", "closest", "index"):
@@ -114,7 +119,8 @@ class CurveRuntime:
         )
         closest = None if placement == "model" else placement == "closest"
         cache = EncodingCache(cache_bytes) if cache_bytes > 0 else None
-        return cls(graphs, prior=prior, closest=closest, cache=cache, model_dir=root)
+        named = load_priors(priors_dir, manifest, manifest.latent_dim)
+        return cls(graphs, prior=prior, closest=closest, cache=cache, model_dir=root, priors=named)
 
     # ----------------------------------------------------------------------- what the model is
 
@@ -298,9 +304,16 @@ class CurveRuntime:
         drawn = self.sampler.draw(
             count, seed=root, temperature=temperature, prior=prior, valid=valid, max_draws=max_draws, offset=offset
         )
-        frames = [frame] * count if frame else None
+        frames: list[Frame] | None = [frame] * count if frame else None
+        out, ctrl = drawn.decoded, drawn.ctrl
+        named = self.priors.get(drawn.prior)
+        if named is not None:  # a user's family: each sample in the frame of its nearest reference curve
+            if frames is None and named.reference.frames.size:
+                frames = [named.reference.frame(int(i)) for i in named.nearest(drawn.latents)]
+            if named.closed:  # loops stay loops
+                out, ctrl = _closed_rows(out, ctrl)
         placed = decoded_to_caller(
-            self.graphs, drawn.decoded, drawn.ctrl, drawn.params, frames=frames, n_points=n_points, spacing=spacing
+            self.graphs, out, ctrl, drawn.params, frames=frames, n_points=n_points, spacing=spacing
         )
         return Sampled(
             placed.curves,
@@ -366,6 +379,13 @@ def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:
             length = _number(curve_length(c))
         out.append({"smoothness": smooth, "self_intersects": bool(self_intersects(c)), "length": length})
     return out
+
+
+def _closed_rows(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """Decoded rows (and control points) each with its ends joined (placing.joined)."""
+    rows = [joined(o, None if ctrl is None else ctrl[i]) for i, o in enumerate(out)]
+    closed_out = np.stack([o for o, _ in rows]).astype(np.float32)
+    return closed_out, None if ctrl is None else np.stack([c for _, c in rows]).astype(np.float32)
 
 
 def _common_length(prep: Prepared) -> int | None:

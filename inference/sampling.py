@@ -16,6 +16,7 @@ from curve_vae.geometry import self_intersects
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.priors import NamedPrior
 
 MAX_DRAWS = 10  # per sampled curve: the shipped prior rejects 25% of draws, so 10 fail with probability ~1e-6;
 # and a distribution that rejects almost everything (the standard prior) costs at most 10 decodes a curve
@@ -38,9 +39,17 @@ class Sampler:
     """Draws from a model's latent priors through its decoder; valid curves stay inside a disc of the model plane
     (the paper's curves: their control points' radius-64 disc about the centre) and never cross themselves."""
 
-    def __init__(self, graphs: ModelGraphs, prior: LatentPrior | None, disc_center: np.ndarray, disc_radius: float):
+    def __init__(
+        self,
+        graphs: ModelGraphs,
+        prior: LatentPrior | None,
+        disc_center: np.ndarray,
+        disc_radius: float,
+        named: dict[str, NamedPrior] | None = None,
+    ):
         self.graphs = graphs
         self.prior = prior
+        self.named = named or {}  # priors fitted to users' curves (inference.priors), by name
         self.disc_center = np.asarray(disc_center, np.float64)
         self.disc_radius = float(disc_radius)
 
@@ -58,11 +67,12 @@ class Sampler:
         """`count` curves decoded from latents of a distribution.
 
         prior "learned": the Gaussian mixture fitted to the training curves' latent means (the default where the
-        model ships one); "standard": the VAE's N(0, I). temperature scales the spread (see inference/prior.py).
-        valid: a draw whose curve crosses itself or leaves the disc is rejected and item i draws again, at most
-        max_draws times in all. Item i's draws come from its own generator default_rng([seed, i]), so the seed
-        decides every curve, across rejections too, and the first items of a larger count are those of a smaller;
-        `offset` starts the sequence at item offset, so pages of it are the curves of one larger request.
+        model ships one); "standard": the VAE's N(0, I); any other: a prior fitted to a user's curves
+        (inference.priors), its validity judged against its own reference curves. temperature scales the spread
+        (see inference/prior.py). valid: a draw whose curve crosses itself or leaves the region of the data is
+        rejected and item i draws again, at most max_draws times in all. Item i's draws come from its own generator
+        default_rng([seed, i]), so the seed decides every curve, across rejections too; `offset` starts the
+        sequence at item offset, so pages of it are the curves of one larger request.
         """
         g = self.graphs
         chosen = prior or ("learned" if self.prior is not None else "standard")
@@ -70,11 +80,16 @@ class Sampler:
             raise InputError(
                 ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
             )
+        if chosen not in ("learned", "standard") and chosen not in self.named:
+            known = ", ".join(["learned", "standard", *self.named])
+            raise InputError(("prior",), f"no prior named {chosen!r} on this server; it has: {known} (GET /model)")
         rngs = [np.random.default_rng([seed, i]) for i in range(offset, offset + count)]
-        learned = self.prior
+        named = self.named.get(chosen)
+        learned = named.mixture if named is not None else self.prior
+        plausible = named.plausible if named is not None else self.plausible
 
         def one(i: int) -> np.ndarray:
-            if chosen == "learned":
+            if chosen != "standard":
                 assert learned is not None
                 return learned.draw(rngs[i], temperature)
             return rngs[i].standard_normal(g.latent_dim) * temperature
@@ -94,7 +109,7 @@ class Sampler:
                 params[todo] = par
             if not valid:
                 break
-            good = self.plausible(decoded.astype(np.float64))
+            good = plausible(decoded.astype(np.float64))
             ok[todo[good]] = True
             todo = todo[~good & (draws[todo] < max_draws)]
             for i in todo:

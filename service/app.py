@@ -113,6 +113,7 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
                 sessions=config,
                 placement=settings.placement,
                 cache_bytes=settings.cache_bytes,
+                priors_dir=settings.priors_dir,
             )
         )
     except ModelLoadError as e:

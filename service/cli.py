@@ -57,6 +57,7 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--access-log", "access_log", str, "true: log a line per request (uvicorn's access log)"),
     ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
     ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
+    ("--priors-dir", "priors_dir", str, "directory of priors fitted with `curve-vae prior` (NAME.npz: prior NAME)"),
     ("--cache-bytes", "cache_bytes", int, "bytes of the encoding cache (curves posted again skip the encoder); 0: off"),
 ]
 _CHOICES = {

@@ -85,6 +85,11 @@ class SampleResponse(CurvesResponse):
     latents: list[list[float]] = Field(description="The latent vector each curve was decoded from.")
     seed: int = Field(description="The seed used: the request's, or the one drawn for it.")
     offset: int = Field(0, description="Index of the first returned curve in the seeded sequence.")
+    frames: list[FrameInfo] | None = Field(
+        None,
+        description="With a prior fitted to users' curves: the frame each curve came back in (its nearest "
+        "reference curve's: their position, size and orientation).",
+    )
     prior: str = Field(description="The distribution the latents were drawn from: learned, standard or a named prior.")
     rejected: int = Field(description="Draws rejected (self-intersecting or outside the disc) and drawn again.")
     invalid: int = Field(description="Curves still invalid after 10 draws each (returned as drawn; normally 0).")
@@ -155,6 +160,11 @@ class ModelInfo(BaseModel):
     )
     prior: dict[str, Any] | None = Field(
         None, description="The learned latent distribution /sample draws from by default, when the model ships one."
+    )
+    priors: dict[str, dict[str, Any]] = Field(
+        default_factory=dict,
+        description="Priors fitted to users' curves that /sample's `prior` may name (CURVE_VAE_PRIORS_DIR): "
+        "components, curves, whether they are closed, the reading they were fitted with.",
     )
     spline: dict[str, Any] | None = Field(
         None,

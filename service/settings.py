@@ -59,6 +59,9 @@ class Settings(BaseSettings):
     # Bytes the encoding cache may hold (inference/cache.py): curves posted again — the page's slider, a pipeline's
     # seed curves and retries — skip the encoder; 0 turns it off. ~3.4 KB a curve of 161 points.
     cache_bytes: int = Field(64 << 20, ge=0)
+    # Priors fitted to users' curves (`curve-vae prior -o DIR/NAME.npz`), loaded at start: /sample's prior "NAME".
+    # One fitted to another model than the one served stops the start with a message naming both.
+    priors_dir: Path | None = None
     # Where a reconstruction's points go: "model", as the model's manifest says (spline.placement: the shipped model
     # "closest", each input point at its closest point on the curve, kept in order); "index", the model's own points
     # (docs/RESULTS.md compares the two); or "closest".

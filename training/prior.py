@@ -7,6 +7,8 @@ own (1.00×), in a 4-second fit; 32 gain little more (scripts/prior_components.p
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from curve_vae.inference.prior import LatentPrior
@@ -26,3 +28,103 @@ def fit_prior(latents: np.ndarray, *, components: int = COMPONENTS, seed: int = 
         means=gm.means_,
         cholesky=np.linalg.cholesky(gm.covariances_),
     )
+
+
+#: Most components `curve-vae prior` tries when it chooses their number by BIC.
+MAX_COMPONENTS = 10
+
+
+def fit_by_bic(
+    latents: np.ndarray, *, components: int | None = None, max_components: int = MAX_COMPONENTS, seed: int = 0
+) -> tuple[LatentPrior, dict[int, float]]:
+    """A full-covariance Gaussian mixture of latents (N, Z): `components` of them, or the count from 1 to
+    `max_components` (and at most one per 20 latents) with the lowest Bayesian information criterion; the prior and
+    the BIC of each count tried."""
+    from sklearn.mixture import GaussianMixture
+
+    x = np.asarray(latents, np.float64)
+    counts = [components] if components else list(range(1, max(1, min(max_components, len(x) // 20)) + 1))
+    fits, bic = {}, {}
+    for k in counts:
+        gm = GaussianMixture(k, covariance_type="full", reg_covar=1e-4, random_state=seed, max_iter=300).fit(x)
+        fits[k], bic[k] = gm, float(gm.bic(x))
+    best = fits[min(bic, key=bic.__getitem__)]
+    prior = LatentPrior(best.weights_ / best.weights_.sum(), best.means_, np.linalg.cholesky(best.covariances_))
+    return prior, bic
+
+
+#: Manifold Parzen windows (Vincent & Bengio 2003) over a user's curves' latents: one component per curve, its
+#: covariance its NEIGHBOURS nearest latents' spread about it, scaled by PARZEN_SCALE² (measured on UIUC airfoils,
+#: docs/RESULTS.md: samples as close to held-out airfoils as the training ones, 2% near-copies).
+NEIGHBOURS = 5
+PARZEN_SCALE = 0.3
+#: Fitting steps on each of a user's curves before its latent joins the prior: the decoder's best latent for it.
+PRIOR_REFINE = 10
+
+
+def fit_parzen(latents: np.ndarray, *, neighbours: int = NEIGHBOURS, scale: float = PARZEN_SCALE) -> LatentPrior:
+    """A mixture of one Gaussian per latent (N, Z), its covariance the spread of its `neighbours` nearest latents
+    about it × scale², plus 1e-6·I: samples stay along the data's own directions."""
+    z = np.asarray(latents, np.float64)
+    d = ((z[:, None] - z[None]) ** 2).sum(-1)
+    np.fill_diagonal(d, np.inf)
+    near = np.argsort(d, axis=1)[:, : min(neighbours, len(z) - 1)]
+    diffs = z[near] - z[:, None]  # (N, k, Z)
+    cov = np.einsum("nki,nkj->nij", diffs, diffs) / near.shape[1] * scale**2 + 1e-6 * np.eye(z.shape[1])
+    return LatentPrior(np.full(len(z), 1.0 / len(z)), z, np.linalg.cholesky(cov))
+
+
+def fit_named_prior(
+    runtime: object,
+    curves: list[np.ndarray],
+    *,
+    name: str,
+    kind: str = "parzen",
+    components: int | None = None,
+    refine: int = PRIOR_REFINE,
+    seed: int = 0,
+    source: str = "",
+) -> object:
+    """The NamedPrior (inference/priors.py) of a user's curves: read with the model's default reading and `refine`
+    fitting steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
+    BIC) — and the reference statistics its samples are placed and judged by."""
+    from curve_vae.geometry import self_intersects
+    from curve_vae.geometry.adapt import is_closed
+    from curve_vae.geometry.frame import MODEL_CENTER
+    from curve_vae.inference.priors import NamedPrior, Reference, frames_array, model_identity
+    from curve_vae.inference.reading import Reading
+
+    rt: Any = runtime
+    reading = rt.reading(Reading(refine=refine))
+    prep = rt.prepare(curves, reading)
+    latents = prep.mean.astype(np.float64)
+    decoded = np.stack([r.decoded for r in prep.rows]).astype(np.float64)
+    closed = [is_closed(c) for c in prep.inputs]
+    reach = float(np.linalg.norm(decoded - np.asarray(MODEL_CENTER), axis=-1).max())
+    reference = Reference(
+        latents,
+        frames_array(prep.frames, closed) if prep.frames[0] is not None else np.zeros((len(latents), 7)),
+        reach,
+        float(self_intersects(decoded).mean()),
+        float(np.mean(closed)),
+    )
+    if kind == "parzen":
+        mixture, fit = fit_parzen(latents), {"neighbours": NEIGHBOURS, "scale": PARZEN_SCALE}
+        chosen = f"one component per curve (manifold Parzen windows, {NEIGHBOURS} neighbours, scale {PARZEN_SCALE})"
+    elif kind == "gmm":
+        mixture, bic = fit_by_bic(latents, components=components, seed=seed)
+        fit = {"bic": {str(k): v for k, v in bic.items()}}
+        chosen = "given" if components else f"BIC over {', '.join(map(str, bic))} components"
+    else:
+        raise ValueError(f"kind must be parzen or gmm, got {kind!r}")
+    meta = {
+        "kind": kind,
+        "reading": {"pose": reading.pose, "spacing": reading.spacing, "refine": reading.refine},
+        "components": len(mixture.weights),
+        "chosen_by": chosen,
+        **fit,
+        "source": source,
+        "model_name": rt.manifest.name,
+        "model_version": rt.manifest.version,
+    }
+    return NamedPrior(name, mixture, reference, model_identity(rt.manifest), meta)

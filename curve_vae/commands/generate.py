@@ -198,6 +198,7 @@ def _add_sample(sub: argparse._SubParsersAction) -> None:
         default="points",
         help="curves as points, as B-splines (control points, knots, params), or both; JSON only (default: points)",
     )
+    s.add_argument("--priors-dir", default="", help="priors fitted with `curve-vae prior`, for --prior NAME")
     add_model_options(s)
     add_server_option(s)
     s.set_defaults(func=cmd_sample)

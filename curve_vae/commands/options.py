@@ -135,12 +135,15 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar (none either when not on a terminal)")
 
 
-def model_runtime(a: argparse.Namespace):
+def model_runtime(a: argparse.Namespace, priors_dir: Path | None = None):
     from curve_vae.inference.models import model_directory
     from curve_vae.inference.runtime import CurveRuntime
 
     model_dir = model_directory(a.model_dir)
-    return CurveRuntime.load(model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False)
+    priors = priors_dir or (getattr(a, "priors_dir", "") or None)
+    return CurveRuntime.load(
+        model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False, priors_dir=priors
+    )
 
 
 def add_server_option(p: argparse.ArgumentParser) -> None:

@@ -63,6 +63,7 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
         "model_size": runtime.model_size,
         "reading": m.reading.model_dump(include={"pose", "spacing"}),
         "prior": m.prior.model_dump(include={"kind", "components", "fitted_on"}) if m.prior else None,
+        "priors": {name: p.describe() for name, p in runtime.priors.items()},
         "spline": (
             {"n_ctrl": m.spline.n_ctrl, "degree": m.spline.degree, "knots": runtime.graphs.knots.tolist()}
             | {
