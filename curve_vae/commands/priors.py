@@ -81,7 +81,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("prior", help="fit a latent prior to your own curves: /sample makes more like them")
     s.add_argument("--curves", required=True, help="a curve file, or a directory of .npy/.csv/.json/.dat files")
     s.add_argument("-o", "--output", required=True, help="the prior, NAME.npz (its name is the file's stem)")
-    s.add_argument("--components", type=int, default=None, help="mixture components (default: chosen by BIC, 1 to 10)")
+    s.add_argument(
+        "--kind",
+        choices=["parzen", "gmm"],
+        default="parzen",
+        help="parzen: one component per curve along its neighbours' directions; gmm: a Gaussian mixture whose size "
+        "BIC chooses (default: parzen)",
+    )
+    s.add_argument(
+        "--components", type=int, default=None, help="with --kind gmm: components (default: chosen by BIC, 1 to 10)"
+    )
+    s.add_argument("--refine", type=int, default=10, help="fitting steps on each curve's latent first (default: 10)")
     s.add_argument("--seed", type=int, default=0, help="seed of the mixture's fit (default: 0)")
     add_model_options(s)
     s.set_defaults(func=cmd_prior)
