@@ -51,17 +51,20 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
     from curve_vae.inference.evaluate_prior import evaluate_prior, format_report
     from curve_vae.inference.priors import NamedPrior
 
-    prior = NamedPrior.load(a.prior)
-    runtime = model_runtime(a, priors_dir=Path(a.prior).parent)
+    builtin = a.prior in ("learned", "standard")
+    prior = None if builtin else NamedPrior.load(a.prior)
+    runtime = model_runtime(a, priors_dir=None if builtin else Path(a.prior).parent)
     held_out = read_curve_files(a.curves)
     if a.train:
         train = read_curve_files(a.train)
-    else:  # the prior's own curves, as the model reconstructs them in their frames
+    elif prior is not None:  # the prior's own curves, as the model reconstructs them in their frames
         ref = prior.reference
         train = list(runtime.decode(ref.latents, frames=[ref.frame(i) for i in range(len(ref.latents))]).curves)
+    else:
+        raise ValueError(f"--prior {a.prior}: a built-in prior needs --train, the curves it was fitted to")
     report = evaluate_prior(
         runtime,
-        prior.name,
+        a.prior if builtin else prior.name,
         held_out,
         train,
         seeds=list(range(a.seeds)),
@@ -96,7 +99,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_model_options(s)
     s.set_defaults(func=cmd_prior)
     s = sub.add_parser("evaluate-prior", help="a prior's samples against held-out curves, with the field's metrics")
-    s.add_argument("--prior", required=True, help="the prior's file (NAME.npz, from curve-vae prior)")
+    s.add_argument(
+        "--prior", required=True, help="the prior's file (NAME.npz, from curve-vae prior), or learned / standard"
+    )
     s.add_argument("--curves", required=True, help="held-out curves: a file or a directory")
     s.add_argument(
         "--train",
