@@ -26,7 +26,7 @@ fi
 SRC=$(mktemp -d)
 trap 'rm -rf "$SRC"' EXIT
 cp -r "$REPO/curve_vae" "$SRC/"
-for d in geometry training service models; do ln -s "$REPO/$d" "$SRC/curve_vae/$d"; done
+for d in geometry inference training service models; do ln -s "$REPO/$d" "$SRC/curve_vae/$d"; done
 export PYTHONPATH=/tmp/site:$SRC
 cd "$SRC"  # not the checkout: python -m would import the checkout's curve_vae/ before the mapped one
 mix_version=()

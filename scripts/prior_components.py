@@ -52,7 +52,7 @@ def main() -> None:
             rt = CurveRuntime.load(scratch, providers="cpu")
             made = rt.sample(len(reference), seed=0, prior="learned", valid=False)
             q = sample_quality(made.curves, ds.test, reference)
-            rejected = 1 - rt.plausible(made.curves.astype(np.float64)).mean()
+            rejected = 1 - rt.sampler.plausible(made.curves.astype(np.float64)).mean()
             print(
                 f"| {k} | {q['self_intersecting']:.1%} | {rejected:.1%} | {q['size_vs_data']:.2f}× | "
                 f"{q['roughness']:.3f}° | {q['coverage_vs_real']:.2f}× | {q['precision_vs_real']:.2f}× | "

@@ -103,9 +103,9 @@ def interpolation(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps
 def matched_only(rt: Any, curves: list[np.ndarray]) -> float:
     """Mean relative RMSE of the plain reconstructions with each input point at its closest point on them: what
     refine's matching gives before any step (model plane: the frames are similarities, the ratio is the same)."""
-    prep = rt._refined(rt.prepare(curves), 0)
+    prep = rt.prepare(curves)  # a model placed closest: each row's feet are the points' matches
     targets = [f.to_model(c, rt.model_size) for f, c in zip(prep.frames, curves)]
-    fits = [evaluate_bspline(c, u) for c, u in zip(prep.ctrl, prep.feet)]
+    fits = [evaluate_bspline(r.ctrl, r.feet) for r in prep.rows]
     return float(relative_rmse(targets, fits).mean())
 
 
@@ -121,8 +121,7 @@ def basins(rt: Any, param: list[np.ndarray], arc: list[np.ndarray], steps: int) 
         for c in param:  # c: the curve at even parameters; its arc-length samples sit at these parameters
             u = (1 - alpha) * np.interp(even, arc_fractions(c), even) + alpha * even
             starts.append(np.stack([np.interp(u, even, c[:, 0]), np.interp(u, even, c[:, 1])], 1))
-        splines: list = []
-        rt.reconstruct(starts, Reading(refine=steps))
+        splines = rt.reconstruct(starts, Reading(refine=steps)).splines
         fits = []
         for sp, points in zip(splines, arc):
             u = closest_params(sp.control_points, points, np.full(len(points), 0.5), window=1.0)

@@ -1,7 +1,7 @@
 """Load and soak: concurrent clients send a mix of every endpoint to a real server on loopback, bounded in time.
 
-    .venv/bin/python scripts/soak.py --clients 32 --duration 60            # the figures of docs/RELIABILITY.md
-    .venv/bin/python scripts/soak.py --clients 8 --duration 5              # the short version CI runs
+    .venv/bin/python bench/soak.py --clients 32 --duration 60            # the figures of docs/RELIABILITY.md
+    .venv/bin/python bench/soak.py --clients 8 --duration 5              # the short version CI runs
 
 Starts `python -m curve_vae.service.cli` on a free loopback port (the shipped model unless --model-dir), warms
 every endpoint up, reads the server's resident memory, then runs the clients until the time or the

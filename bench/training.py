@@ -1,6 +1,6 @@
 """Training throughput of a VAE variant on this machine: curves/s per precision mode.
 
-    .venv/bin/python scripts/benchmark_training.py [--variant inception] [--steps 10] [--compile]
+    .venv/bin/python bench/training.py [--variant inception] [--steps 10] [--compile]
 
 Runs full training steps (forward, loss, backward, Adam) on a batch of 128 random curves,
 first fp32 then bf16 autocast (and torch.compile if asked), in one process, and prints

@@ -1,6 +1,6 @@
 """Inference speed of the decoder: the full layer stack vs the needed prefix (one run).
 
-    .venv/bin/python scripts/benchmark_decoder.py [--batch 256] [--repeats 10] [--threads 1]
+    .venv/bin/python bench/decoder.py [--batch 256] [--repeats 10] [--threads 1]
 
 Both paths of training/model.py's Decoder in eval mode on the same weights and latents:
 prints ms per batch, the ratio, and the largest difference of their outputs in pixels.

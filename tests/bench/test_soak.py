@@ -1,21 +1,19 @@
-"""The short version of scripts/soak.py: a few seconds of mixed concurrent traffic, no error, bounded memory."""
+"""The short version of bench/soak.py: a few seconds of mixed concurrent traffic, no error, bounded memory."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 
 import pytest
 
-from tests.helpers import ROOT, SHIPPED
+from tests.helpers import SHIPPED
 
 pytestmark = pytest.mark.integration
 
 
 def test_short_soak_has_no_errors(tmp_path, capsys):
-    spec = importlib.util.spec_from_file_location("soak", ROOT / "scripts" / "soak.py")
-    soak = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
-    spec.loader.exec_module(soak)  # type: ignore[union-attr]
+    from bench import soak
+
     out = tmp_path / "soak.json"
     args = ["--clients", "8", "--duration", "4", "--model-dir", str(SHIPPED), "--out", str(out)]
     assert soak.main(args) == 0, capsys.readouterr().out
