@@ -74,6 +74,16 @@ def fit_parzen(latents: np.ndarray, *, neighbours: int = NEIGHBOURS, scale: floa
     return LatentPrior(np.full(len(z), 1.0 / len(z)), z, np.linalg.cholesky(cov))
 
 
+def prior_reading(model: Any, refine: int) -> Any:
+    """How a prior's curves are read: in the canonical pose whatever the model's own (the search would read one
+    airfoil in one pose and its neighbour in another, and their latents would not lie together), at the model's own
+    spacing where it has one, else as given; with `refine` fitting steps."""
+    from curve_vae.inference.reading import Reading
+
+    spacing = "parameter" if model.spacing == "search" else model.spacing
+    return Reading(frame=model.frame, pose="canonical", spacing=spacing, refine=refine)
+
+
 def fit_named_prior(
     runtime: object,
     curves: list[np.ndarray],
@@ -85,17 +95,16 @@ def fit_named_prior(
     seed: int = 0,
     source: str = "",
 ) -> object:
-    """The NamedPrior (inference/priors.py) of a user's curves: read with the model's default reading and `refine`
-    fitting steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
+    """The NamedPrior (inference/priors.py) of a user's curves: read as `prior_reading` says, with `refine` fitting
+    steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
     BIC) — and the reference statistics its samples are placed and judged by."""
     from curve_vae.geometry import self_intersects
     from curve_vae.geometry.adapt import is_closed
     from curve_vae.geometry.frame import MODEL_CENTER
     from curve_vae.inference.priors import NamedPrior, Reference, frames_array, model_identity
-    from curve_vae.inference.reading import Reading
 
     rt: Any = runtime
-    reading = rt.reading(Reading(refine=refine))
+    reading = prior_reading(rt.reading(), refine)
     prep = rt.prepare(curves, reading)
     latents = prep.mean.astype(np.float64)
     decoded = np.stack([r.decoded for r in prep.rows]).astype(np.float64)
