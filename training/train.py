@@ -183,7 +183,7 @@ def _restore(
         parts.opt.load_state_dict(ckpt["optimizer"])
         if sched is not None and ckpt.get("scheduler") is not None:
             sched.load_state_dict(ckpt["scheduler"])
-        torch.setrng_state(ckpt["rng"]["torch"])
+        torch.set_rng_state(ckpt["rng"]["torch"])
         parts.gen.bit_generator.state = json.loads(ckpt["rng"]["numpy"])
         state = RunState(**ckpt["state"])
         proc.say(f"resumed {last} at epoch {state.epoch}/{cfg.epochs}")
