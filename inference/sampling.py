@@ -53,6 +53,11 @@ class Sampler:
         self.disc_center = np.asarray(disc_center, np.float64)
         self.disc_radius = float(disc_radius)
 
+    @property
+    def names(self) -> list[str]:
+        """The priors a request may name: learned where the model ships it, standard, and the loaded ones."""
+        return [*(["learned"] if self.prior is not None else []), "standard", *self.named]
+
     def draw(
         self,
         count: int,
@@ -80,8 +85,8 @@ class Sampler:
             raise InputError(
                 ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
             )
-        if chosen not in ("learned", "standard") and chosen not in self.named:
-            known = ", ".join(["learned", "standard", *self.named])
+        if chosen not in self.names:
+            known = ", ".join(self.names)
             raise InputError(("prior",), f"no prior named {chosen!r} on this server; it has: {known} (GET /model)")
         rngs = [np.random.default_rng([seed, i]) for i in range(offset, offset + count)]
         named = self.named.get(chosen)

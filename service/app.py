@@ -42,7 +42,7 @@ from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.access import ApiKeyMiddleware
 from curve_vae.service.errors import on_http_error, on_input_error, on_validation_error
-from curve_vae.service.limits import state_bounds
+from curve_vae.service.limits import name_priors, state_bounds
 from curve_vae.service.metrics import Metrics, MetricsMiddleware
 from curve_vae.service.middleware import BodyLimitMiddleware
 from curve_vae.service.oip import DEFAULT_SIGNATURES, signatures
@@ -256,6 +256,8 @@ def _openapi_of(app: FastAPI, settings: Settings) -> Callable[[], dict[str, Any]
             app.state.openapi_for = runtime_dim()
             schema = state_bounds(FastAPI.openapi(app), settings, runtime_dim())
             rt = app.state.runtime
+            if rt is not None:
+                name_priors(schema, rt.sampler.names)
             app.openapi_schema = describe(
                 schema, signatures(rt) if rt is not None else DEFAULT_SIGNATURES, settings.max_curves
             )

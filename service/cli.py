@@ -92,6 +92,8 @@ def settings_from_args(args: argparse.Namespace) -> Settings:
 def _as_env(settings: Settings) -> dict[str, str]:
     out = {}
     for name, value in settings.model_dump().items():
+        if value is None:  # unset stays unset (str(None) would be read back as the text "None")
+            continue
         out[f"CURVE_VAE_{name.upper()}"] = json.dumps(value) if isinstance(value, list) else str(value)
     return out
 

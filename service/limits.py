@@ -120,3 +120,13 @@ def state_bounds(schema: dict[str, Any], settings: Any, latent_dim: int | None) 
     if "InterpolateRequest" in comps:
         comps["InterpolateRequest"]["not"] = {"required": ["steps", "weights"]}
     return schema
+
+
+def name_priors(schema: dict[str, Any], names: list[str]) -> dict[str, Any]:
+    """/sample's `prior`: the names this server's model and priors folder offer, as the schema's enum."""
+    comps = schema.get("components", {}).get("schemas", {})
+    if "SampleRequest" in comps:
+        field = comps["SampleRequest"]["properties"]["prior"]
+        branch = next((b for b in field.get("anyOf", []) if b.get("type") != "null"), field)
+        branch["enum"] = list(names)
+    return schema

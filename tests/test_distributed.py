@@ -25,7 +25,7 @@ def test_the_ray_job_writes_the_commands_curves(tmp_path):
         "augment",
         str(tmp_path / "seeds.json"),
         "--count",
-        "900",
+        "300",
         "--seed",
         "7",
         "--mode",

@@ -2,7 +2,7 @@
 
 The fresh environment gets the wheel alone; its dependencies are the test environment's, reached through a
 .pth path entry (which does not run the editable install's own finder, so this checkout cannot stand in for
-the wheel). The server is started from a folder outside the checkout and must find the shipped model inside
+the wheel), with torch hidden as a user's install lacks it. The server is started from a folder outside the checkout and must find the shipped model inside
 the package.
 """
 
@@ -21,6 +21,20 @@ from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parents[1]
 pytestmark = [pytest.mark.slow, pytest.mark.integration]
+
+
+HIDE_TORCH = """import sys
+
+
+class HideTorch:
+    def find_spec(self, name, path=None, target=None):
+        if name == "torch" or name.startswith("torch."):
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+        return None
+
+
+sys.meta_path.insert(0, HideTorch())
+"""
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +79,9 @@ def venv(wheel, tmp_path_factory) -> Path:
             text=True,
         ).stdout.strip()
     )
-    (site / "zz_test_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    # the test environment has torch; the install a user gets does not, so it is hidden from this one
+    (site / "_hide_torch.py").write_text(HIDE_TORCH)
+    (site / "zz_test_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\nimport _hide_torch\n")
     return env
 
 

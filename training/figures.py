@@ -33,6 +33,35 @@ def plot_samples(samples: np.ndarray, data: np.ndarray, path: Path, *, n: int = 
     save_figure(fig, path)
 
 
+def plot_beside(made: list[np.ndarray], real: list[np.ndarray], path: Path, *, n: int = 12, title: str = "") -> None:
+    """n generated curves beside n real ones, in their own frame, every cell on the same scale (a family's sizes
+    compare across the two columns)."""
+    plt = pyplot()
+    made, real = made[:n], real[:n]
+    shown = np.concatenate([*made, *real])
+    lo, hi = shown.min(axis=0), shown.max(axis=0)
+    pad = 0.04 * float((hi - lo).max())
+    lo, hi = lo - pad, hi + pad
+    aspect = float((hi[1] - lo[1]) / (hi[0] - lo[0]))
+    rows = -(-n // 2)
+    cell = 1.8
+    fig, axes = plt.subplots(rows, 4, figsize=(4 * cell, rows * cell * min(max(aspect, 0.25), 1.5)), squeeze=False)
+    for j, (curves, label, color) in enumerate(((made, "sampled", "tab:red"), (real, "held out", "tab:blue"))):
+        for i in range(rows * 2):
+            ax = axes[i // 2, 2 * j + i % 2]
+            if i < len(curves):
+                ax.plot(*curves[i].T, color=color, lw=1.0)
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+        axes[0, 2 * j].set_title(label, loc="left", fontsize=10)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    save_figure(fig, path)
+
+
 def pyplot():
     import matplotlib
 

@@ -74,6 +74,12 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
         lsc_lines=a.lsc_lines,
     )
     print(format_report(report))
+    if a.figure:
+        from curve_vae.training.figures import plot_beside
+
+        refuse_overwrite(a.figure, a.force)
+        made = runtime.sample(12, seed=0, prior=a.prior if builtin else prior.name)
+        plot_beside(list(made.curves), held_out, Path(a.figure), title=f"prior {report['prior']}, seed 0")
     if a.out:
         refuse_overwrite(a.out, a.force)
         Path(a.out).write_text(json.dumps(report, indent=1) + "\n")
@@ -117,5 +123,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument("--lsc-lines", type=int, default=100, help="latent lines of LSC; 0 skips (default: 100)")
     s.add_argument("--out", default="", help="also write the report as JSON here")
+    s.add_argument(
+        "--figure", default="", help="also draw 12 samples (seed 0) beside 12 held-out curves here, as PNG"
+    )
     add_model_options(s)
     s.set_defaults(func=cmd_evaluate_prior)

@@ -98,6 +98,8 @@ def test_the_service_lists_named_priors_and_samples_them(model_dir, prior_dir):
         bad = client.post("/sample", json={"count": 3, "prior": "airfoils"})
         assert bad.status_code == 422
         assert "no prior named 'airfoils' on this server; it has: learned, standard, loops, strokes" in bad.text
+        schema = client.get("/openapi.json").json()["components"]["schemas"]["SampleRequest"]
+        assert schema["properties"]["prior"]["anyOf"][0]["enum"] == ["learned", "standard", "loops", "strokes"]
 
 
 def test_a_prior_of_another_model_stops_the_start_naming_both(model_dir, prior_dir, tmp_path):

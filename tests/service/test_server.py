@@ -22,6 +22,7 @@ def test_endpoints_over_a_socket(live_server, curves):
     with httpx.Client(base_url=live_server.url, timeout=30) as http:
         assert http.get("/health").json() == {"status": "ok"}
         assert http.get("/model").json()["providers"] == ["CPUExecutionProvider"]
+        before = _counts(http.get("/metrics").text)  # the server is shared: other tests' requests are counted too
         c = curves(2, 90) * 0.2 - 3
         rec = http.post("/reconstruct", json={"curves": c.tolist()})
         assert rec.status_code == 200 and np.shape(rec.json()["curves"]) == (2, 90, 2)
@@ -35,9 +36,20 @@ def test_endpoints_over_a_socket(live_server, curves):
         assert bad.status_code == 422 and bad.json()["detail"] == "curves[0][1][1]: not a finite number"
         big = http.post("/encode", json={"curves": [np.linspace(0, 1, 8000).reshape(-1, 2).tolist()] * 10})
         assert big.status_code == 413  # the server was started with --max-body-bytes 200000
-        metrics = http.get("/metrics").text
-        assert 'curve_vae_http_requests_total{method="POST",route="/encode",status="413"} 1.0' in metrics
-        assert 'curve_vae_http_requests_total{method="POST",route="/reconstruct",status="200"} 1.0' in metrics
+        after = _counts(http.get("/metrics").text)
+        for route, status in (("/encode", "413"), ("/reconstruct", "200"), ("/interpolate", "200"), ("/encode", "422")):
+            key = f'method="POST",route="{route}",status="{status}"'
+            assert after.get(key, 0) - before.get(key, 0) == 1, key
+
+
+def _counts(metrics: str) -> dict[str, float]:
+    """curve_vae_http_requests_total by its labels, from a Prometheus text page."""
+    out = {}
+    for line in metrics.splitlines():
+        if line.startswith("curve_vae_http_requests_total{"):
+            labels, value = line[len("curve_vae_http_requests_total{") :].rsplit("} ", 1)
+            out[labels] = float(value)
+    return out
 
 
 def test_concurrent_requests(live_server, curves):
