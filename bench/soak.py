@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/soak.py --clients 32 --duration 60            # the figures of docs/RELIABILITY.md
     .venv/bin/python bench/soak.py --clients 8 --duration 5              # the short version CI runs
+    .venv/bin/python bench/soak.py --clients 32 --duration 600 --fresh   # new curves every request, 10 minutes
 
 Starts `python -m curve_vae.service.cli` on a free loopback port (the shipped model unless --model-dir), warms
 every endpoint up, reads the server's resident memory, then runs the clients until the time or the
@@ -62,15 +63,25 @@ def request_mix(seed: int = 0) -> list[tuple[str, str, str, dict | None, int]]:
 
 
 async def _client(
-    http: httpx.AsyncClient, mix: list, rng: random.Random, deadline: float, budget: list[int], out: list
+    http: httpx.AsyncClient,
+    mix: list,
+    rng: random.Random,
+    deadline: float,
+    budget: list[int],
+    out: list,
+    fresh: bool = False,
 ) -> None:
     order = list(mix)
     rng.shuffle(order)  # each client cycles through every kind, in its own order: a balanced mix
+    curves_rng = np.random.default_rng(rng.randrange(2**32))
     i = 0
     while time.monotonic() < deadline and budget[0] > 0:
         budget[0] -= 1
         kind, method, path, body, expected = order[i % len(order)]
         i += 1
+        if fresh and body is not None and "curves" in body and not kind.startswith("bad"):
+            # curves never seen before: every read is the reading's whole work, and the encoding cache fills
+            body = {**body, "curves": _curves(curves_rng, len(body["curves"]), len(body["curves"][0]))}
         start = time.perf_counter()
         try:
             r = await http.request(method, path, json=body)
@@ -82,13 +93,16 @@ async def _client(
         out.append((kind, time.perf_counter() - start, ok, status, expected))
 
 
-async def _load(url: str, clients: int, duration: float, max_requests: int, seed: int) -> list:
+async def _load(url: str, clients: int, duration: float, max_requests: int, seed: int, fresh: bool = False) -> list:
     mix, out, budget = request_mix(seed), [], [max_requests]
     deadline = time.monotonic() + duration
     limits = httpx.Limits(max_connections=clients, max_keepalive_connections=clients)
     async with httpx.AsyncClient(base_url=url, timeout=120, limits=limits) as http:
         await asyncio.gather(
-            *(_client(http, mix, random.Random(seed * 1000 + i), deadline, budget, out) for i in range(clients))
+            *(
+                _client(http, mix, random.Random(seed * 1000 + i), deadline, budget, out, fresh)
+                for i in range(clients)
+            )
         )
     return out
 
@@ -155,7 +169,7 @@ def run(a: argparse.Namespace) -> dict:
         sampler = threading.Thread(target=_sample_memory, args=(server, a.memory_every, stop, samples), daemon=True)
         sampler.start()
         t0 = time.perf_counter()
-        results = asyncio.run(_load(server.url, a.clients, a.duration, a.max_requests, a.seed))
+        results = asyncio.run(_load(server.url, a.clients, a.duration, a.max_requests, a.seed, a.fresh))
         wall = time.perf_counter() - t0
         stop.set()
         sampler.join()
@@ -182,6 +196,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--model-dir", default=str(ROOT / "models"), help="the model to serve (default: the shipped one)")
     p.add_argument("--max-rss-growth-mb", type=float, default=100.0, help="allowed memory growth (default: 100)")
     p.add_argument("--seed", type=int, default=0, help="seed of the request mix and the clients' choices")
+    p.add_argument(
+        "--fresh",
+        action="store_true",
+        help="new curves in every request (default: the mix's curves, which the encoding cache answers after the "
+        "first time)",
+    )
     p.add_argument("--memory-every", type=float, default=5.0, help="seconds between memory readings (default: 5)")
     p.add_argument("--out", default="", help="also write the report as JSON here")
     a = p.parse_args(argv)

@@ -44,7 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
         ("reconstruct", "the output file"),
         ("encode", "the output file"),
         ("prior", "the prior's file"),
-        ("evaluate-prior", "the --out report"),
+        ("evaluate-prior", "the --out report and the --figure"),
     ]:
         sub.choices[name].add_argument("--force", action="store_true", help=f"replace {what} if it exists")
     return p

@@ -11,11 +11,12 @@ from tests.helpers import SHIPPED
 pytestmark = pytest.mark.integration
 
 
-def test_short_soak_has_no_errors(tmp_path, capsys):
+@pytest.mark.parametrize("fresh", [[], ["--fresh"]], ids=["mix", "fresh-curves"])
+def test_short_soak_has_no_errors(tmp_path, capsys, fresh):
     from bench import soak
 
     out = tmp_path / "soak.json"
-    args = ["--clients", "8", "--duration", "4", "--model-dir", str(SHIPPED), "--out", str(out)]
+    args = ["--clients", "8", "--duration", "4", "--model-dir", str(SHIPPED), "--out", str(out), *fresh]
     assert soak.main(args) == 0, capsys.readouterr().out
     report = json.loads(out.read_text())
     assert report["errors"] == 0 and report["requests"] > 20 and report["bad_inputs_tried"] > 0
