@@ -76,6 +76,7 @@ def evaluate_prior(
             )
     base = float(np.median(g.nearest_distance(ref, tr)))  # the held-out curves' own distance to the training ones
     return {
+        "real": real_yardstick(ref, tr, count),
         "prior": prior,
         "seeds": list(seeds),
         "samples_per_seed": count,
@@ -84,6 +85,21 @@ def evaluate_prior(
         "train": len(tr),
         "held_out_nn_to_train": base,
         "metrics": {k: {"mean": g.interval(v)[0], "pm": g.interval(v)[1], "runs": v} for k, v in runs.items()},
+    }
+
+
+def real_yardstick(ref: np.ndarray, train: np.ndarray, count: int = SAMPLES) -> dict[str, float]:
+    """The sample-side metrics with the training curves (at most `count`, the first) in the samples' place: what a
+    generator that returned the data itself would score against the held-out curves."""
+    real = train[:count]
+    return {
+        "mmd_ideallab": g.mmd_ideallab(real, ref),
+        "mmd_gaussian": g.mmd_gaussian(real, ref),
+        **g.prdc(real, ref),
+        "coverage_radius": g.coverage(real, ref),
+        "rvod": g.rvod(real, ref),
+        "vendi": g.vendi(real[:1000]),
+        "dpp": g.dpp_diversity(real[:500]),
     }
 
 
@@ -108,6 +124,10 @@ def format_report(report: dict[str, Any]) -> str:
         f"{report['held_out']} held-out curves ({report['train']} training curves), {report['points']} points by arc "
         f"length; held-out curves' median distance to the training ones: {report['held_out_nn_to_train']:.4g}"
     ]
+    real = report.get("real", {})
+    lines.append(f"  {'metric':22s} {'samples':>12s}   {'interval':9s} {'real':>10s}")
     for name, m in report["metrics"].items():
-        lines.append(f"  {name:22s} {m['mean']:12.5g} ± {m['pm']:.3g}")
+        yard = f"{real[name]:10.5g}" if name in real else ""
+        lines.append(f"  {name:22s} {m['mean']:12.5g} ± {m['pm']:<9.3g} {yard}")
+    lines.append("  (real: the training curves in the samples' place)")
     return "\n".join(lines)

@@ -24,7 +24,7 @@ TINY = {
     "average": ["--bn-curves", "128"],
     "augment": ["--count", "300"],
 }
-ORDER = ["dataset", "train", "average", "export", "evaluate", "sample", "augment", "fit", "revolve"]
+ORDER = ["dataset", "train", "average", "export", "evaluate", "prior", "sample", "augment", "fit", "revolve"]
 
 
 def readme_commands() -> list[list[str]]:
@@ -84,6 +84,8 @@ def test_readme_cli_commands_run_as_written(tmp_path):
         "batch.npy",
         "fits.json",
         "vase.obj",
+        "priors/mine.npz",
+        "mine_samples.json",
     ]:
         assert (tmp_path / made).is_file(), made
     assert np.load(tmp_path / "batch.npy").shape[0] == 300

@@ -56,9 +56,7 @@ def plot_beside(made: list[np.ndarray], real: list[np.ndarray], path: Path, *, n
             ax.set_aspect("equal")
             ax.set_xticks([])
             ax.set_yticks([])
-        axes[0, 2 * j].set_title(label, loc="left", fontsize=10)
-    if title:
-        fig.suptitle(title, fontsize=10)
+        axes[0, 2 * j].set_title(f"{label}: {title}" if title and j == 0 else label, loc="left", fontsize=10)
     save_figure(fig, path)
 
 

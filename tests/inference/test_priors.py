@@ -140,6 +140,8 @@ def test_evaluate_prior_prints_every_metric_with_its_interval(model_dir, prior_d
     assert main(args) == 0
     text = capsys.readouterr().out
     report = json.loads(out.read_text())
+    assert set(report["real"]) >= {"mmd_ideallab", "precision", "recall", "rvod"}  # the data's own scores beside
+    assert "real: the training curves in the samples' place" in text
     want = {
         "valid",
         "mmd_ideallab",
