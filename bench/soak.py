@@ -99,10 +99,7 @@ async def _load(url: str, clients: int, duration: float, max_requests: int, seed
     limits = httpx.Limits(max_connections=clients, max_keepalive_connections=clients)
     async with httpx.AsyncClient(base_url=url, timeout=120, limits=limits) as http:
         await asyncio.gather(
-            *(
-                _client(http, mix, random.Random(seed * 1000 + i), deadline, budget, out, fresh)
-                for i in range(clients)
-            )
+            *(_client(http, mix, random.Random(seed * 1000 + i), deadline, budget, out, fresh) for i in range(clients))
         )
     return out
 

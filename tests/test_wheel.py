@@ -2,8 +2,8 @@
 
 The fresh environment gets the wheel alone; its dependencies are the test environment's, reached through a
 .pth path entry (which does not run the editable install's own finder, so this checkout cannot stand in for
-the wheel), with torch hidden as a user's install lacks it. The server is started from a folder outside the checkout and must find the shipped model inside
-the package.
+the wheel), with torch hidden as a user's install lacks it. The server is started from a folder outside the
+checkout and must find the shipped model inside the package.
 """
 
 import json

@@ -123,8 +123,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument("--lsc-lines", type=int, default=100, help="latent lines of LSC; 0 skips (default: 100)")
     s.add_argument("--out", default="", help="also write the report as JSON here")
-    s.add_argument(
-        "--figure", default="", help="also draw 12 samples (seed 0) beside 12 held-out curves here, as PNG"
-    )
+    s.add_argument("--figure", default="", help="also draw 12 samples (seed 0) beside 12 held-out curves here, as PNG")
     add_model_options(s)
     s.set_defaults(func=cmd_evaluate_prior)
