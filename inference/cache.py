@@ -53,6 +53,7 @@ class EncodingCache:
         size = row.nbytes()
         if size > self.max_bytes:
             return
+        row = row.owned()  # not a view into the request's batch arrays, which would stay alive with it
         with self._lock:
             old = self._rows.pop(key, None)
             if old is not None:

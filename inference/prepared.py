@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -30,9 +31,21 @@ class ReadCurve:
     def decoded_yet(self) -> bool:
         return self.decoded is not None
 
+    ARRAYS: ClassVar[tuple[str, ...]] = ("model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet")
+
     def nbytes(self) -> int:
-        parts = (self.model, self.fraction, self.mean, self.log_var, self.decoded, self.ctrl, self.params, self.feet)
+        parts = (getattr(self, name) for name in self.ARRAYS)
         return sum(p.nbytes for p in parts if p is not None) + 200
+
+    def owned(self) -> ReadCurve:
+        """This row with arrays of its own: a row sliced out of a batch's arrays keeps the whole batch alive, so what
+        is kept (the encoding cache) keeps copies, and `nbytes` is then the memory it holds."""
+        views = {
+            name: np.array(a, copy=True)
+            for name in self.ARRAYS
+            if (a := getattr(self, name)) is not None and (a.base is not None or not a.flags.owndata)
+        }
+        return replace(self, **views) if views else self
 
     def with_decoding(
         self, decoded: np.ndarray, ctrl: np.ndarray | None, params: np.ndarray | None, feet: np.ndarray | None

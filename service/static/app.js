@@ -260,8 +260,9 @@ $("clear").addEventListener("click", () => {
 });
 $("sample").addEventListener("click", async () => {
   try {
-    const r = await api("/sample", { count: needed(), n_points: N_POINTS, frame: { center: [W / 2, H / 2], size: 420 } },
-      $("board-error"));
+    const body = { count: needed(), n_points: N_POINTS, frame: { center: [W / 2, H / 2], size: 420 } };
+    if ($("prior").value) body.prior = $("prior").value;
+    const r = await api("/sample", body, $("board-error"));
     state.curves = r.curves;
     state.recon = r.curves.map(() => null);
     await curvesChanged();
@@ -417,7 +418,30 @@ function drawVase() {
 
 // The key lives for this browser tab only.
 $("api-key").value = sessionStorage.getItem("curve-vae-api-key") || "";
-$("api-key").addEventListener("change", () => sessionStorage.setItem("curve-vae-api-key", $("api-key").value));
+$("api-key").addEventListener("change", () => {
+  sessionStorage.setItem("curve-vae-api-key", $("api-key").value);
+  listPriors();
+});
+
+// The priors this server offers (GET /model): the learned one where the model ships it, the standard N(0, I), and
+// those fitted to users' own curves. Without an answer the menu keeps the server's default.
+async function listPriors() {
+  const headers = $("api-key").value ? { "X-API-Key": $("api-key").value } : {};
+  let info;
+  try {
+    const response = await fetch(API + "/model", { headers });
+    if (!response.ok) return;
+    info = await response.json();
+  } catch (e) { return; }
+  const names = [...(info.prior ? ["learned"] : []), "standard", ...Object.keys(info.priors || {})];
+  $("prior").replaceChildren(...names.map((name) => {
+    const option = document.createElement("option");
+    option.value = name;
+    option.textContent = name;
+    return option;
+  }));
+}
 
 renderTriangle();
 render();
+listPriors();

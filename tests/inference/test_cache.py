@@ -39,7 +39,9 @@ def test_the_cache_holds_at_most_its_bytes_least_recently_used_out_first(model_d
     for k, row in zip(keys, prep.rows):
         cache.put(k, row)
     assert len(cache) == 3 and cache.size <= cache.max_bytes
-    assert cache.get(keys[0]) is None and cache.get(keys[5]) is prep.rows[5]
+    kept = cache.get(keys[5])
+    assert cache.get(keys[0]) is None and kept is not None
+    np.testing.assert_array_equal(kept.mean, prep.rows[5].mean)  # the same row (a copy of its own, see below)
     cache.get(keys[3])  # used: kept over the older 4
     cache.put(keys[0], prep.rows[0])
     assert cache.get(keys[3]) is not None and cache.get(keys[4]) is None
@@ -57,3 +59,25 @@ def test_interpolating_cached_curves_costs_one_decode_per_row(model_dir):
     rt.graphs.decode = lambda z: decoded.append(len(z)) or decode(z)  # type: ignore[method-assign]
     rt.interpolate(curves, np.array([[0.3, 0.7]]))
     assert encoded == [] and decoded == [1]
+
+
+def test_a_kept_row_holds_its_own_bytes_not_the_batch_it_was_sliced_from():
+    """The bytes the cache counts are the bytes it keeps: a row whose arrays are views into a request's batch
+    would keep the whole batch alive (a soak of unseen curves grew 66 MiB a minute before this)."""
+    import gc
+    import weakref
+
+    from curve_vae.inference.prepared import ReadCurve
+
+    batch = np.ones((4096, 161, 2), np.float32)  # 5 MiB, as a request's candidates are
+    latents = np.zeros((4096, 32), np.float32)
+    row = ReadCurve(frame=None, model=batch[7], fraction=None, mean=latents[7], log_var=latents[8], decoded=batch[9])
+    cache = EncodingCache(max_bytes=1 << 20)
+    cache.put(b"k", row)
+    alive = weakref.ref(batch)
+    del batch, latents, row
+    gc.collect()
+    assert alive() is None  # only the row's own points stayed
+    kept = cache.get(b"k")
+    assert kept is not None and kept.model.flags.owndata and kept.decoded is not None and kept.decoded.flags.owndata
+    np.testing.assert_array_equal(kept.model, np.ones((161, 2), np.float32))

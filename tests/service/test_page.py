@@ -284,3 +284,28 @@ def test_page_sends_the_api_key_the_user_types(browser, server_factory):
     page.wait_for_function("window.curveVae.result !== null")
     assert page.locator("#board-error").inner_text() == ""
     assert [e for e in errors if "401" not in e] == []  # the browser logs the refused request itself; nothing else
+
+
+def test_samples_come_from_the_prior_the_user_picks(browser, server_factory, tmp_path):
+    """A server with a folder of priors lists them in the page's menu; the pick goes into /sample's body."""
+    from curve_vae.cli import main
+
+    t = np.linspace(0, 1, 60)
+    strokes = [np.stack([t * 6, a * np.sin(np.pi * t * k)], 1) for a, k in zip(np.linspace(0.5, 2, 12), [1, 2] * 6)]
+    (tmp_path / "strokes.json").write_text(json.dumps([c.tolist() for c in strokes]))
+    priors = tmp_path / "priors"
+    fit = ["prior", "--curves", str(tmp_path / "strokes.json"), "-o", str(priors / "waves.npz"), "--refine", "0"]
+    assert main([*fit, "--model-dir", str(SHIPPED)]) == 0
+    api = server_factory("--model-dir", str(SHIPPED), "--providers", "cpu", "--priors-dir", str(priors))
+    api.wait_ready()
+    page, errors = open_page(browser, api.url + "/")
+    page.wait_for_function("[...document.querySelectorAll('#prior option')].map((o) => o.value).includes('waves')")
+    options = page.eval_on_selector_all("#prior option", "os => os.map((o) => o.value)")
+    assert options == ["learned", "standard", "waves"]
+    page.select_option("#prior", "waves")
+    with page.expect_response("**/sample") as answer:
+        page.click("#sample")
+    assert json.loads(answer.value.request.post_data or "{}")["prior"] == "waves"
+    assert answer.value.json()["prior"] == "waves" and len(answer.value.json()["curves"]) == 2
+    page.wait_for_function("window.curveVae.result !== null")
+    assert errors == []
