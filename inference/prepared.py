@@ -27,11 +27,11 @@ class ReadCurve:
     params: np.ndarray | None = None  # (n_points,) its points' spline parameters, with a head that learns them
     feet: np.ndarray | None = None  # with closest placement or refine: each caller point's spline parameter
 
+    ARRAYS: ClassVar[tuple[str, ...]] = ("model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet")
+
     @property
     def decoded_yet(self) -> bool:
         return self.decoded is not None
-
-    ARRAYS: ClassVar[tuple[str, ...]] = ("model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet")
 
     def nbytes(self) -> int:
         parts = (getattr(self, name) for name in self.ARRAYS)
@@ -43,7 +43,7 @@ class ReadCurve:
         views = {
             name: np.array(a, copy=True)
             for name in self.ARRAYS
-            if (a := getattr(self, name)) is not None and (a.base is not None or not a.flags.owndata)
+            if (a := getattr(self, name)) is not None and a.base is not None
         }
         return replace(self, **views) if views else self
 

@@ -98,9 +98,7 @@ def state_bounds(schema: dict[str, Any], settings: Any, latent_dim: int | None) 
     comps = schema.get("components", {}).get("schemas", {})
 
     def prop(model: str, field: str) -> dict[str, Any]:
-        p = comps[model]["properties"][field]
-        # `X | None` fields: the bound goes on the non-null branch
-        return next((b for b in p.get("anyOf", []) if b.get("type") != "null"), p)
+        return _field_schema(comps, model, field)
 
     for bound in BOUNDS:
         if bound.model not in comps:
@@ -126,7 +124,11 @@ def name_priors(schema: dict[str, Any], names: list[str]) -> dict[str, Any]:
     """/sample's `prior`: the names this server's model and priors folder offer, as the schema's enum."""
     comps = schema.get("components", {}).get("schemas", {})
     if "SampleRequest" in comps:
-        field = comps["SampleRequest"]["properties"]["prior"]
-        branch = next((b for b in field.get("anyOf", []) if b.get("type") != "null"), field)
-        branch["enum"] = list(names)
+        _field_schema(comps, "SampleRequest", "prior")["enum"] = list(names)
     return schema
+
+
+def _field_schema(comps: dict[str, Any], model: str, field: str) -> dict[str, Any]:
+    """A request field's schema; for `X | None` fields its non-null branch, where bounds and choices go."""
+    p = comps[model]["properties"][field]
+    return next((b for b in p.get("anyOf", []) if b.get("type") != "null"), p)

@@ -51,6 +51,9 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
     from curve_vae.inference.evaluate_prior import evaluate_prior, format_report
     from curve_vae.inference.priors import NamedPrior
 
+    for path in (a.out, a.figure):  # before the evaluation's minutes, not after
+        if path:
+            refuse_overwrite(path, a.force)
     builtin = a.prior in ("learned", "standard")
     prior = None if builtin else NamedPrior.load(a.prior)
     runtime = model_runtime(a, priors_dir=None if builtin else Path(a.prior).parent)
@@ -77,11 +80,9 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
     if a.figure:
         from curve_vae.training.figures import plot_beside
 
-        refuse_overwrite(a.figure, a.force)
         made = runtime.sample(12, seed=0, prior=a.prior if builtin else prior.name)
         plot_beside(list(made.curves), held_out, Path(a.figure), title=f"prior {report['prior']}, seed 0")
     if a.out:
-        refuse_overwrite(a.out, a.force)
         Path(a.out).write_text(json.dumps(report, indent=1) + "\n")
     return 0
 

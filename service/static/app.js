@@ -26,13 +26,15 @@ const round = (v) => Math.round(v * 1000) / 1000;
 
 // ------------------------------------------------------------------------------------------ API
 
+// The API key the user typed, as the header the service reads.
+const keyHeader = () => ($("api-key").value ? { "X-API-Key": $("api-key").value } : {});
+
 async function api(path, body, errorEl, { raw = false } = {}) {
   errorEl.textContent = "";
   state.lastRequest = { path, body };
   showCurl();
   let response;
-  const headers = { "Content-Type": "application/json" };
-  if ($("api-key").value) headers["X-API-Key"] = $("api-key").value;
+  const headers = { "Content-Type": "application/json", ...keyHeader() };
   try {
     response = await fetch(API + path, { method: "POST", headers, body: JSON.stringify(body) });
   } catch (e) {
@@ -426,10 +428,9 @@ $("api-key").addEventListener("change", () => {
 // The priors this server offers (GET /model): the learned one where the model ships it, the standard N(0, I), and
 // those fitted to users' own curves. Without an answer the menu keeps the server's default.
 async function listPriors() {
-  const headers = $("api-key").value ? { "X-API-Key": $("api-key").value } : {};
   let info;
   try {
-    const response = await fetch(API + "/model", { headers });
+    const response = await fetch(API + "/model", { headers: keyHeader() });
     if (!response.ok) return;
     info = await response.json();
   } catch (e) { return; }
