@@ -185,16 +185,11 @@ def canonical_frame(points: np.ndarray) -> Frame:
     product moment about the centroid (across × along the chord) is positive. Those two moves turn either statistic
     into its negative, so a curve, its reversal, its mirror image and its rotations all come to the same posed
     points (to rounding; a curve for which both are exactly zero is symmetric under the moves, or keeps the pose
-    it is listed in)."""
-    drawn, flipped = pose_frames(points, chords=1)
-    posed = (np.asarray(points, np.float64) - np.asarray(drawn.center)) @ drawn._linear()  # chord along −y
-    centroid = arc_centroid(posed)
-    offset = (posed[0, 1] + posed[-1, 1]) / 2 - centroid[1]  # along the chord (−y), from the ends' midpoint
-    if abs(offset) <= 1e-9 * drawn.size:
-        seg = np.linalg.norm(np.diff(posed, axis=0), axis=1)
-        rel = (posed[1:] + posed[:-1]) / 2 - centroid
-        offset = -float((seg * rel[:, 0] * rel[:, 1]).sum())
-    return drawn if offset >= 0 else flipped
+    it is listed in). Computed as for a batch of one (geometry.batch.canonical_frames), so a curve gets the same
+    frame alone and in a batch."""
+    from curve_vae.geometry.batch import canonical_frames  # batch builds on this module
+
+    return canonical_frames([points])[0]
 
 
 def posed_frame(points: np.ndarray, rotation: float, *, mirror: bool = False, reverse: bool = False) -> Frame:
@@ -223,6 +218,19 @@ def at_fractions(curve: np.ndarray, fractions: np.ndarray) -> np.ndarray:
     x = np.clip(fractions, 0.0, 1.0) * (len(curve) - 1)
     idx = np.arange(len(curve))
     return np.stack([np.interp(x, idx, curve[:, 0]), np.interp(x, idx, curve[:, 1])], axis=1)
+
+
+def resample_index(curves: np.ndarray, n_points: int) -> np.ndarray:
+    """Curves of one length (k, n, 2) at `n_points` even steps of their point index (`at_fractions` of each at
+    even fractions; `resample` with spacing "parameter"), all at once; a curve of n_points comes back as it is."""
+    pts = np.asarray(curves, np.float64)
+    n = pts.shape[1]
+    if n == n_points:
+        return pts.copy()
+    x = np.linspace(0.0, 1.0, n_points) * (n - 1)
+    lo = np.minimum(np.floor(x).astype(np.int64), n - 2)
+    w = (x - lo)[None, :, None]
+    return pts[:, lo] * (1 - w) + pts[:, lo + 1] * w
 
 
 def resample(points: np.ndarray, n_points: int, *, spacing: str = "arc_length") -> np.ndarray:

@@ -27,6 +27,9 @@ from curve_vae.geometry import (
     pose_frames,
     to_model_plane,
 )
+from curve_vae.geometry.adapt import F32_MAX
+from curve_vae.geometry.batch import FrameRows, Ragged, canonical_frames
+from curve_vae.geometry.frame import resample_index
 from curve_vae.inference.cache import EncodingCache
 from curve_vae.inference.cancel import checkpoint
 from curve_vae.inference.errors import InputError
@@ -111,27 +114,35 @@ class Reader:
 
     def _candidates(self, inputs: list[np.ndarray], index: list[int], reading: Reading) -> list[Candidate]:
         """Every curve in every pose, read as the reading says; spacing "search": its points as given and each of
-        its natural readings that does not put them where they are (a curve at the paper's own spacing is read so)."""
+        its natural readings that does not put them where they are (a curve at the paper's own spacing is read so).
+        The canonical pose is found for all curves at once (geometry.batch)."""
+        canonical: list[Frame] | None = None
+        if reading.frame != "model" and reading.pose == "canonical":
+            try:
+                canonical = canonical_frames(inputs)
+            except ValueError:
+                pass  # the curve whose points coincide is named below
         stage: list[Candidate] = []
         with np.errstate(all="ignore"):
             for c, (i, pts) in enumerate(zip(index, inputs)):
-                checkpoint()  # a natural fit per curve: an abandoned request stops between curves
                 try:
                     if reading.frame == "model":
                         frames: list[Frame | None] = [None]
                     elif reading.pose == "canonical":
-                        frames = [canonical_frame(pts)]
+                        frames = [canonical[c] if canonical is not None else canonical_frame(pts)]
                     elif reading.pose == "search":
                         frames = list(pose_frames(pts, chords=POSE_CHORD_COUNT))
                     else:
                         frames = [fit_frame(pts)]
                     if reading.spacing == "search":
+                        checkpoint()  # a natural fit per curve: an abandoned request stops between curves
                         spaced = [("parameter", None)] + [
                             ("natural", n)
                             for n in natural_readings(pts)
                             if np.abs(n - np.linspace(0.0, 1.0, len(n))).max() > SAME_READING
                         ]
                     elif reading.spacing == "natural":
+                        checkpoint()
                         spaced = [("natural", natural_params(pts))]  # it does not depend on the pose: fitted once
                     else:
                         spaced = [(reading.spacing, None)]
@@ -143,8 +154,11 @@ class Reader:
     def _model_points(
         self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
     ) -> tuple[np.ndarray, list[np.ndarray | None]]:
-        """Each candidate's model-plane points (k, n_points, 2) float32 and where its curve's points sit along them."""
+        """Each candidate's model-plane points (k, n_points, 2) float32 and where its curve's points sit along them.
+        Candidates read at their points as given are mapped all at once (`_model_points_as_given`)."""
         g = self.graphs
+        if stage and all(s == "parameter" for _, _, s, _ in stage):
+            return self._model_points_as_given(inputs, index, stage)
         rows, fractions = [], []
         with np.errstate(all="ignore"):
             for c, f, spacing, natural in stage:
@@ -153,16 +167,41 @@ class Reader:
                         inputs[c], f, model_size=g.model_size, n_points=g.n_points, spacing=spacing, natural=natural
                     )
                 except BeyondFloat32:
-                    raise InputError(
-                        ("curves", index[c]),
-                        "its extent is too small or too large to map to the model's frame"
-                        if f is not None
-                        else 'coordinates beyond float32 range; use frame "auto"',
-                    ) from None
+                    raise InputError(("curves", index[c]), _beyond(f is not None)) from None
                 rows.append(m)
                 fractions.append(fraction)
         batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, g.n_points, 2), np.float32)
         return batch, fractions
+
+    def _model_points_as_given(
+        self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
+    ) -> tuple[np.ndarray, list[np.ndarray | None]]:
+        """`to_model_plane` with spacing "parameter" for every candidate at once: each curve through its frame
+        (geometry.batch), then the curves of each length to the model's count along their point index."""
+        g = self.graphs
+        curves = Ragged.of([inputs[c] for c, _, _, _ in stage])
+        framed = [f for _, f, _, _ in stage]
+        with np.errstate(all="ignore"):
+            if all(f is not None for f in framed):
+                flat = FrameRows.of(framed).to_model(curves, g.model_size)  # type: ignore[arg-type]
+            else:
+                flat = np.concatenate(
+                    [
+                        f.to_model(p, g.model_size) if f is not None else p
+                        for f, p in zip(framed, curves.split(curves.points))
+                    ]
+                )
+            out = np.empty((len(stage), g.n_points, 2))
+            parts = curves.split(flat)
+            for n in np.unique(curves.lengths):
+                rows = np.flatnonzero(curves.lengths == n)
+                out[rows] = resample_index(np.stack([parts[r] for r in rows]), g.n_points)
+        bad = ~(np.abs(out) <= F32_MAX).reshape(len(out), -1).all(axis=1)  # also true for inf and nan
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise InputError(("curves", index[stage[k][0]]), _beyond(framed[k] is not None))
+        fractions = [None if n == g.n_points else np.linspace(0.0, 1.0, n) for n in curves.lengths]
+        return out.astype(np.float32), fractions
 
     # ----------------------------------------------------------------------------------- decoding, placement
 
@@ -176,9 +215,7 @@ class Reader:
             decoded, ctrl, params = g.decode(np.stack([r.mean for r in rows]))
             feet: list[np.ndarray | None] = [None] * len(rows)
             if self.closest and ctrl is not None:
-                targets = [
-                    r.frame.to_model(p, g.model_size) if r.frame is not None else p for r, p in zip(rows, inputs)
-                ]
+                targets = self._targets(inputs, [r.frame for r in rows])
                 placed, err = ordered_closest_params(ctrl, targets, degree=g.spline_degree)
                 feet = list(placed)
             else:
@@ -191,6 +228,21 @@ class Reader:
             for i, r in enumerate(rows)
         ]
         return out, np.where(np.isfinite(err), err, np.inf)
+
+    def _targets(self, inputs: list[np.ndarray], frames: list[Frame | None]) -> list[np.ndarray]:
+        """Each caller curve in the model plane, through its frame: all at once where every curve has one."""
+        if frames and all(f is not None for f in frames):
+            curves = Ragged.of(inputs)
+            return curves.split(FrameRows.of(frames).to_model(curves, self.graphs.model_size))  # type: ignore[arg-type]
+        return [f.to_model(p, self.graphs.model_size) if f is not None else p for f, p in zip(frames, inputs)]
+
+
+def _beyond(framed: bool) -> str:
+    return (
+        "its extent is too small or too large to map to the model's frame"
+        if framed
+        else 'coordinates beyond float32 range; use frame "auto"'
+    )
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:
