@@ -104,9 +104,12 @@ def _ordered_nearest(points: np.ndarray, samples: np.ndarray, lengths: np.ndarra
     b, n, _ = points.shape
     m = samples.shape[1]
     p = points.astype(np.float32)
-    # |p - s|² = |p|² - 2 p·s + |s|², the constant |p|² left out: the nearest sample is the same
-    d = np.matmul(p, samples.transpose(0, 2, 1)) * np.float32(-2.0) + (samples * samples).sum(-1)[:, None, :]
-    out = d.argmin(axis=2)
+    # the squared distances as _match computes them (float32, x and y apart), so that both find the same samples
+    dx = samples[:, None, :, 0] - p[:, :, None, 0]  # (b, n, m)
+    dy = samples[:, None, :, 1] - p[:, :, None, 1]
+    np.multiply(dx, dx, out=dx)
+    np.multiply(dy, dy, out=dy)
+    out = np.add(dx, dy, out=dx).argmin(axis=2)
     out[:, 0] = 0
     out[np.arange(n)[None, :] >= (lengths - 1)[:, None]] = m - 1  # each curve's last point and its padding: the end
     tangled = (np.diff(out, axis=1) < 0).any(axis=1)
