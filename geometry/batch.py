@@ -18,7 +18,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from curve_vae.geometry.frame import CLOSED, MODEL_CENTER, POSE_CHORDS, Frame
+from curve_vae.geometry.frame import (
+    CLOSED,
+    MODEL_CENTER,
+    POSE_CHORDS,
+    Frame,
+    chord_heading,
+    pose_candidates,
+    posed_frame,
+    signed_turning,
+    turns_clockwise,
+)
 
 
 @dataclass(frozen=True)
@@ -200,3 +210,75 @@ def _chord_heading(pts: np.ndarray) -> np.ndarray:
         np.arctan2(chord[:, 1], chord[:, 0]),
         np.arctan2(out[:, 1], out[:, 0]) - np.pi / 2,
     )
+
+
+# ----------------------------------------------------------------------------------------------- one pose for a set
+
+
+def shared_pose_frames(curves: Sequence[np.ndarray], *, chords: int = 3, flips: bool = True) -> list[list[Frame]]:
+    """`frame.pose_frames` for a set of curves that are mixed together (interpolated, augmented): the same candidate
+    poses — one rotation and mirror image each — for every curve of the set, so that the curves keep their turns
+    relative to each other; each curve's frame still fits its own bounding box (centre and size blend).
+
+    The curves are aligned one way first: a curve listed the other way round from the set's first curve (its chord
+    pointing against the first's; for loops, turning the other way) is read reversed, so a curve and its reversal
+    are read alike. The set is mirrored when its aligned curves turn clockwise overall (their signed turnings
+    summed), and its chord direction is the mean of their unit chord directions; from there the candidates are
+    pose_frames' own. Per curve: [candidate 0, candidate 1, …], candidate k the same pose for every curve.
+    """
+    pts = [np.asarray(c, np.float64) for c in curves]
+    if not pts:
+        return []
+    for c in pts:
+        if not np.ptp(c, axis=0).max() > 0:
+            raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+    against = _against_first(pts)
+    aligned = [c[::-1] if a else c for c, a in zip(pts, against)]
+    turning = sum(signed_turning(c) for c in aligned)
+    if abs(turning) > 1e-9:
+        mirror = turning < 0
+    else:
+        mirror = sum(float(turns_clockwise(c)) - 0.5 for c in aligned) > 0
+    flip = np.array([-1.0, 1.0]) if mirror else np.ones(2)
+    headings = np.array([chord_heading(c * flip) for c in aligned])
+    heading = float(np.arctan2(np.sin(headings).sum(), np.cos(headings).sum()))
+    poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
+    return [
+        [posed_frame(c, turn, mirror=mir, reverse=rev != a) for turn, mir, rev in poses] for c, a in zip(pts, against)
+    ]
+
+
+def _against_first(curves: list[np.ndarray]) -> list[bool]:
+    """Which curves run the other way round from the first: open curves by their chords (pointing apart by more than
+    a right angle), loops and nearly closed curves by the sign of their turning."""
+
+    def chord(c: np.ndarray) -> np.ndarray | None:
+        d = c[-1] - c[0]
+        reach = 2 * np.linalg.norm(c - _arc_centroid(c[None])[0], axis=1).max()
+        return d / np.hypot(*d) if np.hypot(*d) >= CLOSED * reach else None
+
+    first, first_turn = chord(curves[0]), signed_turning(curves[0])
+    out = []
+    for c in curves:
+        mine = chord(c)
+        if first is not None and mine is not None:
+            out.append(bool(mine @ first < 0))
+        else:
+            out.append(bool(signed_turning(c) * first_turn < 0))
+    return out
+
+
+def shared_canonical_frames(curves: Sequence[np.ndarray]) -> list[Frame]:
+    """`frame.canonical_frame` for a set of curves mixed together: of the set's first two shared candidates (chord
+    straight down; as drawn, or reversed and mirrored across the chord's normal), the one in which the curves'
+    arc-length centroids lie towards their chords' ends on the whole (each curve's offset ÷ its size, summed; a curve
+    alone gets its own canonical frame)."""
+    if len(curves) <= 1:
+        return canonical_frames(curves)
+    candidates = shared_pose_frames(curves, chords=1)
+    total = 0.0
+    for c, (drawn, _) in zip(curves, candidates):
+        posed = np.asarray(c, np.float64) @ drawn._linear()
+        centroid = _arc_centroid(posed[None])[0]
+        total += ((posed[0, 1] + posed[-1, 1]) / 2 - centroid[1]) / drawn.size
+    return [drawn if total >= 0 else flipped for drawn, flipped in candidates]

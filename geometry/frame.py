@@ -164,6 +164,16 @@ def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> l
     pts = np.asarray(points, np.float64)
     mirror = turns_clockwise(pts)
     heading = chord_heading(pts * ([-1.0, 1.0] if mirror else 1.0))
+    poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
+    return [posed_frame(pts, turn, mirror=mir, reverse=rev) for turn, mir, rev in poses]
+
+
+def pose_candidates(
+    heading: float, mirror: bool, *, chords: int = 3, flips: bool = True
+) -> list[tuple[float, bool, bool]]:
+    """The poses (rotation, mirror, reverse) `pose_frames` tries for a curve whose chord, mirrored as `mirror`
+    says, points at `heading` (radians): its chord turned to each of the first `chords` POSE_CHORDS, with `flips`
+    each also reversed and mirrored across the chord's normal."""
     poses = []
     for target in POSE_CHORDS[:chords]:
         turn = float(np.angle(np.exp(1j * (target - heading))))
@@ -175,7 +185,7 @@ def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> l
             c, s = np.cos(turn), np.sin(turn)
             a = (np.eye(2) - 2 * np.outer(n, n)) @ np.array([[c, -s], [s, c]]) @ np.diag([-1.0, 1.0])
             poses.append((float(np.arctan2(a[1, 0], a[0, 0])), not mirror, True))
-    return [posed_frame(pts, turn, mirror=mir, reverse=rev) for turn, mir, rev in poses]
+    return poses
 
 
 def canonical_frame(points: np.ndarray) -> Frame:

@@ -55,3 +55,37 @@ def test_frame_rows_map_every_curve_as_its_own_frame_does(model_size):
 def test_points_that_all_coincide_are_refused():
     with pytest.raises(ValueError, match="coincide"):
         canonical_frames([np.ones((5, 2)), np.zeros((4, 2))])
+
+
+def test_a_set_shares_its_poses_and_each_curve_keeps_its_own_box():
+    from curve_vae.geometry.batch import shared_pose_frames
+
+    curves = _drawn(3, seed=3)
+    per_curve = shared_pose_frames(curves)
+    assert len(per_curve) == 3 and all(len(f) == 6 for f in per_curve)
+    for k in range(6):
+        poses = {(round(f[k].rotation, 12), f[k].mirror) for f in per_curve}
+        assert len(poses) == 1  # candidate k is one pose for the whole set
+    for c, frames in zip(curves, per_curve):
+        posed = frames[0].to_model(c, 100.0)
+        assert np.isclose(np.ptp(posed, axis=0).max(), 100.0)  # its own bounding box fills the model's
+
+
+def test_a_curve_and_its_reversal_are_read_alike_in_a_set():
+    from curve_vae.geometry.batch import shared_canonical_frames
+
+    c = _drawn(1, seed=4)[0]
+    fa, fb = shared_canonical_frames([c, c[::-1]])
+    np.testing.assert_allclose(fa.to_model(c, 100.0), fb.to_model(c[::-1], 100.0), atol=1e-9)
+
+
+def test_a_set_turns_with_its_curves():
+    """Turning every curve of a set turns the set's pose with them: the posed curves stay where they were."""
+    from curve_vae.geometry.batch import shared_canonical_frames
+
+    curves = _drawn(2, seed=5)
+    turn = np.array([[0.0, 1.0], [-1.0, 0.0]])
+    before = shared_canonical_frames(curves)
+    after = shared_canonical_frames([c @ turn for c in curves])
+    for c, fa, fb in zip(curves, before, after):
+        np.testing.assert_allclose(fb.to_model(c @ turn, 100.0), fa.to_model(c, 100.0), atol=1e-9)
