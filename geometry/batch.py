@@ -26,6 +26,7 @@ from curve_vae.geometry.frame import (
     chord_heading,
     pose_candidates,
     posed_frame,
+    resample,
     signed_turning,
     turns_clockwise,
 )
@@ -216,15 +217,18 @@ def _chord_heading(pts: np.ndarray) -> np.ndarray:
 
 
 def shared_pose_frames(curves: Sequence[np.ndarray], *, chords: int = 3, flips: bool = True) -> list[list[Frame]]:
-    """`frame.pose_frames` for a set of curves that are mixed together (interpolated, augmented): the same candidate
-    poses — one rotation and mirror image each — for every curve of the set, so that the curves keep their turns
-    relative to each other; each curve's frame still fits its own bounding box (centre and size blend).
+    """`frame.pose_frames` for a set of curves that are mixed together (interpolated, augmented): candidates that
+    agree, across the set, on what does not blend — the mirror image and the point order — so that in-betweens are
+    mapped back through a continuous blend of the curves' frames (`frame.blend_frames`: centres, sizes and rotations
+    blend; mirror and order cannot).
 
-    The curves are aligned one way first: a curve listed the other way round from the set's first curve (its chord
-    pointing against the first's; for loops, turning the other way) is read reversed, so a curve and its reversal
-    are read alike. The set is mirrored when its aligned curves turn clockwise overall (their signed turnings
-    summed), and its chord direction is the mean of their unit chord directions; from there the candidates are
-    pose_frames' own. Per curve: [candidate 0, candidate 1, …], candidate k the same pose for every curve.
+    The curves are aligned one way first: a curve listed the other way round from the set's first curve (nearer it
+    point for point reversed than as listed) is read reversed, so a curve and its reversal are read alike. The set
+    is mirrored when its aligned curves turn clockwise overall (their signed turnings summed). Then each curve's
+    candidates are pose_frames' own for that mirror: its own chord turned to each of the first `chords`
+    POSE_CHORDS (rotations blend, and a latent mix of two curves posed chord down keeps its chord down), as drawn
+    and, with `flips`, reversed and mirrored across the chord's normal. Per curve: [candidate 0, candidate 1, …];
+    candidate k is flipped for every curve or for none (k odd: flipped).
     """
     pts = [np.asarray(c, np.float64) for c in curves]
     if not pts:
@@ -240,31 +244,34 @@ def shared_pose_frames(curves: Sequence[np.ndarray], *, chords: int = 3, flips: 
     else:
         mirror = sum(float(turns_clockwise(c)) - 0.5 for c in aligned) > 0
     flip = np.array([-1.0, 1.0]) if mirror else np.ones(2)
-    headings = np.array([chord_heading(c * flip) for c in aligned])
-    heading = float(np.arctan2(np.sin(headings).sum(), np.cos(headings).sum()))
-    poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
-    return [
-        [posed_frame(c, turn, mirror=mir, reverse=rev != a) for turn, mir, rev in poses] for c, a in zip(pts, against)
-    ]
+    out = []
+    for c, a, al in zip(pts, against, aligned):
+        poses = pose_candidates(chord_heading(al * flip), mirror, chords=chords, flips=flips)
+        out.append([posed_frame(c, turn, mirror=mir, reverse=rev != a) for turn, mir, rev in poses])
+    return out
 
 
-def _against_first(curves: list[np.ndarray]) -> list[bool]:
-    """Which curves run the other way round from the first: open curves by their chords (pointing apart by more than
-    a right angle), loops and nearly closed curves by the sign of their turning."""
+#: A curve of a set is read reversed when, reversed, it lies within this share of its distance as listed from the
+#: set's first curve (point for point, in their own boxes).
+AGAINST = 0.5
 
-    def chord(c: np.ndarray) -> np.ndarray | None:
-        d = c[-1] - c[0]
-        reach = 2 * np.linalg.norm(c - _arc_centroid(c[None])[0], axis=1).max()
-        return d / np.hypot(*d) if np.hypot(*d) >= CLOSED * reach else None
 
-    first, first_turn = chord(curves[0]), signed_turning(curves[0])
+def _against_first(curves: list[np.ndarray], samples: int = 32) -> list[bool]:
+    """Which curves run the other way round from the first: those that, each in its own bounding box (centred, unit
+    size) and at `samples` points evenly along its length, lie clearly nearer the first point for point when
+    reversed than as listed (AGAINST: a curve and its reversal; two strokes of one shape drawn from opposite ends;
+    not two different shapes whose ends lie close together, which stay as they were drawn)."""
+
+    def shape(c: np.ndarray) -> np.ndarray:
+        lo, hi = c.min(axis=0), c.max(axis=0)
+        return resample((c - (lo + hi) / 2) / (hi - lo).max(), samples)
+
+    first = shape(curves[0])
     out = []
     for c in curves:
-        mine = chord(c)
-        if first is not None and mine is not None:
-            out.append(bool(mine @ first < 0))
-        else:
-            out.append(bool(signed_turning(c) * first_turn < 0))
+        mine = shape(c)
+        reversed_, listed = (np.linalg.norm(m - first, axis=1).sum() for m in (mine[::-1], mine))
+        out.append(bool(reversed_ < AGAINST * listed))
     return out
 
 

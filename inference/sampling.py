@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from curve_vae.geometry import self_intersects
+from curve_vae.geometry import sample_bspline, self_intersects
+from curve_vae.geometry.adapt import joined_ends
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.prior import LatentPrior
@@ -114,7 +115,7 @@ class Sampler:
                 params[todo] = par
             if not valid:
                 break
-            good = plausible(decoded.astype(np.float64))
+            good = plausible(self._as_returned(decoded, points, closed=named is not None and named.closed))
             ok[todo[good]] = True
             todo = todo[~good & (draws[todo] < max_draws)]
             for i in todo:
@@ -122,6 +123,19 @@ class Sampler:
                 draws[i] += 1
         invalid = int((~ok).sum()) if valid else 0
         return Drawn(z, out, ctrl, params, chosen, rejected=int(draws.sum() - count), invalid=invalid)
+
+    def _as_returned(self, decoded: np.ndarray, ctrl: np.ndarray | None, *, closed: bool) -> np.ndarray:
+        """(B, n, 2) float64: the decoded curves as `CurveRuntime.sample` returns them, in the model plane: a closed
+        family's closed, its ends joined on the control points (placing.joined), so what is judged is what is
+        returned (the joined spline can cross itself where the decoder's open curve does not)."""
+        out = decoded.astype(np.float64)
+        if not closed:
+            return out
+        if ctrl is None:
+            return np.stack([joined_ends(c) for c in out])
+        joined = np.array(ctrl, np.float64)
+        joined[:, 0] = joined[:, -1] = (joined[:, 0] + joined[:, -1]) / 2
+        return sample_bspline(joined, out.shape[1], self.graphs.spline_degree)
 
     def plausible(self, curves: np.ndarray) -> np.ndarray:
         """(B, n, 2) model-plane curves -> (B,) bool: finite, free of self-intersections and inside the disc."""

@@ -99,7 +99,7 @@ def fit_named_prior(
     steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
     BIC) — and the reference statistics its samples are placed and judged by."""
     from curve_vae.geometry import self_intersects
-    from curve_vae.geometry.adapt import is_closed
+    from curve_vae.geometry.adapt import is_closed, joined_ends
     from curve_vae.geometry.frame import MODEL_CENTER
     from curve_vae.inference.priors import NamedPrior, Reference, frames_array, model_identity
 
@@ -114,7 +114,8 @@ def fit_named_prior(
         latents,
         frames_array(prep.frames, closed) if prep.frames[0] is not None else np.zeros((len(latents), 7)),
         reach,
-        float(self_intersects(decoded).mean()),
+        # a closed curve's reconstruction is returned closed (its ends joined): that loop is what may cross itself
+        float(self_intersects(np.stack([joined_ends(d) if c else d for d, c in zip(decoded, closed)])).mean()),
         float(np.mean(closed)),
     )
     if kind == "parzen":
