@@ -20,7 +20,7 @@ TINY = {
     "dataset": TINY_DATA,
     "train": [*TINY_DATA, "--epochs", "1", "--no-progress"],
     "export": ["--prior-components", "2", "--suite-count", "8"],
-    "evaluate": ["--fresh-seed", "-1", "--suite-count", "8"],
+    "evaluate": ["--fresh-seed", "-1", "--suite-count", "8", "--morph-count", "2"],
     "average": ["--bn-curves", "128"],
     "augment": ["--count", "300"],
 }

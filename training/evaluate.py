@@ -231,6 +231,7 @@ def run_evaluation(
     runtime: Any = None,
     suite_count: int = 0,
     suite_refine: int = 0,
+    morph_count: int = 0,
 ) -> dict[str, Any]:
     """Evaluate on each named test set; write report.json (and figures) into out_dir.
 
@@ -238,7 +239,7 @@ def run_evaluation(
     generation report of its priors, the first test set held out and the second as the real reference,
     and with suite_count > 0 the family suite (training/suite.py) of that many curves per set (with
     suite_refine > 0 also refined by that many fitting steps, as report["families_refined"] = {"refine": steps,
-    "sets": …}).
+    "sets": …}), and with morph_count > 0 the morph suite (training/morphs.py) of that many pairs.
     """
     from curve_vae.training.figures import plot_samples, plot_training
 
@@ -257,6 +258,11 @@ def run_evaluation(
         report["families"], refined = _family_suite(runtime, suite_count, out, figures, suite_refine)
         if refined is not None:
             report["families_refined"] = refined
+    if runtime is not None and morph_count > 0:
+        from curve_vae.training.morphs import morph_pairs, run_morphs
+        from curve_vae.training.suite import paper_test_split
+
+        report["morphs"] = run_morphs(runtime, morph_pairs(paper_test_split(), morph_count))
     if figures and log_path is not None and log_path.exists():
         plot_training(log_path, out / "training.png")
     atomic_write_text(out / "report.json", json.dumps(report, indent=2) + "\n")

@@ -10,6 +10,7 @@ from curve_vae.commands.options import (
     DATA_HELP,
     DEFAULT_MODELS,
     FRESH_TEST_SEED,
+    add_morph_option,
     add_suite_option,
     data_path,
 )
@@ -84,6 +85,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
         runtime=runtime,
         suite_count=a.suite_count,
         suite_refine=a.suite_refine,
+        morph_count=a.morph_count,
     )
     for name, r in report["test_sets"].items():
         s_in, s_out = r["smoothness_input"]["roughness"], r["smoothness_output"]["roughness"]
@@ -99,6 +101,11 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
             f"self-intersecting {lat['self_intersecting']:.1%}; point-wise blends {pw['roughness']:.3f}°, "
             f"{pw['self_intersecting']:.1%}"
         )
+    if "morphs" in report:
+        from curve_vae.training.morphs import format_morphs
+
+        print(f"morph suite ({report['morphs']['pairs']} pairs, {report['morphs']['steps']} steps):")
+        print(format_morphs(report["morphs"]))
     for prior, g in report.get("generation", {}).items():
         if isinstance(g, dict):
             raw, kept = g["every_draw"], g["valid"]
@@ -219,6 +226,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument("--no-figures", action="store_true", help="write only report.json")
     add_suite_option(s)
+    add_morph_option(s)
     s.set_defaults(func=cmd_evaluate)
 
 

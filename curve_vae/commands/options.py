@@ -94,6 +94,16 @@ def add_suite_option(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_morph_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--morph-count",
+        type=int,
+        default=40,
+        help="pairs of the morph suite (training/morphs.py: sweeps between pairs of the paper's curves drawn in one "
+        "pose, their chords' turn and end points' drift beside point-wise blending); 0 skips it (default: 40)",
+    )
+
+
 def add_model_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("model (offline: onnxruntime on the exported graphs, no server)")
     g.add_argument(

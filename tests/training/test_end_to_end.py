@@ -100,10 +100,12 @@ def test_evaluate_exported_model(trained, capsys):
     tmp, data, _, _, _ = trained
     out = tmp / "eval"
     args = ["evaluate", "--model-dir", str(tmp / "models"), "--data", data, "--out", str(out), "--suite-count", "20"]
-    assert main(args) == 0
+    assert main([*args, "--morph-count", "4"]) == 0
     printed = capsys.readouterr().out
     assert "test: MSE" in printed and "fresh_seed_7919: MSE" in printed
     report = json.loads((out / "report.json").read_text())
+    assert "morph suite (4 pairs, 7 steps)" in printed and report["morphs"]["pointwise"]["end_drift_max"] < 1e-9
+    assert 0 <= report["morphs"]["default"]["share_turning_beyond_limit"] <= 1
     for name in ("test", "fresh_seed_7919"):
         interp = report["test_sets"][name]["interpolation"]
         assert interp["pairs"] > 150 and interp["steps"] == 5
