@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from curve_vae.cli import main
-from curve_vae.files import read_curves
+from curve_vae.curvefiles import read_curves
 from curve_vae.geometry import random_control_points, sample_bspline
 
 
