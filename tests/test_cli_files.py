@@ -24,7 +24,14 @@ pytestmark = pytest.mark.skipif(not (SHIPPED / "manifest.json").is_file(), reaso
 
 @pytest.mark.parametrize(
     "name",
-    ["page-export.json", "page-export.csv", "inkscape_drawing.svg", "selig_notes.dat", "ezdxf_drawing.dxf"],
+    [
+        "page-export.json",
+        "page-export.csv",
+        "page-export.dxf",
+        "inkscape_drawing.svg",
+        "selig_notes.dat",
+        "ezdxf_drawing.dxf",
+    ],
 )
 def test_reconstruct_gives_one_curve_back_per_curve_in(name, tmp_path, capsys):
     out = tmp_path / "out.json"

@@ -51,6 +51,15 @@ def test_the_pages_svg_export_gives_its_strokes_y_up():
         np.testing.assert_allclose(got, np.asarray(saved["points"]) - [0, 700], atol=1e-3)
 
 
+def test_the_pages_dxf_export_gives_its_strokes_and_splines():
+    curves = read_curves(FILES / "page-export.dxf")
+    assert len(curves) == 3 + 3 + 1  # the strokes as polylines; the reconstructions and the mix as SPLINEs
+    for got, saved in zip(curves[:3], PAGE[:3]):
+        np.testing.assert_array_equal(got, saved["points"])
+    mix = PAGE[3]["spline"]  # the export's mix: its spline sampled along its parameter
+    np.testing.assert_allclose(curves[-1][[0, -1]], np.asarray(mix["control_points"])[[0, -1]], atol=1e-9)
+
+
 @pytest.mark.parametrize(
     ("name", "code", "warning"),
     [
