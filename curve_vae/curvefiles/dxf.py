@@ -21,8 +21,8 @@ def read_dxf(path: str | Path, name: str) -> list[np.ndarray]:
     """The curves of a DXF drawing's model space, in the order they are stored."""
     try:
         doc = ezdxf.readfile(str(path))
-    except (OSError, ezdxf.DXFError) as e:
-        raise CurveFileError(f"{name}: not a DXF drawing ({e})") from None
+    except (OSError, ezdxf.DXFError) as err:
+        raise CurveFileError(f"{name}: not a DXF drawing ({err})") from None
     curves: list[np.ndarray] = []
     for e in doc.modelspace().query("LWPOLYLINE POLYLINE SPLINE"):
         pts = _points(e)
