@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -55,6 +56,8 @@ def cmd_encode(a: argparse.Namespace) -> int:
     from curve_vae.inference.reading import Reading
 
     refuse_overwrite(a.output, a.force)
+    if a.output != "-" and Path(a.output).suffix.lower() not in ("", ".json"):
+        raise ValueError(f"{a.output}: encode writes latents as JSON (a .json file, or - for stdout)")
     curves = read_curves(a.input)
     if a.server:
         with server_client(a) as c:
