@@ -93,7 +93,7 @@ def parse_csv(text: str, name: str) -> list[np.ndarray]:
         row = _cells(lines[i], delimiter)
         values = [number(row[j]) if j < len(row) else None for j in (x, y)]
         if values[0] is None or values[1] is None or (not header and len(row) != 2):
-            what = "x and y in the columns the header names" if header else "two numbers x,y"
+            what = "two numbers x,y" if not header or len(cells) == 2 else "numbers in the columns named x and y"
             raise CurveFileError(f"{name}:{i + 1}: expected {what}, got {lines[i].strip()!r}")
         if key is not None and row[key] != last:
             curves.append([])

@@ -78,7 +78,8 @@
       const row = cells(lines[i], delimiter);
       const [px, py] = [number(row[x] ?? ""), number(row[y] ?? "")];
       if (px === null || py === null || (!header && row.length !== 2)) {
-        throw new CurveFileError(`${name}:${i + 1}: expected ${header ? "x and y in the columns the header names" : "two numbers x,y"}, got "${lines[i].trim()}"`);
+        const what = !header || head.length === 2 ? "two numbers x,y" : "numbers in the columns named x and y";
+        throw new CurveFileError(`${name}:${i + 1}: expected ${what}, got "${lines[i].trim()}"`);
       }
       if (key >= 0 && row[key] !== last) { curves.push([]); last = row[key]; }
       curves[curves.length - 1].push([px, py]);

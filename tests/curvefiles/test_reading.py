@@ -145,7 +145,13 @@ def test_npz_arrays_by_name(tmp_path):
 @pytest.mark.parametrize(
     ("name", "text", "message"),
     [
-        pytest.param("bad.csv", "x,y\n0,0\n1,oops\n", r"bad\.csv:3: expected x and y", id="csv-row"),
+        pytest.param("bad.csv", "x,y\n0,0\n1,oops\n", r"bad\.csv:3: expected two numbers x,y", id="csv-row"),
+        pytest.param(
+            "cols.csv",
+            "curve,x,y\nA,0,0\nA,1,\n",
+            r"cols\.csv:3: expected numbers in the columns named x and y",
+            id="cols",
+        ),
         pytest.param("three.csv", "0,0,1\n", r"three\.csv:1: expected two numbers x,y", id="csv-columns"),
         pytest.param("empty.json", "[]", r"empty\.json: no curve in this file", id="json-empty"),
         pytest.param("other.json", '{"latents": []}', r"other\.json: a JSON object needs a 'curves' list", id="obj"),
