@@ -155,3 +155,29 @@ def test_samples_side_by_side_and_clear_clears_everything(browser, server):  # n
     )
     assert not painted and page.locator("#board path").count() == 0
     assert errors == []
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "selig_notes.dat",
+        "selig_two_line_header_notes.dat",
+        "selig_remarks.dat",
+        "lednicer_two_line_header.dat",
+        "selig_fortran.dat",
+        "page-export.csv",
+        "page-export.json",
+    ],
+)
+def test_the_page_reads_a_file_as_the_command_line_does(browser, server, name):  # noqa: F811
+    """files.js and curve_vae/curvefiles read the same curves from the same file."""
+    from curve_vae.curvefiles import read_curves
+
+    page, errors = open_page(browser, server.url + "/")
+    text = (FILES / name).read_text()
+    got = page.evaluate("([name, text]) => window.curveFiles.parse(name, text).curves", [name, text])
+    want = read_curves(FILES / name)
+    assert len(got) == len(want)
+    for g, w in zip(got, want):
+        np.testing.assert_allclose(g, w, rtol=1e-15, atol=0)
+    assert errors == []
