@@ -58,7 +58,8 @@ def _arrays(path: Path, name: str) -> list[np.ndarray]:
 
 
 def read_curves(path: str | Path) -> list[np.ndarray]:
-    """Every curve of one file, by its extension (anything else is read as JSON); "-" reads JSON from stdin."""
+    """Every curve of one file, by its extension (.txt as an airfoil's .dat; anything else is read as JSON); "-" reads
+    JSON from stdin."""
     name = str(path)
     if name == "-":
         return parse_json(sys.stdin.read(), "<stdin>")
@@ -77,7 +78,7 @@ def read_curves(path: str | Path) -> list[np.ndarray]:
 
         return read_dxf(p, name)
     text = p.read_text(errors="replace")
-    if suffix == ".dat":
+    if suffix in (".dat", ".txt"):  # airfoil coordinates come as either
         return [parse_dat(text, name)]
     if suffix in (".csv", ".tsv"):
         return parse_csv(text, name)
@@ -85,11 +86,13 @@ def read_curves(path: str | Path) -> list[np.ndarray]:
 
 
 def read_curve_files(source: str | Path) -> list[np.ndarray]:
-    """Every curve of a file, or of every curve file under a directory (sorted by path). A file of another kind in
-    the directory is named in a warning; a curve file that cannot be read stops it, naming the file."""
+    """Every curve of a file, or of every curve file under a directory (sorted by path; hidden ones aside). A file of
+    another kind in the directory is named in a warning; a curve file that cannot be read stops it, naming the file."""
     src = Path(source)
     if src.is_dir():
-        files = sorted(p for p in src.rglob("*") if p.is_file() and not p.name.startswith("."))
+        files = sorted(  # hidden files and folders (.git, .ipynb_checkpoints) are not the user's curves
+            p for p in src.rglob("*") if p.is_file() and not any(q.startswith(".") for q in p.relative_to(src).parts)
+        )
         paths = [p for p in files if p.suffix.lower() in CURVE_SUFFIXES]
         others = [p.relative_to(src).as_posix() for p in files if p.suffix.lower() not in CURVE_SUFFIXES]
         if others:

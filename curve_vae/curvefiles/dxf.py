@@ -1,5 +1,5 @@
 """DXF in and out (ezdxf). In: the model space's LWPOLYLINE and POLYLINE entities (their vertices; bulges as arcs)
-and SPLINEs (sampled along their parameter), x and y. Out: a B-spline as a SPLINE entity with its control points and
+and SPLINEs (sampled along their parameter), x and y, those of inserted blocks where the INSERT puts them. Out: a B-spline as a SPLINE entity with its control points and
 knots exactly, points as an LWPOLYLINE."""
 
 from __future__ import annotations
@@ -10,9 +10,11 @@ from typing import Any
 import ezdxf
 import numpy as np
 from ezdxf import path as dxfpath
+from ezdxf.disassemble import recursive_decompose
 
 from curve_vae.curvefiles.common import MIN_POINTS, CurveFileError, as_curves, warn
 
+KINDS = ("LWPOLYLINE", "POLYLINE", "SPLINE")
 #: Points along a SPLINE per control point (at least 64 in all).
 SAMPLES_PER_CONTROL_POINT = 8
 
@@ -24,9 +26,11 @@ def read_dxf(path: str | Path, name: str) -> list[np.ndarray]:
     except (OSError, ezdxf.DXFError) as err:
         raise CurveFileError(f"{name}: not a DXF drawing ({err})") from None
     curves: list[np.ndarray] = []
-    for e in doc.modelspace().query("LWPOLYLINE POLYLINE SPLINE"):
+    for e in recursive_decompose(doc.modelspace()):  # blocks' entities where they are inserted, transformed
+        if e.dxftype() not in KINDS:
+            continue
         pts = _points(e)
-        label = f"{e.dxftype()} #{e.dxf.handle}"
+        label = f"{e.dxftype()} #{e.dxf.handle}" if e.dxf.handle else f"{e.dxftype()} of a block"
         if len(pts) < MIN_POINTS:
             warn(f"{name}: {label}: {len(pts)} points, not a curve; skipped")
             continue

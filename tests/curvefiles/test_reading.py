@@ -88,6 +88,8 @@ def test_a_folder_of_airfoils_with_notes_is_read_whole(tmp_path):
     for f in FILES.glob("*.dat"):
         (tmp_path / f.name).write_text(f.read_text())
     (tmp_path / "README.txt").write_text("where these came from")
+    (tmp_path / ".ipynb_checkpoints").mkdir()
+    (tmp_path / ".ipynb_checkpoints" / "half-saved.json").write_text("[[0, 0], [1,")  # hidden: not the user's curves
     with pytest.warns(CurveFileWarning, match=r"1 file\(s\) not of a curve kind skipped: README\.txt"):
         curves = read_curve_files(tmp_path)
     assert len(curves) == 5 and all(len(c) == 69 for c in curves)
@@ -107,13 +109,15 @@ def test_an_inkscape_drawing_gives_its_path_polyline_and_polygon_with_their_tran
     assert len(polygon) == 5 and np.array_equal(polygon[0], polygon[-1])  # a polygon is a loop
 
 
-def test_a_dxf_gives_its_polylines_and_spline():
-    open_lw, closed_lw, old, spline = read_curves(FILES / "ezdxf_drawing.dxf")
+def test_a_dxf_gives_its_polylines_and_spline_and_the_block_it_inserts():
+    open_lw, closed_lw, old, spline, inserted = read_curves(FILES / "ezdxf_drawing.dxf")
     np.testing.assert_array_equal(open_lw, [[0, 0], [10, 4], [20, 5], [30, 3], [40, 0]])
     np.testing.assert_array_equal(closed_lw, [[50, 0], [60, 0], [60, 10], [50, 10], [50, 0]])
     np.testing.assert_array_equal(old, [[0, 20], [8, 26], [16, 28], [24, 26], [32, 20]])
     assert len(spline) == 64
     np.testing.assert_allclose(spline[[0, -1]], [[0, 40], [50, 45]], atol=1e-9)  # clamped: ends at its ends
+    block = np.array([[0, 0], [5, 2], [10, 2.5], [15, 1.5], [20, 0]])
+    np.testing.assert_allclose(inserted, [100, 10] + 2 * block @ [[0, 1], [-1, 0]], atol=1e-9)  # turned 90°, × 2
 
 
 @pytest.mark.parametrize(
