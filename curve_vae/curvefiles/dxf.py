@@ -1,6 +1,6 @@
 """DXF in and out (ezdxf). In: the model space's LWPOLYLINE and POLYLINE entities (their vertices; bulges as arcs)
-and SPLINEs (sampled along their parameter), x and y, those of inserted blocks where the INSERT puts them. Out: a B-spline as a SPLINE entity with its control points and
-knots exactly, points as an LWPOLYLINE."""
+and SPLINEs (sampled along their parameter), x and y, those of inserted blocks where the INSERT puts them. Out: a
+B-spline as a SPLINE entity with its control points and knots exactly, points as an LWPOLYLINE."""
 
 from __future__ import annotations
 
