@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import json
 
-import ezdxf
 import numpy as np
 import pytest
+from ezdxf import recover
 
 from tests.helpers import FIXTURES
 from tests.service.test_page import arc, browser, draw, open_page, server, state  # noqa: F401 - fixtures
@@ -90,7 +90,8 @@ def test_the_dxf_download_holds_the_curves_and_the_splines_exactly(browser, serv
     s = _wait_for(page, 3)
     with page.expect_download() as download:
         page.click("#download-dxf")
-    doc = ezdxf.readfile(download.value.path())
+    doc, audit = recover.readfile(download.value.path())  # ezdxf's audit, as a CAD program would check it
+    assert not audit.has_errors and not audit.fixes, [e.message for e in audit.errors]
     polylines = list(doc.modelspace().query("LWPOLYLINE"))
     splines = {e.dxf.layer: e for e in doc.modelspace().query("SPLINE")}
     assert [p.dxf.layer for p in polylines] == ["input-A", "input-B", "input-C"]
