@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
+from typing import TextIO
 
 from curve_vae import __version__
 from curve_vae.commands import curves, data, design, generate, model, priors, train
@@ -62,7 +63,14 @@ def _show_file_warnings(command: str) -> None:
 
     shown = warnings.showwarning
 
-    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001 - warnings' own signature
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: TextIO | None = None,
+        line: str | None = None,
+    ) -> None:
         if issubclass(category, CurveFileWarning):
             print(f"curve-vae {command}: warning: {message}", file=sys.stderr)
         else:
