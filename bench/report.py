@@ -14,10 +14,13 @@ ROW_LABELS = {
     "A_fast": "A, the fast path (pose as_is, spacing parameter)",
     "B": "**B: /reconstruct, 1 curve, the default request**, 16 connections",
     "B_fast": "B, the fast path (pose as_is, spacing parameter)",
+    "A_one": "A, one pass (pose canonical, spacing parameter)",
+    "B_one": "B, one pass (pose canonical, spacing parameter)",
     "B_npy": "B with a .npy body",
     "B_cached": "B with the encoding cache on (the same curve every time)",
     "latency_1": "/reconstruct, 1 curve, the default request, 1 connection",
     "latency_1_fast": "/reconstruct, 1 curve, the fast path, 1 connection",
+    "latency_1_one": "/reconstruct, 1 curve, one pass, 1 connection",
     "latency_1_search": "/reconstruct, 1 curve, the search (pose, spacing search), 1 connection",
     "interpolate": "/interpolate, pair, 5 steps, the default request, 16 connections",
     "spinning": "B, spinning on (`--spinning true`)",
@@ -25,6 +28,7 @@ ROW_LABELS = {
     "workers": "B, `--workers 2 --inference-concurrency 1`",
     "one_session": "B, one session pair for both threads (`--sessions 1`)",
     "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
+    "micro_batch_one": "B, one pass, micro-batching on",
 }
 
 
@@ -55,7 +59,19 @@ def _table(r: dict[str, Any]) -> list[str]:
         "| other CPU s | non-2xx |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    single = ("B", "B_fast", "B_npy", "B_cached", "spinning", "access_log", "workers", "one_session", "micro_batch")
+    single = (
+        "B",
+        "B_fast",
+        "B_one",
+        "B_npy",
+        "B_cached",
+        "spinning",
+        "access_log",
+        "workers",
+        "one_session",
+        "micro_batch",
+        "micro_batch_one",
+    )
     for key, label in ROW_LABELS.items():
         if key not in r:
             continue

@@ -43,6 +43,7 @@ LUA = Path(__file__).resolve().parent / "post.lua"
 RUNS = (
     "A",
     "B",
+    "one_pass",
     "B_npy",
     "latency",
     "interpolate",
@@ -232,6 +233,7 @@ def _load(
 
 
 FAST = {"pose": "as_is", "spacing": "parameter"}  # the fast path: the curve read as it is listed
+ONE_PASS = {"pose": "canonical", "spacing": "parameter"}  # one encoding per curve, in the canonical pose
 SEARCH = {"pose": "search", "spacing": "search"}  # every pose and spacing candidate, the closest kept
 NO_CACHE = {"CURVE_VAE_CACHE_BYTES": "0"}  # wrk posts one body again and again: without this, every curve is a hit
 
@@ -259,6 +261,11 @@ def _default_server_runs(
         if "B" in runs:
             load("B", server, "/reconstruct", json_body(one))
             load("B_fast", server, "/reconstruct", json_body(one, **FAST))
+        if "one_pass" in runs:
+            r = load("A_one", server, "/reconstruct", json_body(many, **ONE_PASS), c=2)
+            r["curves_per_s"] = r["rps"] * 128
+            load("B_one", server, "/reconstruct", json_body(one, **ONE_PASS))
+            load("latency_1_one", server, "/reconstruct", json_body(one, **ONE_PASS), c=1)
         if "B_npy" in runs:
             load("B_npy", server, "/reconstruct", npy_body(one), "application/x-npy")
         if "latency" in runs:
@@ -288,6 +295,8 @@ def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: se
             server = Server(model_dir, *flags, env=NO_CACHE)
             try:
                 load(name, server, "/reconstruct", single)
+                if name == "micro_batch" and "one_pass" in runs:  # does sharing graph runs help a one-pass request?
+                    load("micro_batch_one", server, "/reconstruct", json_body(_callers(1, seed=1), **ONE_PASS))
             finally:
                 server.stop()
 
@@ -303,7 +312,7 @@ def _ceiling_again(report: dict[str, Any], model_dir: Path, secs: float) -> None
         inproc[key] = max(inproc[key], again[key])
     inproc["ceiling"] = top = max(inproc["ceiling"], again["ceiling"])
     for name, x in report.items():
-        if name in ("A", "A_fast", "B", "B_fast", "B_npy", "B_cached", *VARIANTS):
+        if name in ("A", "A_fast", "A_one", "B", "B_fast", "B_one", "B_npy", "B_cached", "micro_batch_one", *VARIANTS):
             x["ratio"] = x.get("curves_per_s", x["rps"]) / top
 
 

@@ -86,6 +86,60 @@ def evaluate_bspline(control_points: np.ndarray, params: np.ndarray, degree: int
     return np.einsum("pc,...cd->...pd", basis, ctrl)
 
 
+def spline_values(
+    control_points: np.ndarray, params: np.ndarray, owner: np.ndarray | None = None, *, degree: int = 3, order: int = 0
+) -> list[np.ndarray]:
+    """Points of clamped uniform B-splines (B, n_ctrl, 2) at parameters (N,) in [0, 1], point k on spline `owner[k]`
+    (default: every point on the first), and their first `order` derivatives in u: [(N, 2), …], order + 1 arrays.
+
+    A batch of curves of any lengths in a few array operations, whatever the batch: on each knot span the degree + 1
+    basis functions that are non-zero there are polynomials (`_span_polynomials`), so each parameter's values and
+    derivatives are its span's coefficients times powers of its place in the span, gathered against its own
+    spline's control points.
+    """
+    c = np.asarray(control_points, np.float64)
+    u = np.clip(np.asarray(params, np.float64), 0.0, 1.0)
+    who = np.zeros(len(u), np.int64) if owner is None else np.asarray(owner, np.int64)
+    coef = _span_polynomials(c.shape[-2], degree)  # (spans, degree + 1 functions, degree + 1 powers)
+    spans = len(coef)
+    span = np.minimum((u * spans).astype(np.int64), spans - 1)
+    x = u * spans - span  # place in the span, [0, 1]
+    first = who * c.shape[-2] + span  # each point's first control point at work, among all the splines' rows
+    near = c.reshape(-1, 2)[first[:, None] + np.arange(degree + 1)]  # (N, degree + 1, 2)
+    a = coef[span]  # (N, functions, powers)
+    powers = np.vander(x, degree + 1, increasing=True)  # (N, powers) x^k
+    out = []
+    for d in range(order + 1):
+        # the d-th derivative of x^k is k!/(k - d)!·x^(k - d); in u, times spans^d
+        xs = np.zeros_like(powers)
+        xs[:, d:] = powers[:, : degree + 1 - d] * (_FALLING[d, d : degree + 1] * float(spans) ** d)
+        w = np.einsum("njk,nk->nj", a, xs)  # (N, functions) the basis values (or derivatives) at u
+        out.append(np.einsum("nj,njd->nd", w, near))
+    return out
+
+
+#: k!/(k - d)! for d (rows) and k (columns) up to degree 7: the factor of x^(k - d) in the d-th derivative of x^k
+_FALLING = np.array([[np.prod(np.arange(k - d + 1, k + 1)) if k >= d else 0.0 for k in range(8)] for d in range(8)])
+
+
+@lru_cache(maxsize=16)
+def _span_polynomials(n_ctrl: int, degree: int) -> np.ndarray:
+    """(spans, degree + 1, degree + 1): on knot span s of a clamped uniform B-spline, basis function s + j is
+    Σ_k coef[s, j, k]·x^k, x ∈ [0, 1] the place in the span — solved from the basis at degree + 1 places (exact up to
+    rounding: the functions are polynomials of that degree there). Read-only."""
+    knots = clamped_uniform_knots(n_ctrl, degree)
+    spans = n_ctrl - degree
+    x = np.linspace(0.0, 1.0, degree + 1)
+    vander = np.vander(x, degree + 1, increasing=True)  # (places, powers)
+    coef = np.empty((spans, degree + 1, degree + 1))
+    for s in range(spans):
+        u = np.clip((s + x) / spans, 0.0, 1.0)
+        basis = BSpline.design_matrix(u, knots, degree).toarray()[:, s : s + degree + 1]  # (places, functions)
+        coef[s] = np.linalg.solve(vander, basis).T
+    coef.setflags(write=False)
+    return coef
+
+
 def arc_length_params(control_points: np.ndarray, n_points: int, *, degree: int = 3, dense: int = 4096) -> np.ndarray:
     """n_points parameters in [0, 1] of a clamped uniform B-spline (n_ctrl, 2), evenly spaced in its arc length."""
     return params_at_arc_fractions(control_points, np.linspace(0.0, 1.0, n_points), degree=degree, dense=dense)

@@ -164,6 +164,16 @@ def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> l
     pts = np.asarray(points, np.float64)
     mirror = turns_clockwise(pts)
     heading = chord_heading(pts * ([-1.0, 1.0] if mirror else 1.0))
+    poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
+    return [posed_frame(pts, turn, mirror=mir, reverse=rev) for turn, mir, rev in poses]
+
+
+def pose_candidates(
+    heading: float, mirror: bool, *, chords: int = 3, flips: bool = True
+) -> list[tuple[float, bool, bool]]:
+    """The poses (rotation, mirror, reverse) `pose_frames` tries for a curve whose chord, mirrored as `mirror`
+    says, points at `heading` (radians): its chord turned to each of the first `chords` POSE_CHORDS, with `flips`
+    each also reversed and mirrored across the chord's normal."""
     poses = []
     for target in POSE_CHORDS[:chords]:
         turn = float(np.angle(np.exp(1j * (target - heading))))
@@ -175,7 +185,7 @@ def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> l
             c, s = np.cos(turn), np.sin(turn)
             a = (np.eye(2) - 2 * np.outer(n, n)) @ np.array([[c, -s], [s, c]]) @ np.diag([-1.0, 1.0])
             poses.append((float(np.arctan2(a[1, 0], a[0, 0])), not mirror, True))
-    return [posed_frame(pts, turn, mirror=mir, reverse=rev) for turn, mir, rev in poses]
+    return poses
 
 
 def canonical_frame(points: np.ndarray) -> Frame:
@@ -185,16 +195,11 @@ def canonical_frame(points: np.ndarray) -> Frame:
     product moment about the centroid (across × along the chord) is positive. Those two moves turn either statistic
     into its negative, so a curve, its reversal, its mirror image and its rotations all come to the same posed
     points (to rounding; a curve for which both are exactly zero is symmetric under the moves, or keeps the pose
-    it is listed in)."""
-    drawn, flipped = pose_frames(points, chords=1)
-    posed = (np.asarray(points, np.float64) - np.asarray(drawn.center)) @ drawn._linear()  # chord along −y
-    centroid = arc_centroid(posed)
-    offset = (posed[0, 1] + posed[-1, 1]) / 2 - centroid[1]  # along the chord (−y), from the ends' midpoint
-    if abs(offset) <= 1e-9 * drawn.size:
-        seg = np.linalg.norm(np.diff(posed, axis=0), axis=1)
-        rel = (posed[1:] + posed[:-1]) / 2 - centroid
-        offset = -float((seg * rel[:, 0] * rel[:, 1]).sum())
-    return drawn if offset >= 0 else flipped
+    it is listed in). Computed as for a batch of one (geometry.batch.canonical_frames), so a curve gets the same
+    frame alone and in a batch."""
+    from curve_vae.geometry.batch import canonical_frames  # batch builds on this module
+
+    return canonical_frames([points])[0]
 
 
 def posed_frame(points: np.ndarray, rotation: float, *, mirror: bool = False, reverse: bool = False) -> Frame:
@@ -223,6 +228,19 @@ def at_fractions(curve: np.ndarray, fractions: np.ndarray) -> np.ndarray:
     x = np.clip(fractions, 0.0, 1.0) * (len(curve) - 1)
     idx = np.arange(len(curve))
     return np.stack([np.interp(x, idx, curve[:, 0]), np.interp(x, idx, curve[:, 1])], axis=1)
+
+
+def resample_index(curves: np.ndarray, n_points: int) -> np.ndarray:
+    """Curves of one length (k, n, 2) at `n_points` even steps of their point index (`at_fractions` of each at
+    even fractions; `resample` with spacing "parameter"), all at once; a curve of n_points comes back as it is."""
+    pts = np.asarray(curves, np.float64)
+    n = pts.shape[1]
+    if n == n_points:
+        return pts.copy()
+    x = np.linspace(0.0, 1.0, n_points) * (n - 1)
+    lo = np.minimum(np.floor(x).astype(np.int64), n - 2)
+    w = (x - lo)[None, :, None]
+    return pts[:, lo] * (1 - w) + pts[:, lo + 1] * w
 
 
 def resample(points: np.ndarray, n_points: int, *, spacing: str = "arc_length") -> np.ndarray:

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from curve_vae.geometry.bspline import _basis_splines, sample_bspline
+from curve_vae.geometry.bspline import sample_bspline, spline_values
 
 #: Samples of each spline the match runs over: about 9 per knot span of the shipped 31-point head.
 DENSE = 257
@@ -44,7 +44,6 @@ def ordered_closest_params(
     count = len(points)
     if count == 0:
         return [], np.zeros(0)
-    n_ctrl = ctrl.shape[1]
     samples = sample_bspline(ctrl, dense, degree)  # (B, m, 2)
     grid = np.linspace(0.0, 1.0, dense)
     lengths = np.array([len(p) for p in points])
@@ -59,16 +58,13 @@ def ordered_closest_params(
         idx = order[start:stop]
         longest = int(lengths[idx].max())
         padded = np.stack([_padded(np.asarray(points[i], np.float64), longest) for i in idx])
-        sample_idx = _match(padded, samples[idx].astype(np.float32), lengths[idx])
+        sample_idx = _ordered_nearest(padded, samples[idx].astype(np.float32), lengths[idx])
         for row, i in enumerate(idx):
             params[i] = grid[sample_idx[row, : lengths[i]]]
         start = stop
-    basis, slope = _basis_splines(n_ctrl, degree)
-    curvature = slope.derivative()
     flat_u = np.concatenate(params)
     owner = np.repeat(np.arange(count), lengths)
     flat_p = np.concatenate([np.asarray(p, np.float64) for p in points])
-    c = ctrl[owner]  # (N, n_ctrl, 2)
     step = 1.0 / (dense - 1)
     lo, hi = np.clip(flat_u - step, 0.0, 1.0), np.clip(flat_u + step, 0.0, 1.0)
     inner = np.ones(len(flat_u), bool)
@@ -76,21 +72,21 @@ def ordered_closest_params(
     inner[ends[:-1]] = inner[ends[1:] - 1] = False
     flat_u[ends[:-1]], flat_u[ends[1:] - 1] = 0.0, 1.0
 
-    def at(u: np.ndarray, fn=basis) -> np.ndarray:
-        return np.einsum("nk,nkd->nd", fn(u), c)
+    def at(u: np.ndarray, order: int = 0) -> list[np.ndarray]:
+        return spline_values(ctrl, u, owner, degree=degree, order=order)
 
-    r = at(flat_u) - flat_p
+    r = at(flat_u)[0] - flat_p
     for _ in range(newton):
-        t, k = at(flat_u, slope), at(flat_u, curvature)
+        _, t, k = at(flat_u, 2)
         grad, curv = (r * t).sum(-1), (t * t).sum(-1) + (r * k).sum(-1)
         moved = np.clip(flat_u - np.where(curv > 0, grad / np.where(curv > 0, curv, 1.0), 0.0), lo, hi)
         moved = np.where(inner, moved, flat_u)
-        r_moved = at(moved) - flat_p
+        r_moved = at(moved)[0] - flat_p
         closer = (r_moved**2).sum(-1) < (r**2).sum(-1)
         flat_u = np.where(closer, moved, flat_u)
         r = np.where(closer[:, None], r_moved, r)
     out = [np.maximum.accumulate(flat_u[a:b]) for a, b in zip(ends[:-1], ends[1:])]
-    r = at(np.concatenate(out)) - flat_p
+    r = at(np.concatenate(out))[0] - flat_p
     distance = np.bincount(owner, weights=(r**2).sum(-1), minlength=count)
     return out, distance
 
@@ -98,6 +94,28 @@ def ordered_closest_params(
 def _padded(points: np.ndarray, length: int) -> np.ndarray:
     """(length, 2): the points, then their last point repeated (a repeated end matches the spline's end)."""
     return np.concatenate([points, np.repeat(points[-1:], length - len(points), axis=0)])
+
+
+def _ordered_nearest(points: np.ndarray, samples: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """`_match`'s answer, found the quick way where it can be: each inner point's nearest sample, for all points of all
+    curves in one array operation. Where those indices already run in order (ends at the ends), no order-keeping
+    assignment can be closer, so they are the match; the dynamic programme runs only on the curves where they do not
+    (a curve that comes back near itself, a corner sharper than the spline's)."""
+    b, n, _ = points.shape
+    m = samples.shape[1]
+    p = points.astype(np.float32)
+    # the squared distances as _match computes them (float32, x and y apart), so that both find the same samples
+    dx = samples[:, None, :, 0] - p[:, :, None, 0]  # (b, n, m)
+    dy = samples[:, None, :, 1] - p[:, :, None, 1]
+    np.multiply(dx, dx, out=dx)
+    np.multiply(dy, dy, out=dy)
+    out = np.add(dx, dy, out=dx).argmin(axis=2)
+    out[:, 0] = 0
+    out[np.arange(n)[None, :] >= (lengths - 1)[:, None]] = m - 1  # each curve's last point and its padding: the end
+    tangled = (np.diff(out, axis=1) < 0).any(axis=1)
+    if tangled.any():
+        out[tangled] = _match(points[tangled], samples[tangled], lengths[tangled])
+    return out
 
 
 def _match(points: np.ndarray, samples: np.ndarray, lengths: np.ndarray) -> np.ndarray:

@@ -9,8 +9,11 @@ import numpy as np
 
 from curve_vae.geometry import Frame, polyline_to_caller, spline_to_caller
 from curve_vae.geometry.adapt import F32_MAX, joined_ends
+from curve_vae.geometry.batch import FrameRows, Ragged
+from curve_vae.geometry.bspline import spline_values
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.results import Curves, Spline
 
 
@@ -47,6 +50,44 @@ def to_caller(
     )
     assert g.knots is not None
     return curve, Spline(c, g.knots, g.spline_degree, u)
+
+
+def placed_to_caller(g: ModelGraphs, prep: Prepared) -> tuple[list[np.ndarray], list[Spline], np.ndarray] | None:
+    """`to_caller` of every reconstruction at its caller's points at once, for a batch whose points were placed on
+    their splines (`ReadCurve.feet`) in frames of their own: each curve's points, its spline in the caller's frame
+    and its MSE (paper eq. 4) against the input; a closed input comes back closed. None where the batch is not of
+    that kind (the caller's code then maps each curve by itself)."""
+    rows = prep.rows
+    if not rows or not prep.placed or any(r.frame is None or r.ctrl is None for r in rows):
+        return None
+    curves = Ragged.of(prep.inputs)
+    starts, ends = curves.starts, curves.starts + curves.lengths - 1
+    pts = curves.points
+    extent = (np.maximum.reduceat(pts, starts) - np.minimum.reduceat(pts, starts)).max(axis=1)
+    closed = np.abs(pts[ends] - pts[starts]).max(axis=1) <= 1e-9 * extent  # geometry.adapt.is_closed, per curve
+    ctrl = np.stack([r.ctrl for r in rows]).astype(np.float64)  # type: ignore[misc]
+    ctrl[closed, 0] = ctrl[closed, -1] = (ctrl[closed, 0] + ctrl[closed, -1]) / 2  # joined: a loop comes back a loop
+    frames = FrameRows.of([r.frame for r in rows])  # type: ignore[misc]
+    feet = np.concatenate([r.feet for r in rows])  # type: ignore[misc]
+    model = spline_values(ctrl, feet, curves.owner, degree=g.spline_degree)[0]
+    back = frames.from_model(Ragged(model, curves.lengths), g.model_size)
+    n_ctrl = ctrl.shape[1]
+    ctrl_back = frames.from_model(Ragged(ctrl.reshape(-1, 2), np.full(len(rows), n_ctrl)), g.model_size)
+    reverse = frames.reverse[curves.owner]
+    params = np.where(reverse, 1.0 - feet, feet)[curves.reversed_where(frames.reverse)]
+    sq = ((pts - back) ** 2).sum(axis=1)
+    mse = np.bincount(curves.owner, weights=sq, minlength=len(rows)) / (2 * curves.lengths)
+    bad = ~(np.isfinite(mse) & np.isfinite(np.add.reduceat(np.abs(back).sum(axis=1), starts)))
+    if bad.any():
+        raise InputError(
+            ("curves", int(np.argmax(bad))), "the reconstruction does not fit in float64: scale the curve down"
+        )
+    assert g.knots is not None
+    splines = [
+        Spline(c, g.knots, g.spline_degree, u)
+        for c, u in zip(ctrl_back.reshape(len(rows), n_ctrl, 2), curves.split(params))
+    ]
+    return curves.split(back), splines, mse
 
 
 def decoded_to_caller(

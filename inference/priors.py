@@ -20,6 +20,7 @@ import numpy as np
 
 from curve_vae.files import atomic_path
 from curve_vae.geometry import Frame, self_intersects
+from curve_vae.geometry.adapt import joined_ends
 from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.prior import LatentPrior
@@ -77,8 +78,10 @@ class NamedPrior:
         safe = np.where(finite[:, None, None], curves, 0)
         reach = np.linalg.norm(safe - np.asarray(MODEL_CENTER), axis=-1).max(axis=1)
         ok = finite & (reach <= self.reference.reach * REACH_MARGIN)
-        if ok.any() and self.reference.crossing < 0.5 and not self.closed:
-            ok[ok] = ~self_intersects(curves[ok])
+        if ok.any() and self.reference.crossing < 0.5:
+            # a closed family's samples are returned closed (their ends joined): that loop must not cross itself
+            candidates = np.stack([joined_ends(c) for c in curves[ok]]) if self.closed else curves[ok]
+            ok[ok] = ~self_intersects(candidates)
         return ok
 
     # ------------------------------------------------------------------------------------------ files

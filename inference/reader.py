@@ -13,6 +13,7 @@ with the same reading come from the encoding cache. `refine` fits each latent cl
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 
@@ -27,6 +28,15 @@ from curve_vae.geometry import (
     pose_frames,
     to_model_plane,
 )
+from curve_vae.geometry.adapt import F32_MAX
+from curve_vae.geometry.batch import (
+    FrameRows,
+    Ragged,
+    canonical_frames,
+    shared_canonical_frames,
+    shared_pose_frames,
+)
+from curve_vae.geometry.frame import resample_index
 from curve_vae.inference.cache import EncodingCache
 from curve_vae.inference.cancel import checkpoint
 from curve_vae.inference.errors import InputError
@@ -42,7 +52,15 @@ SAME_READING = 1e-4
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
 
-Candidate = tuple[int, Frame | None, str, np.ndarray | None]  # (curve, frame, spacing, natural parameters)
+
+class Candidate(NamedTuple):
+    """One way of reading one curve: its frame (with the pose), its spacing and natural parameters."""
+
+    curve: int  # which of the curves read
+    frame: Frame | None
+    spacing: str
+    natural: np.ndarray | None  # the natural reading's parameters, with spacing "natural"
+    pose: int  # which of the curve's pose candidates (the same pose for every curve of a shared set)
 
 
 class Reader:
@@ -56,17 +74,25 @@ class Reader:
         self.fitter = fitter
         self.cache = cache
 
-    def read(self, curves: Sequence[np.ndarray], reading: Reading, *, decoded: bool = True) -> Prepared:
+    def read(
+        self, curves: Sequence[np.ndarray], reading: Reading, *, decoded: bool = True, shared: bool = False
+    ) -> Prepared:
         """Each curve read as `reading` (resolved: no "auto") says. decoded: also decode each latent and, for a model
-        placed closest, place the caller's points on the spline (an encoding alone needs neither)."""
+        placed closest, place the caller's points on the spline (an encoding alone needs neither). shared: the
+        curves are a set that is mixed together (interpolated, augmented), read in one pose (`_shared`)."""
         inputs = [np.asarray(c, np.float64) for c in curves]
+        shared = shared and len(inputs) > 1 and reading.frame != "model" and reading.pose in ("canonical", "search")
         key = f"{reading.key}/{'closest' if self.closest else 'index'}"
+        if shared:  # a curve's pose depends on its set: kept apart from its pose alone, per set
+            key += "/set/" + EncodingCache.key(np.concatenate(inputs), str([len(c) for c in inputs])).hex()
         keys = [EncodingCache.key(c, key) for c in inputs] if self.cache is not None else []
         rows: list[ReadCurve | None] = (
             [self.cache.get(k) for k in keys] if self.cache is not None else [None] * len(inputs)
         )
         todo = [i for i, r in enumerate(rows) if r is None]
-        for i, row in zip(todo, self._fresh([inputs[i] for i in todo], todo, reading)):
+        if shared and todo:  # the set's pose is chosen for all its curves at once
+            todo = list(range(len(inputs)))
+        for i, row in zip(todo, self._fresh([inputs[i] for i in todo], todo, reading, shared=shared)):
             rows[i] = row
         if reading.refine > 0 and todo:  # cached rows were cached refined: the reading's key counts the steps
             if self.fitter is None or not self.graphs.has_splines:
@@ -86,39 +112,69 @@ class Reader:
 
     # ----------------------------------------------------------------------------------- candidates
 
-    def _fresh(self, inputs: list[np.ndarray], index: list[int], reading: Reading) -> list[ReadCurve]:
-        """Curves not in the cache: their candidates, encoded; with several per curve, decoded and the closest kept."""
-        stage = self._candidates(inputs, index, reading)
+    def _fresh(self, inputs: list[np.ndarray], index: list[int], reading: Reading, *, shared: bool) -> list[ReadCurve]:
+        """Curves not in the cache: their candidates, encoded; with several per curve, decoded and the closest kept
+        (shared: each curve's closest in the pose whose candidates are closest over the whole set)."""
+        stage = self._candidates(inputs, index, reading, shared=shared)
         models, fractions = self._model_points(inputs, index, stage)
         if not stage:
             return []
         with np.errstate(all="ignore"):
             mean, log_var = self.graphs.encode(models)
-        _check_finite(mean, log_var, [index[c[0]] for c in stage])
+        _check_finite(mean, log_var, [index[c.curve] for c in stage])
         if len(stage) == len(inputs):  # one candidate each: nothing to choose
             return [
-                ReadCurve(f, m, fr, mu, lv)
-                for (_, f, _, _), m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)
+                ReadCurve(c.frame, m, fr, mu, lv) for c, m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)
             ]
-        rows = [
-            ReadCurve(f, m, fr, mu, lv) for (_, f, _, _), m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)
-        ]
-        owners = [c[0] for c in stage]
+        rows = [ReadCurve(c.frame, m, fr, mu, lv) for c, m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)]
+        owners = [c.curve for c in stage]
         rows, err = self._decoded([inputs[o] for o in owners], rows)
         owner = np.asarray(owners)
+        if shared:
+            err = self._in_shared_pose(inputs, stage, err)
         best = [int(np.flatnonzero(owner == i)[err[owner == i].argmin()]) for i in range(len(inputs))]
         return [rows[b] for b in best]
 
-    def _candidates(self, inputs: list[np.ndarray], index: list[int], reading: Reading) -> list[Candidate]:
+    @staticmethod
+    def _in_shared_pose(inputs: list[np.ndarray], stage: list[Candidate], err: np.ndarray) -> np.ndarray:
+        """The candidates' errors with every pose but the set's best made infinite: the best pose is the one whose
+        closest candidate per curve (a mean squared distance, so that long curves do not outweigh short ones) sums
+        least over the set."""
+        owner = np.array([c.curve for c in stage])
+        pose = np.array([c.pose for c in stage])
+        per_point = err / np.array([len(inputs[o]) for o in owner])
+        totals = {}
+        for p in np.unique(pose):
+            best = [per_point[(pose == p) & (owner == i)].min() for i in range(len(inputs))]
+            totals[int(p)] = float(np.sum(best))
+        chosen = min(totals, key=totals.__getitem__)
+        return np.where(pose == chosen, err, np.inf)
+
+    def _candidates(
+        self, inputs: list[np.ndarray], index: list[int], reading: Reading, *, shared: bool = False
+    ) -> list[Candidate]:
         """Every curve in every pose, read as the reading says; spacing "search": its points as given and each of
-        its natural readings that does not put them where they are (a curve at the paper's own spacing is read so)."""
+        its natural readings that does not put them where they are (a curve at the paper's own spacing is read so).
+        The canonical pose is found for all curves at once (geometry.batch); shared: the set's poses, the same for
+        every curve (geometry.batch.shared_pose_frames)."""
+        posed: list[list[Frame]] | None = None
+        try:
+            if shared and reading.pose == "canonical":
+                posed = [[f] for f in shared_canonical_frames(inputs)]
+            elif shared:
+                posed = shared_pose_frames(inputs, chords=POSE_CHORD_COUNT)
+            elif reading.frame != "model" and reading.pose == "canonical":
+                posed = [[f] for f in canonical_frames(inputs)]
+        except ValueError:
+            pass  # the curve whose points coincide is named below
         stage: list[Candidate] = []
         with np.errstate(all="ignore"):
             for c, (i, pts) in enumerate(zip(index, inputs)):
-                checkpoint()  # a natural fit per curve: an abandoned request stops between curves
                 try:
                     if reading.frame == "model":
                         frames: list[Frame | None] = [None]
+                    elif posed is not None:
+                        frames = list(posed[c])
                     elif reading.pose == "canonical":
                         frames = [canonical_frame(pts)]
                     elif reading.pose == "search":
@@ -126,43 +182,73 @@ class Reader:
                     else:
                         frames = [fit_frame(pts)]
                     if reading.spacing == "search":
+                        checkpoint()  # a natural fit per curve: an abandoned request stops between curves
                         spaced = [("parameter", None)] + [
                             ("natural", n)
                             for n in natural_readings(pts)
                             if np.abs(n - np.linspace(0.0, 1.0, len(n))).max() > SAME_READING
                         ]
                     elif reading.spacing == "natural":
+                        checkpoint()
                         spaced = [("natural", natural_params(pts))]  # it does not depend on the pose: fitted once
                     else:
                         spaced = [(reading.spacing, None)]
                 except ValueError as e:  # all points coincide
                     raise InputError(("curves", i), str(e)) from e
-                stage += [(c, f, s, n) for f in frames for s, n in spaced]
+                stage += [Candidate(c, f, s, n, p) for p, f in enumerate(frames) for s, n in spaced]
         return stage
 
     def _model_points(
         self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
     ) -> tuple[np.ndarray, list[np.ndarray | None]]:
-        """Each candidate's model-plane points (k, n_points, 2) float32 and where its curve's points sit along them."""
+        """Each candidate's model-plane points (k, n_points, 2) float32 and where its curve's points sit along them.
+        Candidates read at their points as given are mapped all at once (`_model_points_as_given`)."""
         g = self.graphs
+        if stage and all(c.spacing == "parameter" for c in stage):
+            return self._model_points_as_given(inputs, index, stage)
         rows, fractions = [], []
         with np.errstate(all="ignore"):
-            for c, f, spacing, natural in stage:
+            for c, f, spacing, natural, _ in stage:
                 try:
                     m, fraction = to_model_plane(
                         inputs[c], f, model_size=g.model_size, n_points=g.n_points, spacing=spacing, natural=natural
                     )
                 except BeyondFloat32:
-                    raise InputError(
-                        ("curves", index[c]),
-                        "its extent is too small or too large to map to the model's frame"
-                        if f is not None
-                        else 'coordinates beyond float32 range; use frame "auto"',
-                    ) from None
+                    raise InputError(("curves", index[c]), _beyond(f is not None)) from None
                 rows.append(m)
                 fractions.append(fraction)
         batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, g.n_points, 2), np.float32)
         return batch, fractions
+
+    def _model_points_as_given(
+        self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
+    ) -> tuple[np.ndarray, list[np.ndarray | None]]:
+        """`to_model_plane` with spacing "parameter" for every candidate at once: each curve through its frame
+        (geometry.batch), then the curves of each length to the model's count along their point index."""
+        g = self.graphs
+        curves = Ragged.of([inputs[c.curve] for c in stage])
+        framed = [c.frame for c in stage]
+        with np.errstate(all="ignore"):
+            if all(f is not None for f in framed):
+                flat = FrameRows.of(framed).to_model(curves, g.model_size)  # type: ignore[arg-type]
+            else:
+                flat = np.concatenate(
+                    [
+                        f.to_model(p, g.model_size) if f is not None else p
+                        for f, p in zip(framed, curves.split(curves.points))
+                    ]
+                )
+            out = np.empty((len(stage), g.n_points, 2))
+            parts = curves.split(flat)
+            for n in np.unique(curves.lengths):
+                rows = np.flatnonzero(curves.lengths == n)
+                out[rows] = resample_index(np.stack([parts[r] for r in rows]), g.n_points)
+        bad = ~(np.abs(out) <= F32_MAX).reshape(len(out), -1).all(axis=1)  # also true for inf and nan
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise InputError(("curves", index[stage[k].curve]), _beyond(framed[k] is not None))
+        fractions = [None if n == g.n_points else np.linspace(0.0, 1.0, n) for n in curves.lengths]
+        return out.astype(np.float32), fractions
 
     # ----------------------------------------------------------------------------------- decoding, placement
 
@@ -176,9 +262,7 @@ class Reader:
             decoded, ctrl, params = g.decode(np.stack([r.mean for r in rows]))
             feet: list[np.ndarray | None] = [None] * len(rows)
             if self.closest and ctrl is not None:
-                targets = [
-                    r.frame.to_model(p, g.model_size) if r.frame is not None else p for r, p in zip(rows, inputs)
-                ]
+                targets = self._targets(inputs, [r.frame for r in rows])
                 placed, err = ordered_closest_params(ctrl, targets, degree=g.spline_degree)
                 feet = list(placed)
             else:
@@ -191,6 +275,21 @@ class Reader:
             for i, r in enumerate(rows)
         ]
         return out, np.where(np.isfinite(err), err, np.inf)
+
+    def _targets(self, inputs: list[np.ndarray], frames: list[Frame | None]) -> list[np.ndarray]:
+        """Each caller curve in the model plane, through its frame: all at once where every curve has one."""
+        if frames and all(f is not None for f in frames):
+            curves = Ragged.of(inputs)
+            return curves.split(FrameRows.of(frames).to_model(curves, self.graphs.model_size))  # type: ignore[arg-type]
+        return [f.to_model(p, self.graphs.model_size) if f is not None else p for f, p in zip(frames, inputs)]
+
+
+def _beyond(framed: bool) -> str:
+    return (
+        "its extent is too small or too large to map to the model's frame"
+        if framed
+        else 'coordinates beyond float32 range; use frame "auto"'
+    )
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:

@@ -35,7 +35,14 @@ from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.manifest import Manifest, ModelLoadError
-from curve_vae.inference.placing import check_finite, check_range, decoded_to_caller, joined, to_caller
+from curve_vae.inference.placing import (
+    check_finite,
+    check_range,
+    decoded_to_caller,
+    joined,
+    placed_to_caller,
+    to_caller,
+)
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.priors import NamedPrior, load_priors
@@ -156,15 +163,23 @@ class CurveRuntime:
     # ----------------------------------------------------------------------- curves in and out
 
     def prepare(
-        self, curves: Sequence[np.ndarray], reading: Reading | None = None, *, decoded: bool = True
+        self,
+        curves: Sequence[np.ndarray],
+        reading: Reading | None = None,
+        *,
+        decoded: bool = True,
+        together: bool = False,
     ) -> Prepared:
-        """Each caller curve (n_i, 2), n_i ≥ 4, read into the model (inference.reader)."""
-        return self.reader.read(curves, self.reading(reading), decoded=decoded)
+        """Each caller curve (n_i, 2), n_i ≥ 4, read into the model (inference.reader). together: the curves are one
+        set, read in one pose, as `interpolate` and `plan_augment` read the curves they mix."""
+        return self.reader.read(curves, self.reading(reading), decoded=decoded, shared=together)
 
-    def encode(self, curves: Sequence[np.ndarray], reading: Reading | None = None) -> Encoding:
+    def encode(
+        self, curves: Sequence[np.ndarray], reading: Reading | None = None, *, together: bool = False
+    ) -> Encoding:
         """Latent mean and log-variance of each curve, and the frame (with its pose) each was mapped from; with
-        refine, the means are the fitted latents."""
-        prep = self.prepare(curves, reading, decoded=False)
+        refine, the means are the fitted latents. together: read as one set (`prepare`)."""
+        prep = self.prepare(curves, reading, decoded=False, together=together)
         return Encoding(prep.mean, prep.log_var, prep.frames)
 
     def decode(
@@ -185,18 +200,29 @@ class CurveRuntime:
         return decoded_to_caller(self.graphs, out, ctrl, params, frames=frames, n_points=n_points, spacing=spacing)
 
     def reconstruct(
-        self, curves: Sequence[np.ndarray], reading: Reading | None = None, *, n_points: int | None = None
+        self,
+        curves: Sequence[np.ndarray],
+        reading: Reading | None = None,
+        *,
+        n_points: int | None = None,
+        together: bool = False,
     ) -> Reconstruction:
         """Encode the means, decode them: the curves in the caller's frame and their MSE (paper eq. 4) there.
 
         The MSE compares each input with its reconstruction at the input's own points, whatever `n_points` asks
         for the returned curves. A closed input (its last point its first) comes back closed: the reconstruction's
         ends are joined at their midpoint. A model placed closest (and any refine) returns each input point at its
-        closest point on the reconstruction.
+        closest point on the reconstruction. together: the curves read as one set, in one pose (`prepare`): the
+        ends of a sweep between them.
         """
         r = self.reading(reading)
-        prep = self.reader.read(curves, r)
+        prep = self.reader.read(curves, r, shared=together)
         g = self.graphs
+        if n_points is None:
+            with np.errstate(all="ignore"):
+                placed = placed_to_caller(g, prep)  # every curve at once, where the batch allows it
+            if placed is not None:
+                return Reconstruction(placed[0], placed[2], prep.mean, prep.frames, placed[1])  # type: ignore[arg-type]
         results, splines, mse = [], [], np.empty(len(prep.rows))
         with np.errstate(all="ignore"):
             for i, (pts, row) in enumerate(zip(prep.inputs, prep.rows)):
@@ -228,12 +254,14 @@ class CurveRuntime:
 
         weights: (rows, len(curves)), rows summing to 1. With frame "auto" each interpolant comes back in the same
         blend of the inputs' frames. Length: n_points; else the inputs' common length, at the blend of their
-        points' positions; else the model's. With refine the means are the fitted latents, and the positions
-        blended are the input points' closest points on their fitted splines, so a row [1, 0, …] gives the refined
-        reconstruction of the first curve. When every input is closed, so is every interpolant.
+        points' positions; else the model's. The curves are read as one set, in one pose
+        (geometry.batch.shared_pose_frames; a curve listed the other way round from the first is read reversed), so
+        the in-betweens turn and move as the curves do: a row [1, 0, …] is `reconstruct(curves, together=True)`'s
+        first curve. With refine the means are the fitted latents, and the positions blended are the input points'
+        closest points on their fitted splines. When every input is closed, so is every interpolant.
         """
         r = self.reading(reading)
-        prep = self.reader.read(curves, r, decoded=False)  # only the latents are mixed
+        prep = self.reader.read(curves, r, decoded=False, shared=True)  # only the latents are mixed
         return self.mix(prep, np.asarray(weights, np.float64), n_points=n_points, spacing=r.spacing)
 
     def mix(
@@ -337,7 +365,7 @@ class CurveRuntime:
         reading: Reading | None = None,
     ) -> AugmentPlan:
         """Encode the seed curves once and fix who may be mixed with whom (`neighbour_pools`); see `AugmentPlan`."""
-        prep = self.prepare(curves, reading, decoded=False)  # only the latents are mixed
+        prep = self.reader.read(curves, self.reading(reading), decoded=False, shared=True)  # mixed: in one pose
         mean = prep.mean.astype(np.float64)
         pools = neighbour_pools(mean, mode, neighbours)
         return AugmentPlan(prep=prep, mean=mean, k=SOURCES_PER_MODE[mode], seed=seed, pools=pools)

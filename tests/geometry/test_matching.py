@@ -54,3 +54,58 @@ def test_a_curve_that_comes_back_near_itself_is_not_matched_across():
     ctrl = fit_bspline(loop, 31, param="chord").control_points
     (u,), _ = ordered_closest_params(ctrl[None], [loop[::-1][::-1]])
     assert np.all(np.diff(u) >= 0) and abs(u[100] - 0.5) < 0.05  # the far end matched at the far end
+
+
+def _reconstructed_like(count: int, seed: int) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Splines and curves near them as a reconstruction leaves them: open curves, loops whose ends meet (an airfoil's
+    trailing edge), spirals that come back near themselves, at several lengths and noise levels."""
+    rng = np.random.default_rng(seed)
+    ctrl = _splines(count, seed)
+    t = np.linspace(0, 1, 31)
+    ctrl[::3] = np.stack([64 + 50 * np.cos(2 * np.pi * t), 64 + 20 * np.sin(2 * np.pi * t)], -1)  # loops
+    ctrl[1::3] = np.stack([64 + 60 * t * np.cos(5 * np.pi * t), 64 + 60 * t * np.sin(5 * np.pi * t)], -1)  # spirals
+    lengths = rng.choice([4, 7, 50, 161, 300], count)
+    noise = rng.choice([0.0, 0.3, 3.0], count)
+    pts = [sample_bspline(c, n) + rng.normal(0, s, (n, 2)) for c, n, s in zip(ctrl, lengths, noise)]
+    return ctrl, pts
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_quick_match_is_the_order_keeping_programme(seed):
+    """Nearest samples where they run in order, the dynamic programme elsewhere: the same sample for every point."""
+    from curve_vae.geometry.matching import DENSE, _match, _ordered_nearest, _padded
+
+    ctrl, pts = _reconstructed_like(24, seed)
+    samples = sample_bspline(ctrl, DENSE).astype(np.float32)
+    lengths = np.array([len(p) for p in pts])
+    padded = np.stack([_padded(p, lengths.max()) for p in pts])
+    np.testing.assert_array_equal(_ordered_nearest(padded, samples, lengths), _match(padded, samples, lengths))
+
+
+def test_a_curve_is_placed_alike_alone_and_in_batches_of_any_size():
+    ctrl, pts = _reconstructed_like(128, seed=4)
+    together, d_all = ordered_closest_params(ctrl, pts)
+    for size in (1, 7):
+        for start in range(0, 21, size):
+            part, d = ordered_closest_params(ctrl[start : start + size], pts[start : start + size])
+            for a, b in zip(part, together[start : start + size]):
+                np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(d, d_all[start : start + size], rtol=1e-12)
+
+
+def test_spline_values_and_derivatives_are_scipys():
+    from scipy.interpolate import BSpline
+
+    from curve_vae.geometry import clamped_uniform_knots
+    from curve_vae.geometry.bspline import spline_values
+
+    rng = np.random.default_rng(5)
+    ctrl = _splines(3)
+    u = np.concatenate([[0.0, 1.0, 1 / 28, 0.5, 27 / 28], rng.uniform(0, 1, 500)])
+    owner = rng.integers(0, 3, len(u))
+    values = spline_values(ctrl, u, owner, order=2)
+    for i, c in enumerate(ctrl):
+        spline, mine = BSpline(clamped_uniform_knots(31), c, 3), owner == i
+        for d, v in enumerate(values):
+            ref = spline(u[mine], d)
+            np.testing.assert_allclose(v[mine], ref, rtol=0, atol=1e-11 * np.abs(ref).max())

@@ -245,10 +245,11 @@ def test_pair_ends_are_the_reconstructions(runtime, curves):
     a, b = curves(1, 161)[0] * 2 + 9, curves(1, 161, seed=5)[0] / 3
     res = runtime.interpolate([a, b], simplex_grid(2, 3))
     out, frames = res.curves, res.frames
-    rec = runtime.reconstruct([a, b]).curves
+    rec = runtime.reconstruct([a, b], together=True).curves
     np.testing.assert_allclose(out[0], rec[0], atol=1e-9)
     np.testing.assert_allclose(out[-1], rec[1], atol=1e-9)
-    fa, fb = runtime.encode([a, b]).frames  # the poses each curve reconstructs best in
+    fa, fb = runtime.encode([a, b], together=True).frames  # the set's one pose, each curve's own box
+    assert (fa.rotation, fa.mirror, fa.reverse) == (fb.rotation, fb.mirror, fb.reverse)
     assert frames[0] == fa and frames[-1] == fb
     assert frames[1] == blend_frames([fa, fb], np.array([[0.5, 0.5]]))[0]
 
@@ -256,7 +257,7 @@ def test_pair_ends_are_the_reconstructions(runtime, curves):
 def test_interpolants_keep_a_common_input_length(runtime, curves):
     a, b = curves(1, 60)[0], curves(1, 60, seed=6)[0] + 50
     out = runtime.interpolate([a, b], simplex_grid(2, 4)).curves
-    rec = runtime.reconstruct([a, b]).curves
+    rec = runtime.reconstruct([a, b], together=True).curves
     assert out.shape == (4, 60, 2)
     np.testing.assert_allclose(out[0], rec[0], atol=1e-9)  # same spacing as the first input's reconstruction
     mixed = runtime.interpolate([a, curves(1, 70)[0]], simplex_grid(2, 2)).curves

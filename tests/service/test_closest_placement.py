@@ -65,7 +65,7 @@ def test_encoding_is_not_changed_by_the_placement(closest_runtime, runtime):
 
 def test_an_interpolation_row_of_one_curve_is_its_reconstruction(closest_runtime):
     a, b = _user_curves()[:2]
-    ra, rb = closest_runtime.reconstruct([a, b]).curves
+    ra, rb = closest_runtime.reconstruct([a, b], together=True).curves  # a sweep's ends: the pair read as a set
     out = closest_runtime.interpolate([a, b], np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]])).curves
     np.testing.assert_allclose(out[0], ra, atol=1e-6 * np.abs(ra).max())
     np.testing.assert_allclose(out[-1], rb, atol=1e-6 * np.abs(rb).max())

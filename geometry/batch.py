@@ -1,0 +1,284 @@
+"""A batch of curves of any lengths as arrays: their canonical frames, and their points mapped into and out of the
+model plane, for all curves at once.
+
+A request's curves have their own lengths, so a batch is held "ragged": every point of every curve in one array
+(N, 2), `lengths` (B,) saying how many belong to each curve, in order. Frames are per curve, applied to every point
+through its owner's row (`FrameRows`). Curves of one length are stacked (k, n, 2) where a computation runs along a
+curve (turning, centroids, bounding boxes): `canonical_frames` groups them so.
+
+The per-curve functions of frame.py say what each step means; these give the same answers (to rounding) for a whole
+batch in a few array operations, which is what the service's hot path runs (nothing per point or per curve in
+Python).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from curve_vae.geometry.frame import (
+    CLOSED,
+    MODEL_CENTER,
+    POSE_CHORDS,
+    Frame,
+    chord_heading,
+    pose_candidates,
+    posed_frame,
+    signed_turning,
+    turns_clockwise,
+)
+
+
+@dataclass(frozen=True)
+class Ragged:
+    """Curves of any lengths: their points end to end (N, 2) and each curve's point count (B,)."""
+
+    points: np.ndarray
+    lengths: np.ndarray
+
+    @classmethod
+    def of(cls, curves: Sequence[np.ndarray]) -> Ragged:
+        lengths = np.array([len(c) for c in curves], np.int64)
+        flat = np.concatenate([np.asarray(c, np.float64) for c in curves]) if len(curves) else np.zeros((0, 2))
+        return cls(flat, lengths)
+
+    @property
+    def starts(self) -> np.ndarray:
+        return np.concatenate([[0], np.cumsum(self.lengths)[:-1]]).astype(np.int64)
+
+    @property
+    def owner(self) -> np.ndarray:
+        """(N,) the curve each point belongs to."""
+        return np.repeat(np.arange(len(self.lengths)), self.lengths)
+
+    def split(self, flat: np.ndarray) -> list[np.ndarray]:
+        """Per-point values (N, …) back into one array per curve (views)."""
+        return np.split(flat, np.cumsum(self.lengths)[:-1]) if len(self.lengths) else []
+
+    def reversed_where(self, flip: np.ndarray) -> np.ndarray:
+        """(N,) the index each point takes its value from when the curves where `flip` (B,) is true are listed end
+        to end the other way round."""
+        i = np.arange(len(self.points))
+        own = self.owner
+        first, count = self.starts[own], self.lengths[own]
+        return np.where(flip[own], 2 * first + count - 1 - i, i)
+
+
+@dataclass(frozen=True)
+class FrameRows:
+    """Frames (B of them) as arrays: centres (B, 2), sizes (B,), pose maps (B, 2, 2) (row vectors: p @ M), and
+    which reverse the point order (B,)."""
+
+    center: np.ndarray
+    size: np.ndarray
+    linear: np.ndarray
+    reverse: np.ndarray
+
+    @classmethod
+    def of(cls, frames: Sequence[Frame]) -> FrameRows:
+        return cls(
+            np.array([f.center for f in frames], np.float64).reshape(-1, 2),
+            np.array([f.size for f in frames], np.float64),
+            np.array([f._linear() for f in frames], np.float64).reshape(-1, 2, 2),
+            np.array([f.reverse for f in frames], bool),
+        )
+
+    def to_model(self, curves: Ragged, model_size: float) -> np.ndarray:
+        """`Frame.to_model` of every curve (N, 2): each point through its own curve's frame, in the model's order."""
+        own = curves.owner
+        p = np.einsum("nd,nde->ne", curves.points - self.center[own], self.linear[own])
+        p = p * (model_size / self.size)[own, None] + np.asarray(MODEL_CENTER)
+        return p[curves.reversed_where(self.reverse)]
+
+    def from_model(self, curves: Ragged, model_size: float) -> np.ndarray:
+        """`Frame.from_model` of every curve (N, 2): model-plane points back to their curves' frames and order."""
+        own = curves.owner
+        p = (curves.points - np.asarray(MODEL_CENTER)) * (self.size / model_size)[own, None]
+        p = np.einsum("nd,ned->ne", p, self.linear[own]) + self.center[own]  # the transpose: the inverse
+        return p[curves.reversed_where(self.reverse)]
+
+
+# ----------------------------------------------------------------------------------------------- canonical frames
+
+
+def canonical_frames(curves: Sequence[np.ndarray]) -> list[Frame]:
+    """`frame.canonical_frame` of every curve, computed for the curves of each length together. Raises ValueError
+    naming the first curve whose points all coincide."""
+    out: list[Frame | None] = [None] * len(curves)
+    lengths = np.array([len(c) for c in curves])
+    for n in np.unique(lengths):
+        idx = np.flatnonzero(lengths == n)
+        for i, f in zip(idx, _canonical_same_length(np.stack([np.asarray(curves[i], np.float64) for i in idx]))):
+            out[i] = f
+    return out  # type: ignore[return-value]
+
+
+def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
+    """Canonical frames of curves of one length (k, n, 2); see frame.canonical_frame for what each step means."""
+    extent = np.ptp(pts, axis=1).max(axis=1)  # (k,)
+    if not (extent > 0).all():
+        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+    mirror = _turns_clockwise(pts)
+    flip = np.where(mirror, -1.0, 1.0)[:, None]
+    heading = _chord_heading(pts * np.stack([flip, np.ones_like(flip)], axis=-1))
+    target = POSE_CHORDS[0]
+    turn = np.angle(np.exp(1j * (target - heading)))
+    drawn = _linear(turn, mirror)  # (k, 2, 2)
+    # the other candidate: reflected across the chord's normal and reversed (frame.pose_frames' `flips`)
+    normal = np.array([np.cos(target), np.sin(target)])
+    c, s = np.cos(turn), np.sin(turn)
+    rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (k, 2, 2) column-vector rotations
+    a = (np.eye(2) - 2 * np.outer(normal, normal)) @ rot @ np.diag([-1.0, 1.0])
+    turn_flipped = np.arctan2(a[:, 1, 0], a[:, 0, 0])
+    flipped = _linear(turn_flipped, ~mirror)
+    posed = np.einsum("knd,kde->kne", pts, drawn)  # chord along −y (a translation changes no statistic below)
+    centroid = _arc_centroid(posed)  # (k, 2)
+    offset = (posed[:, 0, 1] + posed[:, -1, 1]) / 2 - centroid[:, 1]
+    box_drawn = _box(pts, drawn)
+    level = np.abs(offset) <= 1e-9 * box_drawn[1]
+    if level.any():  # a loop's centroid lies on its chord's normal: the product moment decides
+        seg = np.linalg.norm(np.diff(posed, axis=1), axis=2)
+        rel = (posed[:, 1:] + posed[:, :-1]) / 2 - centroid[:, None, :]
+        offset = np.where(level, -(seg * rel[..., 0] * rel[..., 1]).sum(axis=1), offset)
+    keep = offset >= 0
+    box_flipped = _box(pts, flipped)
+    frames = []
+    for i in range(len(pts)):
+        (center, size), turned, mir, rev = (
+            ((box_drawn[0][i], box_drawn[1][i]), turn[i], mirror[i], False)
+            if keep[i]
+            else ((box_flipped[0][i], box_flipped[1][i]), turn_flipped[i], not mirror[i], True)
+        )
+        frames.append(Frame((float(center[0]), float(center[1])), float(size), float(turned), bool(mir), rev))
+    return frames
+
+
+def _linear(rotation: np.ndarray, mirror: np.ndarray) -> np.ndarray:
+    """(k, 2, 2) `Frame._linear` of each pose (row vectors, mirror first)."""
+    c, s = np.cos(rotation), np.sin(rotation)
+    m = np.stack([np.stack([c, s], -1), np.stack([-s, c], -1)], -2)
+    m[mirror] = np.array([[-1.0, 0.0], [0.0, 1.0]]) @ m[mirror]
+    return m
+
+
+def _box(pts: np.ndarray, linear: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """frame.posed_frame's centre (k, 2) and size (k,): the bounding box taken in the posed orientation."""
+    q = np.einsum("knd,kde->kne", pts, linear)
+    lo, hi = q.min(axis=1), q.max(axis=1)
+    return np.einsum("ke,kde->kd", (lo + hi) / 2, linear), (hi - lo).max(axis=1)
+
+
+def _turns_clockwise(pts: np.ndarray) -> np.ndarray:
+    """frame.turns_clockwise of each curve (k, n, 2) -> (k,): by the signed turning, or the signed area where that
+    is zero to rounding."""
+    d = np.diff(pts, axis=1)  # (k, n - 1, 2)
+    moving = np.linalg.norm(d, axis=2) > 0
+    # a segment of zero length is skipped: each takes the last moving segment before it (or the first after it), so
+    # the turn between the moving segments on either side is counted once and the repeats add nothing
+    j = np.arange(d.shape[1])
+    last = np.maximum.accumulate(np.where(moving, j, -1), axis=1)
+    first = np.argmax(moving, axis=1)
+    d = np.take_along_axis(d, np.where(last < 0, first[:, None], last)[..., None], axis=1)
+    cross = d[:, :-1, 0] * d[:, 1:, 1] - d[:, :-1, 1] * d[:, 1:, 0]
+    dot = (d[:, :-1] * d[:, 1:]).sum(axis=2)
+    turning = np.arctan2(cross, dot).sum(axis=1)
+    turning = np.where(moving.sum(axis=1) >= 2, turning, 0.0)
+    x, y = pts[..., 0], pts[..., 1]
+    area = (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
+    return np.where(np.abs(turning) > 1e-9, turning < 0, area < 0)
+
+
+def _arc_centroid(pts: np.ndarray) -> np.ndarray:
+    """frame.arc_centroid of each curve (k, n, 2) -> (k, 2)."""
+    seg = np.linalg.norm(np.diff(pts, axis=1), axis=2)
+    total = seg.sum(axis=1)
+    mid = (pts[:, 1:] + pts[:, :-1]) / 2
+    wire = (mid * seg[..., None]).sum(axis=1) / np.where(total > 0, total, 1.0)[:, None]
+    return np.where((total > 0)[:, None], wire, pts.mean(axis=1))
+
+
+def _chord_heading(pts: np.ndarray) -> np.ndarray:
+    """frame.chord_heading of each curve (k, n, 2) -> (k,)."""
+    chord = pts[:, -1] - pts[:, 0]
+    centroid = _arc_centroid(pts)
+    reach = 2 * np.linalg.norm(pts - centroid[:, None], axis=2).max(axis=1)
+    out = (pts[:, 0] + pts[:, -1]) / 2 - centroid
+    return np.where(
+        np.hypot(chord[:, 0], chord[:, 1]) >= CLOSED * reach,
+        np.arctan2(chord[:, 1], chord[:, 0]),
+        np.arctan2(out[:, 1], out[:, 0]) - np.pi / 2,
+    )
+
+
+# ----------------------------------------------------------------------------------------------- one pose for a set
+
+
+def shared_pose_frames(curves: Sequence[np.ndarray], *, chords: int = 3, flips: bool = True) -> list[list[Frame]]:
+    """`frame.pose_frames` for a set of curves that are mixed together (interpolated, augmented): the same candidate
+    poses — one rotation and mirror image each — for every curve of the set, so that the curves keep their turns
+    relative to each other; each curve's frame still fits its own bounding box (centre and size blend).
+
+    The curves are aligned one way first: a curve listed the other way round from the set's first curve (its chord
+    pointing against the first's; for loops, turning the other way) is read reversed, so a curve and its reversal
+    are read alike. The set is mirrored when its aligned curves turn clockwise overall (their signed turnings
+    summed), and its chord direction is the mean of their unit chord directions; from there the candidates are
+    pose_frames' own. Per curve: [candidate 0, candidate 1, …], candidate k the same pose for every curve.
+    """
+    pts = [np.asarray(c, np.float64) for c in curves]
+    if not pts:
+        return []
+    for c in pts:
+        if not np.ptp(c, axis=0).max() > 0:
+            raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+    against = _against_first(pts)
+    aligned = [c[::-1] if a else c for c, a in zip(pts, against)]
+    turning = sum(signed_turning(c) for c in aligned)
+    if abs(turning) > 1e-9:
+        mirror = turning < 0
+    else:
+        mirror = sum(float(turns_clockwise(c)) - 0.5 for c in aligned) > 0
+    flip = np.array([-1.0, 1.0]) if mirror else np.ones(2)
+    headings = np.array([chord_heading(c * flip) for c in aligned])
+    heading = float(np.arctan2(np.sin(headings).sum(), np.cos(headings).sum()))
+    poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
+    return [
+        [posed_frame(c, turn, mirror=mir, reverse=rev != a) for turn, mir, rev in poses] for c, a in zip(pts, against)
+    ]
+
+
+def _against_first(curves: list[np.ndarray]) -> list[bool]:
+    """Which curves run the other way round from the first: open curves by their chords (pointing apart by more than
+    a right angle), loops and nearly closed curves by the sign of their turning."""
+
+    def chord(c: np.ndarray) -> np.ndarray | None:
+        d = c[-1] - c[0]
+        reach = 2 * np.linalg.norm(c - _arc_centroid(c[None])[0], axis=1).max()
+        return d / np.hypot(*d) if np.hypot(*d) >= CLOSED * reach else None
+
+    first, first_turn = chord(curves[0]), signed_turning(curves[0])
+    out = []
+    for c in curves:
+        mine = chord(c)
+        if first is not None and mine is not None:
+            out.append(bool(mine @ first < 0))
+        else:
+            out.append(bool(signed_turning(c) * first_turn < 0))
+    return out
+
+
+def shared_canonical_frames(curves: Sequence[np.ndarray]) -> list[Frame]:
+    """`frame.canonical_frame` for a set of curves mixed together: of the set's first two shared candidates (chord
+    straight down; as drawn, or reversed and mirrored across the chord's normal), the one in which the curves'
+    arc-length centroids lie towards their chords' ends on the whole (each curve's offset ÷ its size, summed; a curve
+    alone gets its own canonical frame)."""
+    if len(curves) <= 1:
+        return canonical_frames(curves)
+    candidates = shared_pose_frames(curves, chords=1)
+    total = 0.0
+    for c, (drawn, _) in zip(curves, candidates):
+        posed = np.asarray(c, np.float64) @ drawn._linear()
+        centroid = _arc_centroid(posed[None])[0]
+        total += ((posed[0, 1] + posed[-1, 1]) / 2 - centroid[1]) / drawn.size
+    return [drawn if total >= 0 else flipped for drawn, flipped in candidates]
