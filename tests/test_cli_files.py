@@ -92,3 +92,17 @@ def test_a_file_that_is_not_curves_is_an_error_not_a_traceback(tmp_path):
     )
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert f"curve-vae reconstruct: error: {bad}: curves[0] (A) is an object without 'points'" in run.stderr
+
+
+@pytest.mark.parametrize("suffix", [".svg", ".dxf", ".csv", ".npy"])
+def test_sample_augment_and_fit_write_any_output_that_reads_back(suffix, tmp_path):
+    made = tmp_path / f"samples{suffix}"
+    assert main(["sample", "--count", "3", "--seed", "1", "--output-as", "both", "-o", str(made)]) == 0
+    assert len(read_curves(made)) == 3
+    mixed = tmp_path / f"mixed{suffix}"
+    assert main(["augment", str(FILES / "page-export.json"), "--count", "2", "--seed", "1", "-o", str(mixed)]) == 0
+    assert len(read_curves(mixed)) == 2
+    if suffix in (".svg", ".dxf"):  # the fits' B-splines, drawn exactly
+        fits = tmp_path / f"fits{suffix}"
+        assert main(["fit", str(FILES / "inkscape_drawing.svg"), "-o", str(fits)]) == 0
+        assert len(read_curves(fits)) == 3
