@@ -1,5 +1,8 @@
-"""`curve-vae` command line: dataset, train, average, export, evaluate, triton, reconstruct, encode, sample, augment,
-fit, revolve, prior, serve.
+"""`curve-vae` command line: train, export and serve the model; reconstruct, encode, sample, augment, fit and revolve
+curves; fit priors to your own.
+
+Commands: dataset, train, average, export, evaluate, triton, reconstruct, encode, sample, augment, fit, revolve, prior,
+evaluate-prior, serve.
 
 The commands live in `curve_vae/commands/`, one module per group; this module assembles the parser.
 Each subcommand imports what it needs when it runs, so `curve-vae serve` and the offline
@@ -10,6 +13,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
+from typing import TextIO
 
 from curve_vae import __version__
 from curve_vae.commands import curves, data, design, generate, model, priors, train
@@ -17,7 +22,9 @@ from curve_vae.commands import curves, data, design, generate, model, priors, tr
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="curve-vae", description=__doc__.splitlines()[0], formatter_class=argparse.ArgumentDefaultsHelpFormatter
+        prog="curve-vae",
+        description=" ".join(__doc__.split("\n\n")[0].split()),
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument("--version", action="version", version=f"curve-vae {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -50,13 +57,38 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _show_file_warnings(command: str) -> None:
+    """What a curve file's reader skipped, as one line the user reads (not Python's warning with its source line)."""
+    from curve_vae.curvefiles.common import CurveFileWarning
+
+    shown = warnings.showwarning
+
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: TextIO | None = None,
+        line: str | None = None,
+    ) -> None:
+        if issubclass(category, CurveFileWarning):
+            print(f"curve-vae {command}: warning: {message}", file=sys.stderr)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    warnings.simplefilter("always", CurveFileWarning)
+    warnings.showwarning = show
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except (ValueError, FileNotFoundError, RuntimeError) as e:
-        print(f"curve-vae {args.command}: error: {e}", file=sys.stderr)
-        return 2
+    with warnings.catch_warnings():
+        _show_file_warnings(args.command)
+        try:
+            return int(args.func(args) or 0)
+        except (ValueError, FileNotFoundError, RuntimeError) as e:
+            print(f"curve-vae {args.command}: error: {e}", file=sys.stderr)
+            return 2
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from curve_vae.files import parse_dat
+from curve_vae.curvefiles import parse_dat
 from curve_vae.training.airfoils import airfoil_texts
 
 

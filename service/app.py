@@ -31,7 +31,6 @@ from typing import Any
 import anyio
 from fastapi import FastAPI
 from fastapi.exceptions import RequestValidationError
-from fastapi.middleware.cors import CORSMiddleware
 from starlette.exceptions import HTTPException
 
 from curve_vae.inference.batching import GraphBatcher
@@ -41,6 +40,7 @@ from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.access import ApiKeyMiddleware
+from curve_vae.service.cors import add_cors
 from curve_vae.service.errors import on_http_error, on_input_error, on_validation_error
 from curve_vae.service.limits import name_priors, state_bounds
 from curve_vae.service.metrics import Metrics, MetricsMiddleware
@@ -224,22 +224,7 @@ def _add_request_middleware(app: FastAPI, settings: Settings) -> None:
     app.add_middleware(BodyLimitMiddleware, max_body_bytes=settings.max_body_bytes)
     if settings.api_keys:  # outside the body limit: a request without a key is refused before its body is read
         app.add_middleware(ApiKeyMiddleware, keys=settings.api_keys)
-    if settings.cors_origins:
-        app.add_middleware(
-            CORSMiddleware,
-            allow_origins=settings.cors_origins,
-            allow_methods=["GET", "POST"],
-            allow_headers=["Content-Type", "Authorization", "X-API-Key"],
-            # what a page on another origin needs to read (the .npy seed, the mesh counts, download names)
-            expose_headers=[
-                "X-Augment-Seed",
-                "X-Mesh-Vertices",
-                "X-Mesh-Faces",
-                "X-Mesh-Closed",
-                "Content-Disposition",
-            ],
-            max_age=600,
-        )
+    add_cors(app, settings)
 
 
 def _openapi_of(app: FastAPI, settings: Settings) -> Callable[[], dict[str, Any]]:

@@ -77,6 +77,8 @@ def _validation_message(err: dict[str, Any], request: Request) -> tuple[str, str
         msg = f"a curve needs at least 4 points, got {ctx.get('actual_length')}"
     elif kind in ("too_short", "too_long") and len(loc) == 3 and loc[0] == "curves":
         msg = f"a point is [x, y]: exactly 2 numbers, got {ctx.get('actual_length')}"
+    elif kind == "list_type" and len(loc) == 2 and loc[0] == "curves" and isinstance(err.get("input"), dict):
+        msg = CURVE_OBJECT
     elif kind == "tuple_type" or (kind == "list_type" and len(loc) == 3 and loc[0] == "curves"):
         msg = "a point is [x, y]: exactly 2 numbers"
     return format_loc(loc), msg
@@ -96,6 +98,10 @@ def _one_unwrapped_curve(body: Any) -> bool:
     )
 
 
+CURVE_OBJECT = (
+    'a curve is a list of [x, y] points, not an object: send each curve\'s "points", {"curves": [[[x, y], ...], ...]} '
+    "(the page's JSON export as it is: curve-vae reconstruct FILE reads it)"
+)
 UNWRAPPED = 'expected a list of curves, got one curve\'s points: wrap it in a list, {"curves": [[[x, y], [x, y], ...]]}'
 
 

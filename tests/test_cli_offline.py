@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from curve_vae.cli import main
-from curve_vae.files import read_curves
+from curve_vae.curvefiles import read_curves
 from curve_vae.geometry import random_control_points, sample_bspline
 
 
@@ -119,3 +119,18 @@ def test_the_papers_model_is_reachable_by_name_from_anywhere(tmp_path, monkeypat
     out = tmp_path / "s.json"
     assert main(["sample", "--model", "paper", "--count", "2", "--seed", "1", "-o", str(out)]) == 0
     assert len(json.loads(out.read_text())["curves"]) == 2
+
+
+def test_help_summarises_the_whole_command_line():
+    """`curve-vae --help` opens with a whole sentence, and the module's list names every command."""
+    import subprocess
+    import sys
+
+    import curve_vae.cli as cli
+
+    out = subprocess.run([sys.executable, "-m", "curve_vae.cli", "--help"], capture_output=True, text=True, timeout=60)
+    summary = " ".join(out.stdout.split("positional arguments")[0].split("\n", 2)[2].split())
+    assert out.returncode == 0 and summary.endswith("fit priors to your own."), summary
+    commands = cli.build_parser()._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+    listed = cli.__doc__.split("Commands:")[1]
+    assert [name for name in commands if name not in listed] == []

@@ -53,6 +53,8 @@ def _inputs(cwd: Path) -> None:
     (cwd / "seeds.json").write_text(json.dumps(seeds))
     (cwd / "curves.json").write_text(json.dumps({"curves": seeds[:2]}))
     (cwd / "profile.json").write_text(json.dumps([[0, 0], [3, 0], [4, 1], [3, 3], [2.5, 5], [3, 7], [0, 7]]))
+    # an airfoil as the UIUC database writes them, notes after the coordinates and all
+    (cwd / "my_airfoil.dat").write_text((ROOT / "tests/fixtures/files/selig_notes.dat").read_text())
     mine = cwd / "my_curves"  # a family of one's own, in three formats
     mine.mkdir()
     for i, c in enumerate(seeds):

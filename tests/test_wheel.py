@@ -91,7 +91,9 @@ def test_the_wheel_holds_one_namespace_and_the_shipped_model(wheel):
     assert tops == {"curve_vae"}
     for f in ("manifest.json", "encoder.onnx", "decoder.onnx", "prior.npz"):
         assert f"curve_vae/models/{f}" in names and f"curve_vae/models/paper/{f}" in names
-    assert "curve_vae/service/static/index.html" in names
+    for page in ("index.html", "app.js", "files.js", "vase.js"):
+        assert f"curve_vae/service/static/{page}" in names
+    assert "curve_vae/curvefiles/svg.py" in names and "curve_vae/curvefiles/dxf.py" in names
     assert not [n for n in names if n.endswith(".pt")]  # torch weights are for training from a checkout
 
 

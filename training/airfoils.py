@@ -12,12 +12,13 @@ feature.
 
 from __future__ import annotations
 
+import warnings
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from curve_vae.files import parse_dat
+from curve_vae.curvefiles import CurveFileWarning, parse_dat
 
 DATABASE = "aerosandbox/geometry/airfoil/airfoil_database/"
 
@@ -40,7 +41,9 @@ def load_airfoils(source: str | Path, count: int = 200, *, seed: int = 0, min_po
     curves = []
     for name, text in texts.items():
         try:
-            c = parse_dat(text, name)
+            with warnings.catch_warnings():  # notes after the coordinates: skipped, as the reader says
+                warnings.simplefilter("ignore", CurveFileWarning)
+                c = parse_dat(text, name)
         except ValueError:
             continue  # a handful of database files hold notes instead of coordinates
         if len(c) >= min_points and np.ptp(c, axis=0).min() > 0:

@@ -295,13 +295,13 @@ def own_curves(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A user's curves as a data set (train, val, test), each (k, n_points, 2) float32 in the model's pose and frame.
 
-    The curves of `source` (curve_vae.files.read_curve_files) are split by curve — `held` of them for
+    The curves of `source` (curve_vae.curvefiles.read_curve_files) are split by curve — `held` of them for
     validation, as many for test (at least one each), seeded — so no test curve is trained on. The training
     split is drawn n_train times, each draw in a fresh random pose (to_pose) and at a spacing drawn from
     SPACINGS ("parameter" keeps the file's own spacing, as the service takes posted points by default), so a
     few hundred curves make a data set of any size. Validation and test curves keep their own spacing.
     """
-    from curve_vae.files import read_curve_files
+    from curve_vae.curvefiles import read_curve_files
     from curve_vae.geometry import resample
 
     curves = read_curve_files(source)

@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from curve_vae.commands.options import add_model_options, add_server_option, model_runtime, server_client
+from curve_vae.curvefiles.help import INPUT_HELP, OUTPUT_HELP
 from curve_vae.files import refuse_overwrite
 from curve_vae.inference.choices import FrameMode, Output, Pose, Spacing, choices
 
@@ -19,7 +21,7 @@ def _reading(a: argparse.Namespace) -> dict[str, Any]:
 
 
 def cmd_reconstruct(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curves, write_output
+    from curve_vae.curvefiles import read_curves, write_output
     from curve_vae.inference.bodies import with_metrics, with_output
     from curve_vae.inference.reading import Reading
 
@@ -42,18 +44,20 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
             {"curves": [c.tolist() for c in rec.curves], "mse": rec.mse.tolist()}, rec.curves, a.metrics
         )
         body = with_output(body, rec.splines, a.output_as)
-    write_output(a.output, body)
+    write_output(a.output, body, array_key="curves" if "curves" in body else None)
     mse = np.asarray(body["mse"])
     print(f"{a.output}: {len(mse)} curves reconstructed, MSE (paper eq. 4) mean {mse.mean():.4g}", file=sys.stderr)
     return 0
 
 
 def cmd_encode(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curves, write_output
+    from curve_vae.curvefiles import read_curves, write_output
     from curve_vae.inference.bodies import frames_json
     from curve_vae.inference.reading import Reading
 
     refuse_overwrite(a.output, a.force)
+    if a.output != "-" and Path(a.output).suffix.lower() not in ("", ".json"):
+        raise ValueError(f"{a.output}: encode writes latents as JSON (a .json file, or - for stdout)")
     curves = read_curves(a.input)
     if a.server:
         with server_client(a) as c:
@@ -72,9 +76,9 @@ def cmd_encode(a: argparse.Namespace) -> int:
     return 0
 
 
-def _add_reading(s: argparse.ArgumentParser) -> None:
-    s.add_argument("input", help="curves: .json ([curve, …] or {curves: …}), .npy (N, n, 2), .csv, .dat, or - (stdin)")
-    s.add_argument("-o", "--output", default="-", help="JSON output file (default: - = stdout)")
+def _add_reading(s: argparse.ArgumentParser, output: str) -> None:
+    s.add_argument("input", help=INPUT_HELP)
+    s.add_argument("-o", "--output", default="-", help=f"{output} (default: - = stdout)")
     s.add_argument("--frame", choices=choices(FrameMode), default="auto", help="frame of the curves (default: auto)")
     s.add_argument("--pose", choices=choices(Pose), default="auto", help="as the service's `pose` (default: auto)")
     s.add_argument(
@@ -85,17 +89,20 @@ def _add_reading(s: argparse.ArgumentParser) -> None:
 
 def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("reconstruct", help="curves through the model and back, with their error (as POST /reconstruct)")
-    _add_reading(s)
+    _add_reading(s, OUTPUT_HELP)
     s.add_argument("--n-points", type=int, default=None, help="points per returned curve (default: the input's)")
     s.add_argument(
-        "--output-as", choices=choices(Output), default="points", help="points, B-splines or both (default: points)"
+        "--output-as",
+        choices=choices(Output),
+        default="points",
+        help="points, B-splines or both; .svg and .dxf outputs draw the B-splines exactly (default: points)",
     )
     s.add_argument("--metrics", action="store_true", help="add smoothness, self-intersection and length per curve")
     add_model_options(s)
     add_server_option(s)
     s.set_defaults(func=cmd_reconstruct)
     s = sub.add_parser("encode", help="latent mean and log-variance of each curve (as POST /encode)")
-    _add_reading(s)
+    _add_reading(s, "JSON output file")
     add_model_options(s)
     add_server_option(s)
     s.set_defaults(func=cmd_encode)

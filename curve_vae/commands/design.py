@@ -7,12 +7,13 @@ import argparse
 import sys
 
 from curve_vae.commands.options import add_server_option, server_client
+from curve_vae.curvefiles.help import INPUT_HELP, OUTPUT_HELP
 from curve_vae.files import refuse_overwrite
 from curve_vae.inference.choices import Axis, FitParam, MeshFormat, choices
 
 
 def cmd_fit(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curves, write_output
+    from curve_vae.curvefiles import read_curves, write_output
     from curve_vae.inference.bodies import fit_body
 
     refuse_overwrite(a.output, a.force)
@@ -32,7 +33,8 @@ def cmd_fit(a: argparse.Namespace) -> int:
 
 
 def cmd_revolve(a: argparse.Namespace) -> int:
-    from curve_vae.files import atomic_path, read_curves
+    from curve_vae.curvefiles import read_curves
+    from curve_vae.files import atomic_path
     from curve_vae.geometry import revolve
     from curve_vae.inference.bodies import mesh_file
 
@@ -57,8 +59,8 @@ def cmd_revolve(a: argparse.Namespace) -> int:
 
 def _add_fit(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("fit", help="least-squares cubic B-spline of each curve (no model needed)")
-    s.add_argument("input", help="curves: .json ([[x, y], …], a list of curves, or {curves: …}), .npy, or - (stdin)")
-    s.add_argument("-o", "--output", default="-", help="JSON output file (default: - = stdout)")
+    s.add_argument("input", help=INPUT_HELP)
+    s.add_argument("-o", "--output", default="-", help=f"{OUTPUT_HELP}; .svg and .dxf draw the fits (default: -)")
     s.add_argument(
         "--n-ctrl",
         type=int,
@@ -85,7 +87,7 @@ def _add_fit(sub: argparse._SubParsersAction) -> None:
 
 def _add_revolve(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("revolve", help="surface of revolution of a profile curve, as OBJ or STL (paper Fig. 12)")
-    s.add_argument("input", help="one profile curve: .json, .npy, or - (stdin)")
+    s.add_argument("input", help=f"one profile curve; {INPUT_HELP}")
     s.add_argument("-o", "--output", required=True, help="mesh file (.obj or .stl)")
     s.add_argument("--format", choices=choices(MeshFormat), default="", help="default: from the file name")
     s.add_argument("--segments", type=int, default=64, help="angular resolution (default: 64)")

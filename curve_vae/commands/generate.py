@@ -16,13 +16,14 @@ from curve_vae.commands.options import (
     model_runtime,
     server_client,
 )
+from curve_vae.curvefiles.help import INPUT_HELP
 from curve_vae.files import refuse_overwrite
 from curve_vae.inference.choices import AugmentMode, FrameMode, Output, Pose, choices
 from curve_vae.progress import bar, counted, shown
 
 
 def cmd_sample(a: argparse.Namespace) -> int:
-    from curve_vae.files import write_output
+    from curve_vae.curvefiles import write_output
     from curve_vae.inference.bodies import sample_body, with_output
     from curve_vae.inference.sampling import fresh_seed
 
@@ -64,7 +65,8 @@ def _sample_body_of(made: Any, output: str, metrics: bool) -> dict[str, Any]:
 
 
 def cmd_augment(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curves, write_npy_chunks, write_output
+    from curve_vae.curvefiles import read_curves, write_output
+    from curve_vae.files import write_npy_chunks
     from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
@@ -196,7 +198,8 @@ def _add_sample(sub: argparse._SubParsersAction) -> None:
         "--output-as",
         choices=choices(Output),
         default="points",
-        help="curves as points, as B-splines (control points, knots, params), or both; JSON only (default: points)",
+        help="curves as points, as B-splines (control points, knots, params), or both; .svg and .dxf outputs draw "
+        "the B-splines exactly (default: points)",
     )
     s.add_argument("--priors-dir", default="", help="priors fitted with `curve-vae prior`, for --prior NAME")
     add_model_options(s)
@@ -206,7 +209,7 @@ def _add_sample(sub: argparse._SubParsersAction) -> None:
 
 def _add_augment(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("augment", help="new curves between given curves, offline (as POST /augment)")
-    s.add_argument("input", help="seed curves: .json ([curve, …] or {curves: …}), .npy (N, n, 2), or - (stdin)")
+    s.add_argument("input", help=f"seed {INPUT_HELP}")
     add_generate_options(s)
     s.add_argument("--mode", choices=choices(AugmentMode), default="pair", help="sources per new curve (default: pair)")
     s.add_argument(

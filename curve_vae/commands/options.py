@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from curve_vae.curvefiles.help import OUTPUT_HELP
 from curve_vae.inference.choices import Providers, Spacing, choices
 from curve_vae.inference.cpus import available_cpus
 from curve_vae.training.families import MIX_VERSION, MIXES
@@ -46,7 +47,8 @@ def add_data_options(p: argparse.ArgumentParser) -> None:
         "--curves",
         default=None,
         metavar="PATH",
-        help="your own curves instead: a file or a directory of .npy/.csv/.json/.dat files; 10%% of the curves are "
+        help="your own curves instead: a curve file or a directory of them (.json, .csv, .npy, .dat, .svg, .dxf, …); "
+        "10%% of the curves are "
         "held out for validation and 10%% for test, and --n-train posed copies of the rest are trained on",
     )
     g.add_argument(
@@ -123,8 +125,7 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
         "-o",
         "--output",
         default="-",
-        help="output: .json (as the REST endpoint answers), .npy (curves only, float32), "
-        "or - for JSON on stdout (default: -)",
+        help=f"{OUTPUT_HELP} (default: -)",
     )
     p.add_argument("--count", type=int, required=True, help="how many curves")
     p.add_argument(

@@ -13,7 +13,7 @@ from curve_vae.files import refuse_overwrite
 
 
 def cmd_prior(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curve_files
+    from curve_vae.curvefiles import read_curve_files
     from curve_vae.training.prior import fit_named_prior
 
     out = Path(a.output)
@@ -47,7 +47,7 @@ def cmd_prior(a: argparse.Namespace) -> int:
 
 
 def cmd_evaluate_prior(a: argparse.Namespace) -> int:
-    from curve_vae.files import read_curve_files
+    from curve_vae.curvefiles import read_curve_files
     from curve_vae.inference.evaluate_prior import evaluate_prior, format_report
     from curve_vae.inference.priors import NamedPrior
 
@@ -89,7 +89,9 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("prior", help="fit a latent prior to your own curves: /sample makes more like them")
-    s.add_argument("--curves", required=True, help="a curve file, or a directory of .npy/.csv/.json/.dat files")
+    s.add_argument(
+        "--curves", required=True, help="a curve file, or a directory of them (.json, .csv, .npy, .dat, .svg, .dxf, …)"
+    )
     s.add_argument("-o", "--output", required=True, help="the prior, NAME.npz (its name is the file's stem)")
     s.add_argument(
         "--kind",

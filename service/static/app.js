@@ -71,15 +71,19 @@ const pathOf = (pts) => pts.map((p, i) => `${i ? "L" : "M"}${round(p[0])},${roun
 function render() {
   const board = $("board");
   board.replaceChildren();
+  // the drawn strokes as pale bands, so that the dashed reconstructions drawn over them stay in sight
   state.curves.forEach((c, i) => {
-    el("path", { d: pathOf(c.map(toBoard)), fill: "none", stroke: COLORS[i], "stroke-width": 3, class: "input" }, board);
-    const [x, y] = toBoard(c[0]);
-    el("text", { x: x + 6, y: y - 6, fill: COLORS[i], "font-size": 22 }, board).textContent = NAMES[i];
+    el("path", { d: pathOf(c.map(toBoard)), fill: "none", stroke: COLORS[i], "stroke-width": 6, "stroke-opacity": 0.3,
+      "stroke-linecap": "round", "stroke-linejoin": "round", class: "input" }, board);
+  });
+  placeLabels(state.curves).forEach(([x, y], i) => {
+    el("text", { x, y, fill: COLORS[i], "font-size": 22, "font-weight": "bold", class: "label" }, board)
+      .textContent = NAMES[i];
   });
   state.recon.forEach((r, i) => {
     if (!r) return;
-    el("path", { d: pathOf(r.points.map(toBoard)), fill: "none", stroke: COLORS[i], "stroke-width": 1.5,
-      "stroke-dasharray": "6 4", class: "reconstruction" }, board);
+    el("path", { d: pathOf(r.points.map(toBoard)), fill: "none", stroke: COLORS[i], "stroke-width": 2,
+      "stroke-dasharray": "7 4", class: "reconstruction" }, board);
     if ($("show-ctrl").checked && r.spline) drawControl(board, r.spline, COLORS[i]);
   });
   if (state.result) {
@@ -90,6 +94,22 @@ function render() {
   if (stroke) drawStroke();  // a stroke in progress survives a redraw by an answer arriving meanwhile
   renderStrip();
   renderMetrics();
+}
+
+// Where each curve's name goes: beside its start, else its end or middle, the first place at least LABEL_GAP from
+// the names placed before it (curves drawn from one point, or samples near each other, would stack them).
+const LABEL_GAP = 34;
+function placeLabels(curves) {
+  const placed = [];
+  for (const c of curves) {
+    const spots = [c[0], c[c.length - 1], c[Math.floor(c.length / 2)]].map(toBoard)
+      .flatMap(([x, y]) => [[x + 8, y - 8], [x + 8, y + 26], [x - 26, y - 8], [x - 26, y + 26]]);
+    const far = (p) => placed.every((q) => Math.hypot(p[0] - q[0], p[1] - q[1]) >= LABEL_GAP);
+    let spot = spots.find(far);
+    for (let k = 1; !spot; k++) spot = spots.map(([x, y]) => [x + LABEL_GAP * k, y]).find(far);
+    placed.push(spot);
+  }
+  return placed;
 }
 
 function drawStroke() {
@@ -177,11 +197,15 @@ function finishStroke() {
     return;
   }
   $("board-error").textContent = "";
-  const max = state.mode === "triplet" ? 3 : 2;
-  if (state.curves.length >= max) { state.curves.shift(); state.recon.shift(); }
-  state.curves.push(pts.map(toApi));
-  state.recon.push(null);
+  addCurve(pts.map(toApi));
   curvesChanged();
+}
+
+// A new curve (API coordinates) in place of the oldest once the mode's two or three are there.
+function addCurve(curve) {
+  if (state.curves.length >= needed()) { state.curves.shift(); state.recon.shift(); }
+  state.curves.push(curve);
+  state.recon.push(null);
 }
 
 // ------------------------------------------------------------------------------------------ model calls
@@ -243,33 +267,47 @@ $("weight").addEventListener("input", () => {
   mixChanged();
 });
 
+function setMode(mode) {
+  state.mode = mode;
+  $(`mode-${mode}`).checked = true;
+  $("pair-controls").hidden = mode !== "pair";
+  $("triplet-controls").hidden = mode !== "triplet";
+  state.curves = state.curves.slice(-needed());
+  state.recon = state.recon.slice(-needed());
+}
 for (const mode of ["pair", "triplet"]) {
-  $(`mode-${mode}`).addEventListener("change", () => {
-    state.mode = mode;
-    $("pair-controls").hidden = mode !== "pair";
-    $("triplet-controls").hidden = mode !== "triplet";
-    state.curves = state.curves.slice(-needed());
-    state.recon = state.recon.slice(-needed());
-    curvesChanged();
-  });
+  $(`mode-${mode}`).addEventListener("change", () => { setMode(mode); curvesChanged(); });
 }
 
 $("show-ctrl").addEventListener("change", render);
 $("fit-closely").addEventListener("change", curvesChanged);
 $("clear").addEventListener("click", () => {
-  Object.assign(state, { curves: [], recon: [], result: null, strip: [] });
+  Object.assign(state, { curves: [], recon: [], result: null, strip: [], vase: null, lastRequest: null });
+  $("curl").textContent = "";
+  for (const id of ["board-error", "mix-error", "strip-error", "vase-error"]) $(id).textContent = "";
+  drawVase();
   curvesChanged();
 });
 $("sample").addEventListener("click", async () => {
   try {
-    const body = { count: needed(), n_points: N_POINTS, frame: { center: [W / 2, H / 2], size: 420 } };
+    const k = needed(), size = Math.min((0.8 * W) / k, 0.75 * H);
+    const body = { count: k, n_points: N_POINTS, frame: { center: [0, 0], size } };
     if ($("prior").value) body.prior = $("prior").value;
     const r = await api("/sample", body, $("board-error"));
-    state.curves = r.curves;
+    // side by side, each in its own slot of the board, not all about its centre
+    state.curves = r.curves.map((c, i) => placed(c, [(W * (i + 0.5)) / k, H / 2]));
     state.recon = r.curves.map(() => null);
     await curvesChanged();
   } catch (e) { /* shown next to the board */ }
 });
+
+// The curve moved so that its bounding box is centred on `center`, and scaled down where it would not fit `box`.
+function placed(curve, center, box = [W / needed(), H]) {
+  const xs = curve.map((p) => p[0]), ys = curve.map((p) => p[1]);
+  const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  const s = Math.min(1, (0.9 * box[0]) / (x1 - x0 || 1), (0.9 * box[1]) / (y1 - y0 || 1));
+  return curve.map(([x, y]) => [center[0] + s * (x - (x0 + x1) / 2), center[1] + s * (y - (y0 + y1) / 2)]);
+}
 
 // The barycentric triangle: A at the top, B bottom left, C bottom right.
 const TRI = [[110, 12], [12, 185], [208, 185]];
@@ -337,9 +375,63 @@ $("download-svg").addEventListener("click", () => {
   svg.setAttribute("height", H);
   download("curves.svg", "image/svg+xml", new XMLSerializer().serializeToString(svg));
 });
+// DXF for CAD: the drawn curves as polylines, the reconstructions and the mix as SPLINE entities, exactly.
+$("download-dxf").addEventListener("click", () => {
+  const items = state.curves.map((points, i) => ({ layer: `input-${NAMES[i]}`, points }));
+  state.recon.forEach((r, i) => { if (r && r.spline) items.push({ layer: `reconstruction-${NAMES[i]}`, spline: r.spline }); });
+  if (state.result && state.result.spline) items.push({ layer: "interpolant", spline: state.result.spline });
+  download("curves.dxf", "image/vnd.dxf", curveFiles.dxf(items));
+});
 $("copy-curl").addEventListener("click", async () => {
   showCurl();
   try { await navigator.clipboard.writeText($("curl").textContent); } catch (e) { /* shown below anyway */ }
+});
+
+// ------------------------------------------------------------------------------------------ open a file
+
+// Curves from a file picked or dropped on the board (JSON, CSV, SVG, DAT; files.js reads them here, in the
+// browser): up to three, in pair or triplet mode as many as there are; one joins the drawn curves.
+async function openFile(file) {
+  $("board-error").textContent = "";
+  let read;
+  try {
+    read = curveFiles.parse(file.name, await file.text());
+  } catch (e) {
+    $("board-error").textContent = e.message;
+    return;
+  }
+  const curves = onBoard(read.curves.slice(0, 3));
+  if (curves.length > 1) {
+    setMode(curves.length === 3 ? "triplet" : "pair");
+    Object.assign(state, { curves: [], recon: [] });
+  }
+  curves.forEach(addCurve);
+  const done = curvesChanged();
+  $("hint").textContent = [`${file.name}: ${curves.length} of its ${read.curves.length} curve(s) opened.`,
+    ...read.notes].join(" ");
+  await done;
+}
+
+// Curves as they are where they lie on the board (the page's own exports); else scaled and centred onto it.
+function onBoard(curves) {
+  const all = curves.flat();
+  const xs = all.map((p) => p[0]), ys = all.map((p) => p[1]);
+  const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  if (x0 >= 0 && x1 <= W && y0 >= 0 && y1 <= H) return curves;
+  const s = Math.min((0.8 * W) / (x1 - x0 || 1), (0.8 * H) / (y1 - y0 || 1));
+  return curves.map((c) => c.map(([x, y]) => [W / 2 + s * (x - (x0 + x1) / 2), H / 2 + s * (y - (y0 + y1) / 2)]));
+}
+
+$("open-file").addEventListener("change", () => {
+  const file = $("open-file").files[0];
+  $("open-file").value = "";  // the same file picked again is read again
+  if (file) openFile(file);
+});
+$("board").addEventListener("dragover", (ev) => ev.preventDefault());
+$("board").addEventListener("drop", (ev) => {
+  ev.preventDefault();
+  const file = ev.dataTransfer.files[0];
+  if (file) openFile(file);
 });
 
 // ------------------------------------------------------------------------------------------ the vase
@@ -356,7 +448,7 @@ $("vase").addEventListener("click", async () => {
   try {
     const r = await revolve("obj");
     if (!r) return;
-    state.vase = parseObj(await r.text());
+    state.vase = curveVase.parseObj(await r.text());
     state.vase.faces_header = Number(r.headers.get("X-Mesh-Faces"));
     drawVase();
   } catch (e) { /* shown next to the vase */ }
@@ -371,52 +463,8 @@ for (const format of ["obj", "stl"]) {
 }
 $("turn").addEventListener("input", drawVase);
 
-function parseObj(text) {
-  const v = [], f = [];
-  for (const line of text.split("\n")) {
-    const p = line.trim().split(/\s+/);
-    if (p[0] === "v") v.push(p.slice(1, 4).map(Number));
-    else if (p[0] === "f") f.push(p.slice(1, 4).map((s) => Number(s.split("/")[0]) - 1));
-  }
-  return { vertices: v, faces: f };
-}
-
-// Flat-shaded triangles, painter's order, turned about the vertical axis and tilted towards the viewer.
-function drawVase() {
-  const canvas = $("vase-view"), g = canvas.getContext("2d");
-  g.clearRect(0, 0, canvas.width, canvas.height);
-  if (!state.vase) return;
-  const { vertices, faces } = state.vase;
-  const t = (Number($("turn").value) * Math.PI) / 180, tilt = 0.35;
-  const c = [0, 1, 2].map((k) => vertices.reduce((s, p) => s + p[k], 0) / vertices.length);
-  const view = vertices.map(([x, y, z]) => {
-    const X = (x - c[0]) * Math.cos(t) + (z - c[2]) * Math.sin(t);
-    const Z = -(x - c[0]) * Math.sin(t) + (z - c[2]) * Math.cos(t);
-    const Y = y - c[1];
-    return [X, Y * Math.cos(tilt) - Z * Math.sin(tilt), Y * Math.sin(tilt) + Z * Math.cos(tilt)];
-  });
-  const size = Math.max(...view.map((p) => Math.max(Math.abs(p[0]), Math.abs(p[1])))) || 1;
-  const s = (0.45 * Math.min(canvas.width, canvas.height)) / size;
-  const tris = faces.map((f) => {
-    const [a, b, d] = f.map((i) => view[i]);
-    const n = [(b[1] - a[1]) * (d[2] - a[2]) - (b[2] - a[2]) * (d[1] - a[1]),
-      (b[2] - a[2]) * (d[0] - a[0]) - (b[0] - a[0]) * (d[2] - a[2]),
-      (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0])];
-    const len = Math.hypot(...n) || 1;
-    return { pts: [a, b, d], depth: (a[2] + b[2] + d[2]) / 3, light: Math.abs(n[2] / len) };
-  }).sort((p, q) => p.depth - q.depth);
-  for (const tri of tris) {
-    const shade = Math.round(90 + 150 * tri.light);
-    g.fillStyle = `rgb(${shade}, ${Math.round(shade * 0.8)}, ${Math.round(shade * 0.6)})`;
-    g.beginPath();
-    tri.pts.forEach(([x, y], i) => {
-      const X = canvas.width / 2 + s * x, Y = canvas.height / 2 - s * y;
-      if (i) g.lineTo(X, Y); else g.moveTo(X, Y);
-    });
-    g.closePath();
-    g.fill();
-  }
-}
+// The vase's mesh, drawn by vase.js at the slider's turn (a blank canvas without one).
+function drawVase() { curveVase.draw($("vase-view"), state.vase, Number($("turn").value)); }
 
 // The key lives for this browser tab only.
 $("api-key").value = sessionStorage.getItem("curve-vae-api-key") || "";

@@ -185,9 +185,14 @@ def test_metrics_are_per_app(make_client):
     assert 'route="/health"' not in b.get("/metrics").text
 
 
-def test_cors_off_by_default(client):
+def test_cors_off_by_default_and_a_preflight_is_told_how_to_allow_its_origin(client):
     r = client.options("/encode", headers={"Origin": "https://app.example", "Access-Control-Request-Method": "POST"})
-    assert "access-control-allow-origin" not in r.headers
+    assert r.status_code == 403 and "access-control-allow-origin" not in r.headers
+    assert r.json()["detail"] == (
+        "origin: calls from https://app.example are not allowed (the server allows no other origin): start it with "
+        "--cors-origins https://app.example or CURVE_VAE_CORS_ORIGINS=https://app.example"
+    )
+    assert client.options("/encode").status_code == 405  # not a preflight: the routes' own answer
 
 
 def test_cors_allows_configured_origins(make_client):
@@ -198,7 +203,8 @@ def test_cors_allows_configured_origins(make_client):
     r = client.post("/encode", json={"curves": [CURVE]}, headers={"Origin": "https://other.example"})
     assert r.headers["access-control-allow-origin"] == "https://other.example"
     r = client.options("/encode", headers={"Origin": "https://evil.example", **pre})
-    assert "access-control-allow-origin" not in r.headers
+    assert r.status_code == 403 and "access-control-allow-origin" not in r.headers
+    assert "CURVE_VAE_CORS_ORIGINS=https://app.example,https://other.example,https://evil.example" in r.json()["detail"]
 
 
 def test_settings_from_environment(monkeypatch):

@@ -309,3 +309,63 @@ def test_samples_come_from_the_prior_the_user_picks(browser, server_factory, tmp
     assert answer.value.json()["prior"] == "waves" and len(answer.value.json()["curves"]) == 2
     page.wait_for_function("window.curveVae.result !== null")
     assert errors == []
+
+
+TINY_PAGE = """<!doctype html><meta charset="utf-8"><title>another origin</title><link rel="icon" href="data:,">
+<script>
+window.reconstruct = async (api) => {
+  const body = JSON.stringify({curves: [[[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]]});
+  try {  // JSON is not a "simple" request: the browser sends a preflight first
+    const r = await fetch(api + "/reconstruct", {method: "POST", headers: {"Content-Type": "application/json"}, body});
+    return {status: r.status, body: await r.json()};
+  } catch (e) { return {error: String(e)}; }
+};
+</script>"""
+
+
+@pytest.fixture
+def other_origin(tmp_path) -> Iterator[str]:
+    """A tiny page served on a second loopback port: another origin than any server's."""
+    import functools
+    import http.server
+    import threading
+
+    (tmp_path / "index.html").write_text(TINY_PAGE)
+
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args: object) -> None:
+            pass
+
+    handler = functools.partial(Quiet, directory=str(tmp_path))
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    httpd.shutdown()
+    thread.join()
+
+
+def test_a_page_on_another_origin_calls_a_server_that_allows_it(
+    browser, server, server_factory, model_dir, other_origin
+):
+    """CURVE_VAE_CORS_ORIGINS lets the origin's fetch through its preflight; a server without it refuses the
+    preflight with a 403 that says how to allow the origin, and the browser blocks the call."""
+    api = server_factory(
+        "--model-dir", str(model_dir), "--providers", "cpu", env={"CURVE_VAE_CORS_ORIGINS": other_origin}
+    )
+    api.wait_ready()
+    page, errors = open_page(browser, other_origin + "/")
+    answer = page.evaluate("(api) => window.reconstruct(api)", api.url)
+    assert answer["status"] == 200 and np.shape(answer["body"]["curves"]) == (1, 7, 2), answer
+    assert errors == []
+
+    refused = page.evaluate("(api) => window.reconstruct(api)", server.url)  # the shipped server: no origins set
+    assert "Failed to fetch" in refused["error"]
+    assert any("CORS policy" in e for e in errors), errors
+    preflight = httpx.options(
+        server.url + "/reconstruct",
+        headers={"Origin": other_origin, "Access-Control-Request-Method": "POST"},
+        timeout=10,
+    )
+    assert preflight.status_code == 403
+    assert f"--cors-origins {other_origin} or CURVE_VAE_CORS_ORIGINS={other_origin}" in preflight.json()["detail"]

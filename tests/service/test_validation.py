@@ -10,6 +10,10 @@ import json
 import numpy as np
 import pytest
 
+from tests.helpers import FIXTURES
+
+FILES = FIXTURES / "files"
+
 C = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]  # a valid curve
 Z = [0.0] * 32  # a valid latent
 LIMITS = {"max_curves": 4, "max_points": 300, "max_body_bytes": 20_000}
@@ -515,3 +519,14 @@ def test_one_curve_not_wrapped_in_a_list_gets_one_error_that_says_wrap_it(client
 def test_a_body_without_content_type_gets_the_header_hint(client):
     r = client.post("/encode", content=json.dumps({"curves": [C]}).encode(), headers={"Content-Type": ""})
     assert r.status_code == 422 and "Content-Type: application/json" in r.json()["detail"], r.json()
+
+
+@pytest.mark.parametrize("path", ["/reconstruct", "/interpolate"])
+def test_the_pages_json_export_posted_as_it_is_gets_told_what_to_send(client, path):
+    """The page's export holds objects with "points"; the API takes point arrays, and says so (the CLI reads it)."""
+    export = json.loads((FILES / "page-export.json").read_text())
+    r = client.post(path, json=export)
+    assert r.status_code == 422
+    detail = r.json()["detail"]
+    assert detail.startswith("curves[0]: a curve is a list of [x, y] points, not an object: send each curve's")
+    assert "curve-vae reconstruct FILE reads it" in detail

@@ -1,0 +1,102 @@
+"""Curves from text: JSON (an API body, a list of curves, one curve, the page's export) and CSV/TSV (x,y rows, a
+header row naming the columns, the page's `curve,role,index,x,y`)."""
+
+from __future__ import annotations
+
+import csv
+import json
+from typing import Any
+
+import numpy as np
+
+from curve_vae.curvefiles.common import CurveFileError, as_curves, number
+
+JSON_SHAPES = (
+    '[[x, y], …] (one curve), [curve, …], {"curves": [curve, …]} (as the API takes them), '
+    '{"curves": [{"name": …, "points": [[x, y], …]}, …]} (the page\'s export) or {"curve": …} (as /revolve takes it)'
+)
+
+
+def parse_json(text: str, name: str) -> list[np.ndarray]:
+    """The curves of a JSON document in any of JSON_SHAPES; CurveFileError says which shapes are read."""
+    try:
+        data: Any = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise CurveFileError(f"{name}:{e.lineno}: not JSON ({e.msg})") from None
+    if isinstance(data, dict):
+        if isinstance(data.get("curves"), list):
+            data = data["curves"]
+        elif "curve" in data:
+            data = [data["curve"]]
+        elif "points" in data:
+            data = [data]
+        else:
+            raise CurveFileError(f"{name}: a JSON object needs a 'curves' list; the shapes read are {JSON_SHAPES}")
+    if not isinstance(data, list):
+        raise CurveFileError(f"{name}: JSON of curves is a list or an object; the shapes read are {JSON_SHAPES}")
+    if data and isinstance(data[0], list) and data[0] and not isinstance(data[0][0], list | dict):
+        data = [data]  # a single curve
+    return as_curves([_points(c, i, name) for i, c in enumerate(data)], name)
+
+
+def _points(curve: Any, i: int, name: str) -> Any:
+    """A curve of a JSON list: its points, from an object (the page's export) or as they are."""
+    if isinstance(curve, dict):
+        if "points" not in curve:
+            label = f" ({curve['name']})" if "name" in curve else ""
+            raise CurveFileError(f"{name}: curves[{i}]{label} is an object without 'points'")
+        return curve["points"]
+    return curve
+
+
+def _delimiter(line: str) -> str | None:
+    for d in ("\t", ",", ";"):
+        if d in line:
+            return d
+    return None  # columns apart by spaces
+
+
+def _cells(line: str, delimiter: str | None) -> list[str]:
+    if delimiter is None:
+        return line.split()
+    return [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
+
+
+def _columns(header: list[str], number_line: int, name: str) -> tuple[int, int, int | None]:
+    """Where x, y and the curve's name are, from a header row."""
+    names = [h.strip().lower() for h in header]
+    curve = next((names.index(k) for k in ("curve", "name", "id") if k in names), None)
+    if "x" in names and "y" in names:
+        return names.index("x"), names.index("y"), curve
+    if len(names) == 2:
+        return 0, 1, None
+    raise CurveFileError(f"{name}:{number_line}: a header row needs columns named x and y, got {','.join(header)}")
+
+
+def parse_csv(text: str, name: str) -> list[np.ndarray]:
+    """Curves from CSV or TSV: one point a row. Without a header, a row is `x,y` and a blank line starts the next
+    curve; with one, the columns named x and y are read and a `curve` (or `name`) column groups the rows."""
+    lines = text.splitlines()
+    first = next((i for i, line in enumerate(lines) if line.strip()), None)
+    if first is None:
+        raise CurveFileError(f"{name}: no curve in this file (it is empty)")
+    delimiter = _delimiter(lines[first])
+    cells = _cells(lines[first], delimiter)
+    header = any(number(c) is None for c in cells)
+    x, y, key = _columns(cells, first + 1, name) if header else (0, 1, None)
+    curves: list[list[tuple[float, float]]] = [[]]
+    last = None
+    for i in range(first + header, len(lines)):
+        if not lines[i].strip():
+            curves.append([])
+            continue
+        row = _cells(lines[i], delimiter)
+        values = [number(row[j]) if j < len(row) else None for j in (x, y)]
+        if values[0] is None or values[1] is None or (not header and len(row) != 2):
+            what = "two numbers x,y" if not header or len(cells) == 2 else "numbers in the columns named x and y"
+            raise CurveFileError(f"{name}:{i + 1}: expected {what}, got {lines[i].strip()!r}")
+        if key is not None and row[key] != last:
+            curves.append([])
+            last = row[key]
+        curves[-1].append((values[0], values[1]))
+    return as_curves([c for c in curves if c], name)

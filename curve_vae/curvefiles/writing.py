@@ -1,0 +1,73 @@
+"""A command's output by the file's extension: .json (the endpoint's answer; the default, and `-` for standard
+output), .csv (the points, `curve,index,x,y`), .npy (the curves as one float32 array), .svg (a path per curve; a
+B-spline as exact cubic Béziers), .dxf (a SPLINE per B-spline, or an LWPOLYLINE per curve). Every file is written
+beside its name and renamed over it when complete."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from curve_vae.curvefiles.bezier import spline_beziers
+from curve_vae.curvefiles.common import CurveFileError
+from curve_vae.files import atomic_path, atomic_write_text
+
+
+def _splines(payload: dict[str, Any]) -> list[dict[str, Any]] | None:
+    """The B-splines of an answer: `splines` (--output-as bspline or both) or `fits` (curve-vae fit)."""
+    return payload.get("splines") or payload.get("fits")
+
+
+def _points(payload: dict[str, Any], path: str, array_key: str | None) -> list[Any]:
+    key = array_key or "curves"
+    if key not in payload:
+        hint = " (ask for points: --output-as points or both)" if _splines(payload) else ""
+        raise CurveFileError(f"{path}: this output holds no curves' points to write as {Path(path).suffix}{hint}")
+    return payload[key]
+
+
+def write_output(path: str, payload: dict[str, Any], array_key: str | None = None) -> None:
+    """`payload` (an endpoint's JSON answer) to `path` in the format its extension names."""
+    suffix = Path(path).suffix.lower() if path != "-" else ".json"
+    if suffix == ".npy":
+        try:
+            arr = np.asarray(_points(payload, path, array_key), dtype=np.float32)
+        except ValueError:
+            raise CurveFileError(f"{path}: curves of different lengths fit no array; write .json or .csv") from None
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:
+            np.save(f, arr)
+    elif suffix == ".csv":
+        rows = ["curve,index,x,y"]
+        for i, c in enumerate(_points(payload, path, array_key)):
+            rows += [f"{i},{j},{x!r},{y!r}" for j, (x, y) in enumerate(np.asarray(c, dtype=np.float64).tolist())]
+        atomic_write_text(path, "\n".join(rows) + "\n")
+    elif suffix in (".svg", ".dxf"):
+        _write_drawing(path, suffix, payload, array_key)
+    else:
+        text = json.dumps(payload, indent=None, separators=(",", ":")) + "\n"
+        if path == "-":
+            sys.stdout.write(text)
+        else:
+            atomic_write_text(path, text)
+
+
+def _write_drawing(path: str, suffix: str, payload: dict[str, Any], array_key: str | None) -> None:
+    from curve_vae.curvefiles.dxf import write_dxf
+    from curve_vae.curvefiles.svg import svg_text
+
+    splines = _splines(payload)
+    curves = None if splines else [np.asarray(c, dtype=np.float64) for c in _points(payload, path, array_key)]
+    if suffix == ".svg":
+        if splines:
+            beziers = [spline_beziers(s["control_points"], s["knots"], s["degree"]) for s in splines]
+            text = svg_text(beziers, beziers=True)
+        else:
+            text = svg_text(curves or [], beziers=False)
+        atomic_write_text(path, text)
+    else:
+        with atomic_path(path) as tmp:
+            write_dxf(tmp, splines=splines, curves=curves)
