@@ -75,18 +75,24 @@ def ordered_closest_params(
     def at(u: np.ndarray, order: int = 0) -> list[np.ndarray]:
         return spline_values(ctrl, u, owner, degree=degree, order=order)
 
-    r = at(flat_u)[0] - flat_p
+    value, t, k = at(flat_u, 2)
+    r = value - flat_p
     for _ in range(newton):
-        _, t, k = at(flat_u, 2)
         grad, curv = (r * t).sum(-1), (t * t).sum(-1) + (r * k).sum(-1)
         moved = np.clip(flat_u - np.where(curv > 0, grad / np.where(curv > 0, curv, 1.0), 0.0), lo, hi)
         moved = np.where(inner, moved, flat_u)
-        r_moved = at(moved)[0] - flat_p
-        closer = (r_moved**2).sum(-1) < (r**2).sum(-1)
-        flat_u = np.where(closer, moved, flat_u)
-        r = np.where(closer[:, None], r_moved, r)
-    out = [np.maximum.accumulate(flat_u[a:b]) for a, b in zip(ends[:-1], ends[1:])]
-    r = at(np.concatenate(out))[0] - flat_p
+        value, t_moved, k_moved = at(moved, 2)  # the next step's slope and curvature too, where the step is taken
+        r_moved = value - flat_p
+        closer = ((r_moved**2).sum(-1) < (r**2).sum(-1))[:, None]
+        flat_u = np.where(closer[:, 0], moved, flat_u)
+        r, t, k = np.where(closer, r_moved, r), np.where(closer, t_moved, t), np.where(closer, k_moved, k)
+    if (lengths == lengths[0]).all():  # in order within each curve: a running maximum along each
+        ordered = np.maximum.accumulate(flat_u.reshape(count, -1), axis=1).ravel()
+    else:
+        ordered = np.concatenate([np.maximum.accumulate(flat_u[a:b]) for a, b in zip(ends[:-1], ends[1:])])
+    if not np.array_equal(ordered, flat_u):
+        r = at(ordered)[0] - flat_p
+    out = np.split(ordered, ends[1:-1])
     distance = np.bincount(owner, weights=(r**2).sum(-1), minlength=count)
     return out, distance
 

@@ -1,0 +1,85 @@
+"""Where a single-curve one-pass request's time goes in-process: `CurveRuntime.reconstruct` of one caller curve with
+pose "canonical", spacing "parameter" (one encoding, one decoding), no cache, one 1-thread session pair, under
+cProfile; each stage's share of the time, and the wall time per request without the profiler.
+
+    .venv/bin/python -m bench.profile_one                 # 300 requests
+    .venv/bin/python -m bench.profile_one --markdown      # the table docs/BENCHMARKS.md shows
+
+Stages are named by the functions they run (cumulative time), so the same script measures an older checkout too.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import pstats
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bench import ceiling
+from curve_vae.inference.reading import Reading
+from curve_vae.inference.runtime import CurveRuntime
+from curve_vae.inference.sessions import SessionConfig
+
+ROOT = Path(__file__).resolve().parents[1]
+#: stage -> the functions (file suffix, name) whose cumulative time is the stage's
+STAGES = {
+    "the two graphs (onnxruntime)": [("graphs.py", "_run_graph")],
+    "placement on the spline": [("matching.py", "ordered_closest_params")],
+    "canonical frame": [("frame.py", "canonical_frame"), ("batch.py", "canonical_frames")],
+    "to the model plane": [("reader.py", "_model_points"), ("reader.py", "_targets")],
+    "back to the caller, MSE": [("placing.py", "to_caller"), ("placing.py", "placed_to_caller")],
+}
+ONE_PASS = Reading(pose="canonical", spacing="parameter")
+
+
+def measure(model_dir: Path, requests: int) -> dict[str, float]:
+    rt = CurveRuntime.load(model_dir, sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
+    one = list(ceiling.callers_curves(ceiling.curves(1, seed=1), seed=1))
+    rt.reconstruct(one, ONE_PASS)
+    start = time.perf_counter()
+    for _ in range(requests):
+        rt.reconstruct(one, ONE_PASS)
+    wall = (time.perf_counter() - start) / requests * 1e3
+    prof = cProfile.Profile()
+    prof.enable()
+    for _ in range(requests):
+        rt.reconstruct(one, ONE_PASS)
+    prof.disable()
+    stats = pstats.Stats(prof).stats  # type: ignore[attr-defined]
+    total = max(ct for (_, _, name), (_, _, _, ct, _) in stats.items() if name == "reconstruct")
+    out = {"wall_ms_per_request": wall}
+    for stage, functions in STAGES.items():
+        out[stage] = (
+            sum(
+                ct
+                for (file, _, name), (_, _, _, ct, _) in stats.items()
+                if any(file.endswith(f) and name == fn for f, fn in functions)
+            )
+            / total
+        )
+    out["everything else"] = 1.0 - sum(v for k, v in out.items() if k != "wall_ms_per_request")
+    return out
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--model-dir", default=str(ROOT / "models"), help="the model (default: the shipped one)")
+    p.add_argument("--requests", type=int, default=300, help="single-curve requests (default: 300)")
+    p.add_argument("--markdown", action="store_true", help="print a Markdown table")
+    a = p.parse_args()
+    r = measure(Path(a.model_dir), a.requests)
+    if a.markdown:
+        print("| stage | share of the request |\n|---|---|")
+        for k, v in r.items():
+            if k != "wall_ms_per_request":
+                print(f"| {k} | {100 * v:.0f}% |")
+        print(f"| wall time per request, without the profiler | {r['wall_ms_per_request']:.2f} ms |")
+    else:
+        print({k: round(float(np.round(v, 4)), 4) for k, v in r.items()})
+
+
+if __name__ == "__main__":
+    main()
