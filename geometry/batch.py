@@ -122,8 +122,9 @@ def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
     if not (extent > 0).all():
         raise ValueError("all points coincide: a curve needs at least 2 distinct points")
     mirror = _turns_clockwise(pts)
-    flip = np.where(mirror, -1.0, 1.0)[:, None]
-    heading = _chord_heading(pts * np.stack([flip, np.ones_like(flip)], axis=-1))
+    flip = np.stack([np.where(mirror, -1.0, 1.0), np.ones(len(pts))], axis=-1)  # (k, 2)
+    centroid = _arc_centroid(pts)  # (k, 2): a wire's centroid moves with every linear map of it
+    heading = _chord_heading(pts * flip[:, None, :], centroid * flip)
     target = POSE_CHORDS[0]
     turn = np.angle(np.exp(1j * (target - heading)))
     drawn = _linear(turn, mirror)  # (k, 2, 2)
@@ -135,7 +136,7 @@ def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
     turn_flipped = np.arctan2(a[:, 1, 0], a[:, 0, 0])
     flipped = _linear(turn_flipped, ~mirror)
     posed = np.einsum("knd,kde->kne", pts, drawn)  # chord along −y (a translation changes no statistic below)
-    centroid = _arc_centroid(posed)  # (k, 2)
+    centroid = np.einsum("kd,kde->ke", centroid, drawn)
     offset = (posed[:, 0, 1] + posed[:, -1, 1]) / 2 - centroid[:, 1]
     box_drawn = _box(pts, drawn)
     level = np.abs(offset) <= 1e-9 * box_drawn[1]
@@ -175,20 +176,24 @@ def _turns_clockwise(pts: np.ndarray) -> np.ndarray:
     """frame.turns_clockwise of each curve (k, n, 2) -> (k,): by the signed turning, or the signed area where that
     is zero to rounding."""
     d = np.diff(pts, axis=1)  # (k, n - 1, 2)
-    moving = np.linalg.norm(d, axis=2) > 0
-    # a segment of zero length is skipped: each takes the last moving segment before it (or the first after it), so
-    # the turn between the moving segments on either side is counted once and the repeats add nothing
-    j = np.arange(d.shape[1])
-    last = np.maximum.accumulate(np.where(moving, j, -1), axis=1)
-    first = np.argmax(moving, axis=1)
-    d = np.take_along_axis(d, np.where(last < 0, first[:, None], last)[..., None], axis=1)
+    moving = (d != 0).any(axis=2)
+    if not moving.all():
+        # a segment of zero length is skipped: each takes the last moving segment before it (or the first after
+        # it), so the turn between the moving segments on either side is counted once and the repeats add nothing
+        j = np.arange(d.shape[1])
+        last = np.maximum.accumulate(np.where(moving, j, -1), axis=1)
+        first = np.argmax(moving, axis=1)
+        d = np.take_along_axis(d, np.where(last < 0, first[:, None], last)[..., None], axis=1)
     cross = d[:, :-1, 0] * d[:, 1:, 1] - d[:, :-1, 1] * d[:, 1:, 0]
-    dot = (d[:, :-1] * d[:, 1:]).sum(axis=2)
+    dot = d[:, :-1, 0] * d[:, 1:, 0] + d[:, :-1, 1] * d[:, 1:, 1]
     turning = np.arctan2(cross, dot).sum(axis=1)
     turning = np.where(moving.sum(axis=1) >= 2, turning, 0.0)
-    x, y = pts[..., 0], pts[..., 1]
-    area = (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
-    return np.where(np.abs(turning) > 1e-9, turning < 0, area < 0)
+    clockwise = turning < 0
+    level = np.abs(turning) <= 1e-9
+    if level.any():  # straight lines, S-bends: the signed area the curve encloses with its chord
+        x, y = pts[level, :, 0], pts[level, :, 1]
+        clockwise[level] = (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1) < 0
+    return clockwise
 
 
 def _arc_centroid(pts: np.ndarray) -> np.ndarray:
@@ -200,10 +205,10 @@ def _arc_centroid(pts: np.ndarray) -> np.ndarray:
     return np.where((total > 0)[:, None], wire, pts.mean(axis=1))
 
 
-def _chord_heading(pts: np.ndarray) -> np.ndarray:
-    """frame.chord_heading of each curve (k, n, 2) -> (k,)."""
+def _chord_heading(pts: np.ndarray, centroid: np.ndarray | None = None) -> np.ndarray:
+    """frame.chord_heading of each curve (k, n, 2) -> (k,); `centroid`: their arc centroids, where known."""
     chord = pts[:, -1] - pts[:, 0]
-    centroid = _arc_centroid(pts)
+    centroid = _arc_centroid(pts) if centroid is None else centroid
     reach = 2 * np.linalg.norm(pts - centroid[:, None], axis=2).max(axis=1)
     out = (pts[:, 0] + pts[:, -1]) / 2 - centroid
     return np.where(
