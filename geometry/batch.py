@@ -222,18 +222,16 @@ def _chord_heading(pts: np.ndarray, centroid: np.ndarray | None = None) -> np.nd
 
 
 def shared_pose_frames(curves: Sequence[np.ndarray], *, chords: int = 3, flips: bool = True) -> list[list[Frame]]:
-    """`frame.pose_frames` for a set of curves that are mixed together (interpolated, augmented): candidates that
-    agree, across the set, on what does not blend — the mirror image and the point order — so that in-betweens are
-    mapped back through a continuous blend of the curves' frames (`frame.blend_frames`: centres, sizes and rotations
-    blend; mirror and order cannot).
+    """`frame.pose_frames` for a set of curves that are mixed together (interpolated, augmented): the same candidate
+    poses — one rotation, mirror image and point order each — for every curve of the set, so that the curves keep
+    their turns relative to each other and in-betweens come back in the plane they were drawn in; each curve's frame
+    still fits its own bounding box (centres and sizes blend).
 
     The curves are aligned one way first: a curve listed the other way round from the set's first curve (nearer it
     point for point reversed than as listed) is read reversed, so a curve and its reversal are read alike. The set
-    is mirrored when its aligned curves turn clockwise overall (their signed turnings summed). Then each curve's
-    candidates are pose_frames' own for that mirror: its own chord turned to each of the first `chords`
-    POSE_CHORDS (rotations blend, and a latent mix of two curves posed chord down keeps its chord down), as drawn
-    and, with `flips`, reversed and mirrored across the chord's normal. Per curve: [candidate 0, candidate 1, …];
-    candidate k is flipped for every curve or for none (k odd: flipped).
+    is mirrored when its aligned curves turn clockwise overall (their signed turnings summed), and its chord
+    direction is the mean of their unit chord directions; from there the candidates are pose_frames' own. Per curve:
+    [candidate 0, candidate 1, …]; candidate k is one pose for the whole set.
     """
     pts = [np.asarray(c, np.float64) for c in curves]
     if not pts:
@@ -249,11 +247,12 @@ def shared_pose_frames(curves: Sequence[np.ndarray], *, chords: int = 3, flips: 
     else:
         mirror = sum(float(turns_clockwise(c)) - 0.5 for c in aligned) > 0
     flip = np.array([-1.0, 1.0]) if mirror else np.ones(2)
-    out = []
-    for c, a, al in zip(pts, against, aligned):
-        poses = pose_candidates(chord_heading(al * flip), mirror, chords=chords, flips=flips)
-        out.append([posed_frame(c, turn, mirror=mir, reverse=rev != a) for turn, mir, rev in poses])
-    return out
+    headings = np.array([chord_heading(c * flip) for c in aligned])
+    heading = float(np.arctan2(np.sin(headings).sum(), np.cos(headings).sum()))
+    poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
+    return [
+        [posed_frame(c, turn, mirror=mir, reverse=rev != a) for turn, mir, rev in poses] for c, a in zip(pts, against)
+    ]
 
 
 #: A curve of a set is read reversed when, reversed, it lies within this share of its distance as listed from the

@@ -60,7 +60,7 @@ class Candidate(NamedTuple):
     frame: Frame | None
     spacing: str
     natural: np.ndarray | None  # the natural reading's parameters, with spacing "natural"
-    pose: int  # which of the curve's pose candidates (in a shared set: odd ones flipped, for every curve alike)
+    pose: int  # which of the curve's pose candidates (in a shared set, candidate k is one pose for every curve)
 
 
 class Reader:
@@ -114,7 +114,7 @@ class Reader:
 
     def _fresh(self, inputs: list[np.ndarray], index: list[int], reading: Reading, *, shared: bool) -> list[ReadCurve]:
         """Curves not in the cache: their candidates, encoded; with several per curve, decoded and the closest kept
-        (shared: each curve's closest in the pose whose candidates are closest over the whole set)."""
+        (shared: each curve's closest in the one pose whose candidates are closest over the whole set)."""
         stage = self._candidates(inputs, index, reading, shared=shared)
         models, fractions = self._model_points(inputs, index, stage)
         if not stage:
@@ -137,19 +137,17 @@ class Reader:
 
     @staticmethod
     def _in_shared_pose(inputs: list[np.ndarray], stage: list[Candidate], err: np.ndarray) -> np.ndarray:
-        """The candidates' errors with those of one side made infinite: the set is read as drawn or flipped as a
-        whole (mirror and order do not blend), whichever side's closest candidate per curve (a mean squared
-        distance, so that long curves do not outweigh short ones) sums less over the set; each curve then keeps its
-        closest candidate on that side (its own chord direction: rotations blend)."""
+        """The candidates' errors with every pose but the set's best made infinite: the best pose is the one whose
+        closest candidate per curve (a mean squared distance, so that long curves do not outweigh short ones) sums
+        least over the set; each curve then keeps its closest candidate in that pose (its spacing)."""
         owner = np.array([c.curve for c in stage])
-        flipped = np.array([c.pose % 2 for c in stage])  # shared_pose_frames: odd candidates are the flipped ones
+        pose = np.array([c.pose for c in stage])
         per_point = err / np.array([len(inputs[o]) for o in owner])
         totals = {}
-        for f in np.unique(flipped):
-            best = [per_point[(flipped == f) & (owner == i)].min() for i in range(len(inputs))]
-            totals[int(f)] = float(np.sum(best))
+        for p in np.unique(pose):
+            totals[int(p)] = float(sum(per_point[(pose == p) & (owner == i)].min() for i in range(len(inputs))))
         chosen = min(totals, key=totals.__getitem__)
-        return np.where(flipped == chosen, err, np.inf)
+        return np.where(pose == chosen, err, np.inf)
 
     def _candidates(
         self, inputs: list[np.ndarray], index: list[int], reading: Reading, *, shared: bool = False

@@ -248,8 +248,8 @@ def test_pair_ends_are_the_reconstructions(runtime, curves):
     rec = runtime.reconstruct([a, b], together=True).curves
     np.testing.assert_allclose(out[0], rec[0], atol=1e-9)
     np.testing.assert_allclose(out[-1], rec[1], atol=1e-9)
-    fa, fb = runtime.encode([a, b], together=True).frames  # one mirror and order for the set; boxes, turns their own
-    assert (fa.mirror, fa.reverse) == (fb.mirror, fb.reverse)
+    fa, fb = runtime.encode([a, b], together=True).frames  # the set's one pose, each curve's own box
+    assert (fa.rotation, fa.mirror, fa.reverse) == (fb.rotation, fb.mirror, fb.reverse)
     assert frames[0] == fa and frames[-1] == fb
     assert frames[1] == blend_frames([fa, fb], np.array([[0.5, 0.5]]))[0]
 

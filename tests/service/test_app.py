@@ -130,10 +130,10 @@ def test_a_curve_interpolated_with_itself_is_its_reconstruction(client, curves):
         np.testing.assert_allclose(curve, rec["curves"][0], rtol=0, atol=1e-9 * 500)
 
 
-def test_a_pair_shares_its_mirror_image_and_order(client, curves):
+def test_a_pair_is_read_in_one_pose(client, curves):
     c = [(curves(1, 161)[0] * 0.1).tolist(), (curves(1, 161, seed=9)[0] + 500).tolist()]
     frames = client.post("/interpolate", json={"curves": c, "steps": 3}).json()["frames"]
-    assert len({(f["mirror"], f["reverse"]) for f in frames}) == 1  # what does not blend is shared
+    assert len({(f["rotation"], f["mirror"], f["reverse"]) for f in frames}) == 1  # one pose; centres, sizes blend
 
 
 def test_health_ready_model(client, model_dir):
