@@ -106,3 +106,19 @@ def test_sample_augment_and_fit_write_any_output_that_reads_back(suffix, tmp_pat
         fits = tmp_path / f"fits{suffix}"
         assert main(["fit", str(FILES / "inkscape_drawing.svg"), "-o", str(fits)]) == 0
         assert len(read_curves(fits)) == 3
+
+
+def test_real_uiuc_files_with_notes_reconstruct_and_fit_a_prior(tmp_path, capsys):
+    """hn1051.dat and hn354sm.dat as the UIUC database has them (tests/fixtures/files/README.md): coordinates, then
+    a block of notes; each reads as one curve, the notes skipped with a warning naming the file and line."""
+    real = FILES / "uiuc"
+    for name in ("hn1051.dat", "hn354sm.dat"):
+        out = tmp_path / f"{name}.json"
+        assert main(["reconstruct", str(real / name), "-o", str(out)]) == 0
+        body = json.loads(out.read_text())
+        assert len(body["curves"]) == 1 and len(body["curves"][0]) > 50
+        err = capsys.readouterr().err
+        assert f"{name}:" in err and "Profilbeiwerte" in err
+    prior = tmp_path / "uiuc.npz"
+    assert main(["prior", "--curves", str(real), "-o", str(prior), "--refine", "0"]) == 0
+    assert prior.stat().st_size > 0
