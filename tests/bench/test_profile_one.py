@@ -1,0 +1,35 @@
+"""bench.profile_one's smoke run: a few single-curve one-pass requests profiled, every stage found, so the script
+that BENCHMARKS' profile table comes from does not rot. The numbers mean nothing here (the suite shares the CPU)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.skipif(not (ROOT / "models" / "manifest.json").is_file(), reason="no shipped model")
+def test_the_profile_names_each_stage_and_they_add_up():
+    from bench.profile_one import STAGES, measure
+
+    shares = measure(ROOT / "models", requests=5)
+    assert set(STAGES) <= set(shares) and shares["wall_ms_per_request"] > 0
+    for stage in STAGES:  # every stage's functions ran: a renamed function would show as 0
+        assert 0 < shares[stage] < 1, stage
+    assert sum(v for k, v in shares.items() if k != "wall_ms_per_request") == pytest.approx(1.0)
+
+
+def test_the_markdown_table_prints():
+    done = subprocess.run(
+        [sys.executable, "-m", "bench.profile_one", "--requests", "3", "--markdown"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "| placement on the spline |" in done.stdout and "wall time per request" in done.stdout
