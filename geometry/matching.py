@@ -44,24 +44,8 @@ def ordered_closest_params(
     count = len(points)
     if count == 0:
         return [], np.zeros(0)
-    samples = sample_bspline(ctrl, dense, degree)  # (B, m, 2)
-    grid = np.linspace(0.0, 1.0, dense)
     lengths = np.array([len(p) for p in points])
-    params: list[np.ndarray] = [np.empty(0)] * count
-    # curves of similar length together, so that padding (the last point repeated) costs little
-    order = np.argsort(lengths, kind="stable")
-    start = 0
-    while start < count:
-        stop = start + 1
-        while stop < count and (stop - start + 1) * lengths[order[stop]] * dense <= CHUNK_ELEMENTS:
-            stop += 1
-        idx = order[start:stop]
-        longest = int(lengths[idx].max())
-        padded = np.stack([_padded(np.asarray(points[i], np.float64), longest) for i in idx])
-        sample_idx = _ordered_nearest(padded, samples[idx].astype(np.float32), lengths[idx])
-        for row, i in enumerate(idx):
-            params[i] = grid[sample_idx[row, : lengths[i]]]
-        start = stop
+    params = _sample_matches(ctrl, points, lengths, degree=degree, dense=dense)
     flat_u = np.concatenate(params)
     owner = np.repeat(np.arange(count), lengths)
     flat_p = np.concatenate([np.asarray(p, np.float64) for p in points])
@@ -95,6 +79,31 @@ def ordered_closest_params(
     out = np.split(ordered, ends[1:-1])
     distance = np.bincount(owner, weights=(r**2).sum(-1), minlength=count)
     return out, distance
+
+
+def _sample_matches(
+    ctrl: np.ndarray, points: Sequence[np.ndarray], lengths: np.ndarray, *, degree: int, dense: int
+) -> list[np.ndarray]:
+    """Each curve's points matched to `dense` even samples of its spline (`_ordered_nearest`): their parameters,
+    curves of similar length run together in chunks of at most CHUNK_ELEMENTS (padding repeats the last point)."""
+    count = len(points)
+    samples = sample_bspline(ctrl, dense, degree)  # (B, m, 2)
+    grid = np.linspace(0.0, 1.0, dense)
+    params: list[np.ndarray] = [np.empty(0)] * count
+    order = np.argsort(lengths, kind="stable")
+    start = 0
+    while start < count:
+        stop = start + 1
+        while stop < count and (stop - start + 1) * lengths[order[stop]] * dense <= CHUNK_ELEMENTS:
+            stop += 1
+        idx = order[start:stop]
+        longest = int(lengths[idx].max())
+        padded = np.stack([_padded(np.asarray(points[i], np.float64), longest) for i in idx])
+        sample_idx = _ordered_nearest(padded, samples[idx].astype(np.float32), lengths[idx])
+        for row, i in enumerate(idx):
+            params[i] = grid[sample_idx[row, : lengths[i]]]
+        start = stop
+    return params
 
 
 def _padded(points: np.ndarray, length: int) -> np.ndarray:
