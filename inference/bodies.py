@@ -6,15 +6,15 @@ for the same request, because both build their bodies here from the runtime's ar
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
-from curve_vae.geometry import Frame, fit_bspline, fit_bspline_auto
+from curve_vae.geometry import Frame, curve_length, fit_bspline, fit_bspline_auto, self_intersects, smoothness
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.results import Augmented, Sampled, Spline
-from curve_vae.inference.runtime import curve_metrics
 
 
 def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
@@ -130,3 +130,20 @@ def mesh_file(mesh: Any, *, points: int, segments: int, axis: str, fmt: str) -> 
             return mesh.to_stl()
     comment = f"curve-vae surface of revolution: {points}-point profile, {segments} segments about the {axis} axis"
     return mesh.to_obj(comment=comment).encode()
+
+
+def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:
+    """Per curve, as the API reports it: smoothness (paper §3.4, degrees), self-intersection, length."""
+    out = []
+    for c in curves:
+        with np.errstate(all="ignore"):
+            smooth = {name: _number(v) for name, v in smoothness(c).items()}
+            length = _number(curve_length(c))
+        out.append({"smoothness": smooth, "self_intersects": bool(self_intersects(c)), "length": length})
+    return out
+
+
+def _number(value: Any) -> float | None:
+    """A JSON number, or null where float64 overflowed (curves near the float limit)."""
+    v = float(value)
+    return v if math.isfinite(v) else None

@@ -7,8 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from curve_vae.geometry import Frame, polyline_to_caller, spline_to_caller
-from curve_vae.geometry.adapt import F32_MAX, joined_ends
+from curve_vae.geometry import Frame, mse_per_curve, polyline_to_caller, spline_to_caller
+from curve_vae.geometry.adapt import F32_MAX, is_closed, joined_ends
 from curve_vae.geometry.batch import FrameRows, Ragged
 from curve_vae.geometry.bspline import spline_values
 from curve_vae.inference.errors import InputError
@@ -90,6 +90,30 @@ def placed_to_caller(g: ModelGraphs, prep: Prepared) -> tuple[list[np.ndarray], 
     return curves.split(back), splines, mse
 
 
+def each_to_caller(
+    g: ModelGraphs, prep: Prepared, *, n_points: int | None, spacing: str
+) -> tuple[list[np.ndarray], list[Spline | None], np.ndarray]:
+    """`placed_to_caller` curve by curve, for any batch: each reconstruction at its caller's points (or `n_points`
+    spaced as `spacing` says), its spline and its MSE at the caller's own points; a closed input comes back closed."""
+    results, splines, mse = [], [], np.empty(len(prep.rows))
+    for i, (pts, row) in enumerate(zip(prep.inputs, prep.rows)):
+        assert row.decoded is not None
+        o, c, u = row.decoded, row.ctrl, row.params
+        if is_closed(pts):  # a loop comes back a loop
+            o, c = joined(o, c)
+        # placed: the spline's points closest to the input's, at their parameters (not the head's)
+        at, head = (row.fraction, u) if row.feet is None else (row.feet, None)
+        own, spline = to_caller(g, o, row.frame, n_points=None, fractions=at, ctrl=c, params=head)
+        mse[i] = mse_per_curve(pts[None], own[None])[0]
+        if n_points is not None:
+            own, spline = to_caller(g, o, row.frame, n_points=n_points, spacing=spacing, ctrl=c, params=u)
+        if not (np.isfinite(own).all() and np.isfinite(mse[i])):
+            raise InputError(("curves", i), "the reconstruction does not fit in float64: scale the curve down")
+        results.append(own)
+        splines.append(spline)
+    return results, splines, mse
+
+
 def decoded_to_caller(
     g: ModelGraphs,
     out: np.ndarray,
@@ -139,3 +163,10 @@ def check_range(a: np.ndarray, field: str) -> None:
     bad = ~(np.abs(a) <= F32_MAX).reshape(len(a), -1).all(axis=1)
     if bad.any():
         raise InputError((field, int(np.argmax(bad))), "values beyond float32 range")
+
+
+def closed_rows(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """Decoded rows (and control points) each with its ends joined (placing.joined)."""
+    rows = [joined(o, None if ctrl is None else ctrl[i]) for i, o in enumerate(out)]
+    closed_out = np.stack([o for o, _ in rows]).astype(np.float32)
+    return closed_out, None if ctrl is None else np.stack([c for _, c in rows]).astype(np.float32)

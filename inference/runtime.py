@@ -19,14 +19,12 @@ the encoding cache (`inference.cache`). Nothing here imports torch.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from curve_vae.geometry import Frame, blend_frames, curve_length, mse_per_curve, self_intersects, smoothness
+from curve_vae.geometry import Frame, blend_frames
 from curve_vae.geometry.adapt import is_closed
 from curve_vae.inference.augmenting import AugmentPlan, neighbour_pools
 from curve_vae.inference.cache import DEFAULT_CACHE_BYTES, EncodingCache
@@ -38,7 +36,9 @@ from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.placing import (
     check_finite,
     check_range,
+    closed_rows,
     decoded_to_caller,
+    each_to_caller,
     joined,
     placed_to_caller,
     to_caller,
@@ -217,30 +217,12 @@ class CurveRuntime:
         """
         r = self.reading(reading)
         prep = self.reader.read(curves, r, shared=together)
-        g = self.graphs
-        if n_points is None:
-            with np.errstate(all="ignore"):
-                placed = placed_to_caller(g, prep)  # every curve at once, where the batch allows it
-            if placed is not None:
-                return Reconstruction(placed[0], placed[2], prep.mean, prep.frames, placed[1])  # type: ignore[arg-type]
-        results, splines, mse = [], [], np.empty(len(prep.rows))
         with np.errstate(all="ignore"):
-            for i, (pts, row) in enumerate(zip(prep.inputs, prep.rows)):
-                assert row.decoded is not None
-                o, c, u = row.decoded, row.ctrl, row.params
-                if is_closed(pts):  # a loop comes back a loop
-                    o, c = joined(o, c)
-                # placed: the spline's points closest to the input's, at their parameters (not the head's)
-                at, head = (row.fraction, u) if row.feet is None else (row.feet, None)
-                own, spline = to_caller(g, o, row.frame, n_points=None, fractions=at, ctrl=c, params=head)
-                mse[i] = mse_per_curve(pts[None], own[None])[0]
-                if n_points is not None:
-                    own, spline = to_caller(g, o, row.frame, n_points=n_points, spacing=r.spacing, ctrl=c, params=u)
-                if not (np.isfinite(own).all() and np.isfinite(mse[i])):
-                    raise InputError(("curves", i), "the reconstruction does not fit in float64: scale the curve down")
-                results.append(own)
-                splines.append(spline)
-        return Reconstruction(results, mse, prep.mean, prep.frames, splines if g.has_splines else None)  # type: ignore[arg-type]
+            placed = placed_to_caller(self.graphs, prep) if n_points is None else None  # every curve at once
+            if placed is None:  # curve by curve: n_points asked, no frames, or a head without closest placement
+                placed = each_to_caller(self.graphs, prep, n_points=n_points, spacing=r.spacing)
+        curves_out, splines, mse = placed
+        return Reconstruction(curves_out, mse, prep.mean, prep.frames, splines if self.has_splines else None)  # type: ignore[arg-type]
 
     def interpolate(
         self,
@@ -339,7 +321,7 @@ class CurveRuntime:
             if frames is None and named.reference.frames.size:
                 frames = [named.reference.frame(int(i)) for i in named.nearest(drawn.latents)]
             if named.closed:  # loops stay loops
-                out, ctrl = _closed_rows(out, ctrl)
+                out, ctrl = closed_rows(out, ctrl)
         placed = decoded_to_caller(
             self.graphs, out, ctrl, drawn.params, frames=frames, n_points=n_points, spacing=spacing
         )
@@ -398,30 +380,6 @@ class CurveRuntime:
             yield self.augment(plan, i, min(i + step, stop), n_points=n_points, spacing=spacing).curves
 
 
-def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:
-    """Per curve, as the API reports it: smoothness (paper §3.4, degrees), self-intersection, length."""
-    out = []
-    for c in curves:
-        with np.errstate(all="ignore"):
-            smooth = {name: _number(v) for name, v in smoothness(c).items()}
-            length = _number(curve_length(c))
-        out.append({"smoothness": smooth, "self_intersects": bool(self_intersects(c)), "length": length})
-    return out
-
-
-def _closed_rows(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
-    """Decoded rows (and control points) each with its ends joined (placing.joined)."""
-    rows = [joined(o, None if ctrl is None else ctrl[i]) for i, o in enumerate(out)]
-    closed_out = np.stack([o for o, _ in rows]).astype(np.float32)
-    return closed_out, None if ctrl is None else np.stack([c for _, c in rows]).astype(np.float32)
-
-
 def _common_length(prep: Prepared) -> int | None:
     lengths = {len(c) for c in prep.inputs}
     return lengths.pop() if len(lengths) == 1 else None
-
-
-def _number(value: Any) -> float | None:
-    """A JSON number, or null where float64 overflowed (curves near the float limit)."""
-    v = float(value)
-    return v if math.isfinite(v) else None

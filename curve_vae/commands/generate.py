@@ -171,7 +171,7 @@ def _frames(parts: list, frames_json: Any) -> Any:
 
 
 def _metrics(made: Any) -> list:
-    from curve_vae.inference.runtime import curve_metrics
+    from curve_vae.inference.bodies import curve_metrics
 
     return curve_metrics(made.curves)
 

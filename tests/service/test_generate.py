@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from curve_vae.geometry import Frame, curve_length, self_intersects, smoothness
-from curve_vae.inference.runtime import curve_metrics
+from curve_vae.inference.bodies import curve_metrics
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 
