@@ -81,14 +81,7 @@ class Sampler:
         sequence at item offset, so pages of it are the curves of one larger request.
         """
         g = self.graphs
-        chosen = prior or ("learned" if self.prior is not None else "standard")
-        if chosen == "learned" and self.prior is None:
-            raise InputError(
-                ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
-            )
-        if chosen not in self.names:
-            known = ", ".join(self.names)
-            raise InputError(("prior",), f"no prior named {chosen!r} on this server; it has: {known} (GET /model)")
+        chosen = self._chosen(prior)
         rngs = [np.random.default_rng([seed, i]) for i in range(offset, offset + count)]
         named = self.named.get(chosen)
         learned = named.mixture if named is not None else self.prior
@@ -123,6 +116,18 @@ class Sampler:
                 draws[i] += 1
         invalid = int((~ok).sum()) if valid else 0
         return Drawn(z, out, ctrl, params, chosen, rejected=int(draws.sum() - count), invalid=invalid)
+
+    def _chosen(self, prior: str | None) -> str:
+        """The prior a request names (None: the learned one where the model ships it, else the standard), checked."""
+        chosen = prior or ("learned" if self.prior is not None else "standard")
+        if chosen == "learned" and self.prior is None:
+            raise InputError(
+                ("prior",), 'this model ships no learned prior (GET /model: prior is null); use "standard"'
+            )
+        if chosen not in self.names:
+            known = ", ".join(self.names)
+            raise InputError(("prior",), f"no prior named {chosen!r} on this server; it has: {known} (GET /model)")
+        return chosen
 
     def _as_returned(self, decoded: np.ndarray, ctrl: np.ndarray | None, *, closed: bool) -> np.ndarray:
         """(B, n, 2) float64: the decoded curves as `CurveRuntime.sample` returns them, in the model plane: a closed

@@ -87,6 +87,14 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
         suite_refine=a.suite_refine,
         morph_count=a.morph_count,
     )
+    _print_test_sets(report)
+    _print_measures(report)
+    print(f"report: {Path(a.out) / 'report.json'}")
+    return 0
+
+
+def _print_test_sets(report: dict) -> None:
+    """Each test set's eq. 4 MSE, smoothness and interpolants, a line or two each."""
     for name, r in report["test_sets"].items():
         s_in, s_out = r["smoothness_input"]["roughness"], r["smoothness_output"]["roughness"]
         print(
@@ -101,6 +109,10 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
             f"self-intersecting {lat['self_intersecting']:.1%}; point-wise blends {pw['roughness']:.3f}°, "
             f"{pw['self_intersecting']:.1%}"
         )
+
+
+def _print_measures(report: dict) -> None:
+    """The morph suite, the priors' samples and the family suite, where the report has them."""
     if "morphs" in report:
         from curve_vae.training.morphs import format_morphs
 
@@ -123,8 +135,6 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
         if "families_refined" in report:
             print(f"the same, refined (request option refine: {report['families_refined']['refine']}):")
             print(format_suite(report["families_refined"]["sets"]))
-    print(f"report: {Path(a.out) / 'report.json'}")
-    return 0
 
 
 def cmd_triton(a: argparse.Namespace) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 import warnings
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
@@ -56,3 +57,17 @@ def as_curves(data: Any, name: str) -> list[np.ndarray]:
     if not curves:
         raise CurveFileError(f"{name}: no curve in this file")
     return curves
+
+
+def drawn_curves(found: Iterable[tuple[str, np.ndarray]], name: str, *, kinds: str) -> list[np.ndarray]:
+    """The curves of a drawing (SVG, DXF) from its (label, points) entities: one of fewer than MIN_POINTS points is
+    skipped with a warning naming it; a drawing with none left is a CurveFileError saying which `kinds` count."""
+    curves = []
+    for label, pts in found:
+        if len(pts) < MIN_POINTS:
+            warn(f"{name}: {label}: {len(pts)} points, not a curve; skipped")
+            continue
+        curves.append(pts)
+    if not curves:
+        raise CurveFileError(f"{name}: no curve in this drawing (no {kinds})")
+    return as_curves(curves, name)

@@ -12,7 +12,7 @@ import numpy as np
 from ezdxf import path as dxfpath
 from ezdxf.disassemble import recursive_decompose
 
-from curve_vae.curvefiles.common import MIN_POINTS, CurveFileError, as_curves, warn
+from curve_vae.curvefiles.common import CurveFileError, drawn_curves
 
 KINDS = ("LWPOLYLINE", "POLYLINE", "SPLINE")
 #: Points along a SPLINE per control point (at least 64 in all).
@@ -25,19 +25,12 @@ def read_dxf(path: str | Path, name: str) -> list[np.ndarray]:
         doc = ezdxf.readfile(str(path))
     except (OSError, ezdxf.DXFError) as err:
         raise CurveFileError(f"{name}: not a DXF drawing ({err})") from None
-    curves: list[np.ndarray] = []
-    for e in recursive_decompose(doc.modelspace()):  # blocks' entities where they are inserted, transformed
-        if e.dxftype() not in KINDS:
-            continue
-        pts = _points(e)
-        label = f"{e.dxftype()} #{e.dxf.handle}" if e.dxf.handle else f"{e.dxftype()} of a block"
-        if len(pts) < MIN_POINTS:
-            warn(f"{name}: {label}: {len(pts)} points, not a curve; skipped")
-            continue
-        curves.append(pts)
-    if not curves:
-        raise CurveFileError(f"{name}: no curve in this drawing (no LWPOLYLINE, POLYLINE or SPLINE of 4 points)")
-    return as_curves(curves, name)
+    found = (
+        (f"{e.dxftype()} #{e.dxf.handle}" if e.dxf.handle else f"{e.dxftype()} of a block", _points(e))
+        for e in recursive_decompose(doc.modelspace())  # blocks' entities where they are inserted, transformed
+        if e.dxftype() in KINDS
+    )
+    return drawn_curves(found, name, kinds="LWPOLYLINE, POLYLINE or SPLINE of 4 points")
 
 
 def _points(e: Any) -> np.ndarray:

@@ -10,7 +10,7 @@ from pathlib import Path as FilePath
 import numpy as np
 import svgelements as se
 
-from curve_vae.curvefiles.common import MIN_POINTS, CurveFileError, as_curves, warn
+from curve_vae.curvefiles.common import CurveFileError, drawn_curves
 
 #: Points per curved segment (cubic, quadratic, arc) of a drawing's path.
 SAMPLES_PER_SEGMENT = 16
@@ -23,20 +23,18 @@ def read_svg(path: str | FilePath, name: str) -> list[np.ndarray]:
     except Exception as e:  # svgelements raises ElementTree's ParseError and others for broken XML
         raise CurveFileError(f"{name}: not an SVG drawing ({e})") from None
     undo = ~se.Matrix(svg.viewbox_transform) if isinstance(svg, se.SVG) and svg.viewbox_transform else se.Matrix()
-    curves: list[np.ndarray] = []
-    for element in svg.elements() if isinstance(svg, se.SVG) else []:
-        if not isinstance(element, se.Path | se.Polyline | se.Polygon):
-            continue
-        label = f"{element.values.get('tag', 'path')}#{element.id}" if element.id else element.values.get("tag", "path")
-        for pts in _subpaths(se.Path(element) if not isinstance(element, se.Path) else element):
-            pts = _apply(undo, pts) * [1, -1]
-            if len(pts) < MIN_POINTS:
-                warn(f"{name}: {label}: {len(pts)} points, not a curve; skipped")
-                continue
-            curves.append(pts)
-    if not curves:
-        raise CurveFileError(f"{name}: no curve in this drawing (no path, polyline or polygon of 4 points or more)")
-    return as_curves(curves, name)
+    found = (
+        (_label(element), _apply(undo, pts) * [1, -1])
+        for element in (svg.elements() if isinstance(svg, se.SVG) else [])
+        if isinstance(element, se.Path | se.Polyline | se.Polygon)
+        for pts in _subpaths(se.Path(element) if not isinstance(element, se.Path) else element)
+    )
+    return drawn_curves(found, name, kinds="path, polyline or polygon of 4 points or more")
+
+
+def _label(element: se.Shape) -> str:
+    tag = element.values.get("tag", "path")
+    return f"{tag}#{element.id}" if element.id else tag
 
 
 def _apply(m: se.Matrix, pts: np.ndarray) -> np.ndarray:

@@ -1,5 +1,5 @@
 """Sweeps between curves read as one set (inference.reader's shared pose): the README's pair turns as its curves
-do, a curve and its reversal mix into the curve, and a set moved moves its sweep."""
+do, and a set moved moves its sweep (a curve mixed with its reversal: tests/inference/test_pose.py)."""
 
 from __future__ import annotations
 
@@ -28,11 +28,3 @@ def test_a_sweep_moves_with_its_pair(shipped_runtime):
     sweep = np.stack(shipped_runtime.interpolate(README_PAIR, STEPS).curves)
     swept = np.stack(shipped_runtime.interpolate(moved, STEPS).curves)
     np.testing.assert_allclose(swept, sweep @ turn * 30 + [500, -20], atol=1e-6 * 30 * 8)
-
-
-def test_interpolating_a_curve_with_its_reversal_gives_the_curve(shipped_runtime):
-    c = README_PAIR[1]
-    (own,) = shipped_runtime.reconstruct([c]).curves
-    mix = shipped_runtime.interpolate([c, c[::-1]], np.array([[1.0, 0.0], [0.7, 0.3], [0.5, 0.5], [0.2, 0.8]]))
-    for curve, weights in zip(mix.curves, mix.weights):  # listed as the heavier source lists its points
-        np.testing.assert_allclose(curve if weights[0] >= 0.5 else curve[::-1], own, atol=1e-6 * np.ptp(c))
