@@ -16,9 +16,46 @@ from curve_vae.commands.options import (
 from curve_vae.files import refuse_overwrite
 from curve_vae.progress import shown
 
+#: Each TrainConfig field's help text (its default is added from the config).
+TRAIN_HELP = {
+    "epochs": "epochs (passes over the training curves)",
+    "batch_size": "global batch size, split across DDP processes",
+    "lr": "Adam learning rate; the peak rate of the onecycle schedule",
+    "schedule": "learning-rate schedule: {schedules}",
+    "warmup": "onecycle: fraction of the steps spent warming up",
+    "beta": "weight of the KL term",
+    "lap_weight": "weight of the Laplacian smoothness term (0: off)",
+    "grad_clip": "clip the gradient norm to this (0: off)",
+    "patience": "early stopping: epochs without a better validation MSE (0: off)",
+    "bf16": "bf16 autocast (fast only with AMX/AVX512-BF16 CPUs or GPUs)",
+    "compile": "torch.compile the model",
+    "seed": "seed of initialisation, batch order and sampling noise",
+    "threads": "torch CPU threads (0: torch's default)",
+    "device": "auto | cpu | cuda",
+    "train_limit": "use only the first N training curves (0: all)",
+    "time_budget": "seconds of training; the schedule follows elapsed training time and the run "
+    "stops when it is spent, whatever the throughput (0: off; --epochs stays an upper bound)",
+    "snapshots": "keep the weights of the latest N epochs as RUN_DIR/epoch-NNNN.pt, to average them "
+    "afterwards with curve-vae average (0: off)",
+    "only_params": "with --spline-params: train only where the points sit along the curves (the head's "
+    "parameter channel); every other weight and BatchNorm statistic stays the starting model's",
+    "match": "what the reconstruction error measures: index (eq. 4, point i to point i); closest (each "
+    "point to its closest point on the decoded spline and back, whatever the points' spacing; needs the "
+    "B-spline head; validation and model selection measure it too); twin (eq. 4 against the curve drawn "
+    "evenly in its own parameter); mixed (index for curves drawn at their own spacing, closest for the rest)",
+    "only_encoder": "train only the encoder: the decoder's weights and every BatchNorm statistic stay the "
+    "starting model's, so every latent decodes as before and only which latent a curve gets changes",
+}
+
 
 def add_train_options(p: argparse.ArgumentParser) -> None:
-    from curve_vae.training.config import SCHEDULES, VARIANTS, TrainConfig
+    _add_model_options(p)
+    _add_training_options(p)
+
+
+def _add_model_options(p: argparse.ArgumentParser) -> None:
+    """The network's options (paper §3.5): variant, latent size, the B-spline head."""
+    from curve_vae.training.config import VARIANTS
 
     g = p.add_argument_group("model (paper §3.5)")
     g.add_argument(
@@ -44,49 +81,22 @@ def add_train_options(p: argparse.ArgumentParser) -> None:
         "a model without them continues with the even parameters it had) (default: the --init-from or resumed "
         "checkpoint's, else off)",
     )
+
+
+def _add_training_options(p: argparse.ArgumentParser) -> None:
+    """One flag per TrainConfig field, its default the config's."""
+    from curve_vae.training.config import SCHEDULES, TrainConfig
+
     d = TrainConfig()
     g = p.add_argument_group("training")
-    helps = {
-        "epochs": "epochs (passes over the training curves)",
-        "batch_size": "global batch size, split across DDP processes",
-        "lr": "Adam learning rate; the peak rate of the onecycle schedule",
-        "schedule": f"learning-rate schedule: {' | '.join(SCHEDULES)}",
-        "warmup": "onecycle: fraction of the steps spent warming up",
-        "beta": "weight of the KL term",
-        "lap_weight": "weight of the Laplacian smoothness term (0: off)",
-        "grad_clip": "clip the gradient norm to this (0: off)",
-        "patience": "early stopping: epochs without a better validation MSE (0: off)",
-        "bf16": "bf16 autocast (fast only with AMX/AVX512-BF16 CPUs or GPUs)",
-        "compile": "torch.compile the model",
-        "seed": "seed of initialisation, batch order and sampling noise",
-        "threads": "torch CPU threads (0: torch's default)",
-        "device": "auto | cpu | cuda",
-        "train_limit": "use only the first N training curves (0: all)",
-        "time_budget": "seconds of training; the schedule follows elapsed training time and the run "
-        "stops when it is spent, whatever the throughput (0: off; --epochs stays an upper bound)",
-        "snapshots": "keep the weights of the latest N epochs as RUN_DIR/epoch-NNNN.pt, to average them "
-        "afterwards with curve-vae average (0: off)",
-        "only_params": "with --spline-params: train only where the points sit along the curves (the head's "
-        "parameter channel); every other weight and BatchNorm statistic stays the starting model's",
-        "match": "what the reconstruction error measures: index (eq. 4, point i to point i); closest (each "
-        "point to its closest point on the decoded spline and back, whatever the points' spacing; needs the "
-        "B-spline head; validation and model selection measure it too); twin (eq. 4 against the curve drawn "
-        "evenly in its own parameter); mixed (index for curves drawn at their own spacing, closest for the rest)",
-        "only_encoder": "train only the encoder: the decoder's weights and every BatchNorm statistic stay the "
-        "starting model's, so every latent decodes as before and only which latent a curve gets changes",
-    }
     for f in fields(TrainConfig):
         flag = "--" + f.name.replace("_", "-")
         default = getattr(d, f.name)
+        help_ = TRAIN_HELP[f.name].format(schedules=" | ".join(SCHEDULES)) + f" (default: {default})"
         if isinstance(default, bool):
-            g.add_argument(
-                flag,
-                action=argparse.BooleanOptionalAction,
-                default=default,
-                help=f"{helps[f.name]} (default: {default})",
-            )
+            g.add_argument(flag, action=argparse.BooleanOptionalAction, default=default, help=help_)
         else:
-            g.add_argument(flag, type=type(default), default=default, help=f"{helps[f.name]} (default: {default})")
+            g.add_argument(flag, type=type(default), default=default, help=help_)
 
 
 def cmd_train(a: argparse.Namespace) -> int:
