@@ -112,12 +112,7 @@ class Fitter:
         # the spline's length as of the target's); the closest points searched near the closer guess, or a guess
         # itself where closer still (pooling points into order can cost more than it gains), so that the fit is
         # never further than the plain reconstruction
-        feet, cost = [], np.empty(count)
-        for i, (c, t, a) in enumerate(zip(decoded[1], targets, around)):
-            guesses = [(self._cost(c, t, g), g) for g in (np.asarray(a, np.float64), *_along(c, t))]
-            closest = self._feet(c, t, min(guesses, key=lambda guess: guess[0])[1])
-            cost[i], u = min([(self._cost(c, t, closest), closest), *guesses], key=lambda start: start[0])
-            feet.append(u)
+        feet, cost = self._start(decoded[1], targets, around)
         damping = np.full(count, 1e-2)
         jac = np.zeros(0)
         for step in range(steps if count else 0):
@@ -125,28 +120,10 @@ class Fitter:
                 shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
                 moved = self.graphs.decode(shifted)[1].astype(np.float64)
                 jac = (moved.reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
-            trial = z.copy()
-            for i in range(count):
-                basis = self._basis(feet[i])
-                residual = (targets[i] - basis @ decoded[1][i]).reshape(-1)
-                j = np.einsum("nk,lkd->ndl", basis, jac[i]).reshape(-1, dim)
-                a = j.T @ j
-                a += damping[i] * np.diag(np.diag(a)) + 1e-9 * (np.trace(a) / dim + 1e-12) * np.eye(dim)
-                try:
-                    trial[i] = z[i] + np.linalg.solve(a, j.T @ residual)
-                except np.linalg.LinAlgError:  # a Jacobian of non-finite numbers: this curve stays where it is
-                    trial[i] = z[i]
+            trial = self._step(z, decoded[1], jac, targets, feet, damping)
             with np.errstate(all="ignore"):
                 tried = _float64(self.graphs.decode(trial))
-            tried_feet, tried_cost = [], np.full(count, np.inf)
-            for i in range(count):
-                c = tried[1][i]
-                if np.isfinite(c).all():
-                    u = self._feet(c, targets[i], feet[i])
-                    tried_cost[i] = self._cost(c, targets[i], u)
-                    tried_feet.append(u)
-                else:
-                    tried_feet.append(feet[i])
+            tried_feet, tried_cost = self._placed(tried[1], targets, feet)
             # Broyden's update of each curve's Jacobian by the step just tried (accepted or not)
             dz, dc = trial - z, tried[1] - decoded[1]
             norm = (dz**2).sum(1)
@@ -159,6 +136,59 @@ class Fitter:
             feet = [tf if b else f for b, tf, f in zip(better, tried_feet, feet)]
             damping = np.where(better, damping / 3, damping * 4)
         return z, decoded, feet  # type: ignore[return-value]
+
+    def _start(
+        self, ctrl: np.ndarray, targets: Sequence[np.ndarray], around: Sequence[np.ndarray]
+    ) -> tuple[list[np.ndarray], np.ndarray]:
+        """Where each target's points start on its spline, and the squared distance there: the closest points
+        searched near the closer of two guesses (the positions given, and the same fractions of the spline's
+        length as of the target's), or a guess itself where closer still."""
+        feet, cost = [], np.empty(len(ctrl))
+        for i, (c, t, a) in enumerate(zip(ctrl, targets, around)):
+            guesses = [(self._cost(c, t, g), g) for g in (np.asarray(a, np.float64), *_along(c, t))]
+            closest = self._feet(c, t, min(guesses, key=lambda guess: guess[0])[1])
+            cost[i], u = min([(self._cost(c, t, closest), closest), *guesses], key=lambda start: start[0])
+            feet.append(u)
+        return feet, cost
+
+    def _step(
+        self,
+        z: np.ndarray,
+        ctrl: np.ndarray,
+        jac: np.ndarray,
+        targets: Sequence[np.ndarray],
+        feet: Sequence[np.ndarray],
+        damping: np.ndarray,
+    ) -> np.ndarray:
+        """Each latent's damped Gauss–Newton step (Levenberg–Marquardt) on its points' distances at `feet`."""
+        dim = z.shape[1]
+        trial = z.copy()
+        for i in range(len(z)):
+            basis = self._basis(feet[i])
+            residual = (targets[i] - basis @ ctrl[i]).reshape(-1)
+            j = np.einsum("nk,lkd->ndl", basis, jac[i]).reshape(-1, dim)
+            a = j.T @ j
+            a += damping[i] * np.diag(np.diag(a)) + 1e-9 * (np.trace(a) / dim + 1e-12) * np.eye(dim)
+            try:
+                trial[i] = z[i] + np.linalg.solve(a, j.T @ residual)
+            except np.linalg.LinAlgError:  # a Jacobian of non-finite numbers: this curve stays where it is
+                trial[i] = z[i]
+        return trial
+
+    def _placed(
+        self, ctrl: np.ndarray, targets: Sequence[np.ndarray], feet: Sequence[np.ndarray]
+    ) -> tuple[list[np.ndarray], np.ndarray]:
+        """The tried splines' feet (searched near the current ones) and squared distances; inf where a spline is
+        not finite (its feet stay)."""
+        tried_feet, tried_cost = [], np.full(len(ctrl), np.inf)
+        for i, c in enumerate(ctrl):
+            if np.isfinite(c).all():
+                u = self._feet(c, targets[i], feet[i])
+                tried_cost[i] = self._cost(c, targets[i], u)
+                tried_feet.append(u)
+            else:
+                tried_feet.append(feet[i])
+        return tried_feet, tried_cost
 
     def _feet(self, ctrl: np.ndarray, target: np.ndarray, around: np.ndarray) -> np.ndarray:
         """Each target point's closest point on the spline near `around`, kept in the points' order: the curve's
