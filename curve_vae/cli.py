@@ -17,7 +17,7 @@ import warnings
 from typing import TextIO
 
 from curve_vae import __version__
-from curve_vae.commands import curves, data, design, generate, model, priors, train
+from curve_vae.commands import curves, data, design, generate, model, priors, ranker, train
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -28,7 +28,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"curve-vae {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for group in (data, train, model, curves, generate, design, priors):
+    for group in (data, train, ranker, model, curves, generate, design, priors):
         group.register(sub)
 
     s = sub.add_parser("serve", help="run the REST service on a model directory")

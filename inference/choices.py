@@ -11,9 +11,10 @@ FrameMode = Literal["auto", "model"]
 
 #: How a curve is turned before it is encoded. "canonical": the one pose geometry.canonical_frame gives the curve
 #: and its reversal, mirror image and rotations alike (one encoding); "search": six candidate poses encoded and
-#: decoded, the closest reconstruction kept (geometry.pose_frames); "as_is": as it is listed; "auto": the reading
-#: the model was trained for (its manifest's `reading.pose`).
-Pose = Literal["auto", "canonical", "search", "as_is"]
+#: decoded, the closest reconstruction kept (geometry.pose_frames); "learned": the search's candidates ranked by
+#: the model's reading ranker (inference.ranker) and only its first two encoded; "as_is": as it is listed; "auto":
+#: the reading the model was trained for (its manifest's `reading.pose`).
+Pose = Literal["auto", "canonical", "search", "learned", "as_is"]
 
 #: How a curve's points are read along it. "parameter": as given, interpolated along their order; "natural": at
 #: even steps of the parameters of the cubic B-spline fitted to it (geometry.natural_params); "arc_length": evenly
@@ -22,7 +23,7 @@ Pose = Literal["auto", "canonical", "search", "as_is"]
 Spacing = Literal["auto", "parameter", "natural", "arc_length", "search"]
 
 #: The poses and spacings a model's manifest may name as its own reading (everything but "auto").
-ModelPose = Literal["canonical", "search", "as_is"]
+ModelPose = Literal["canonical", "search", "learned", "as_is"]
 ModelSpacing = Literal["parameter", "natural", "arc_length", "search"]
 
 #: How returned curves are given: points, B-splines, or both.

@@ -74,6 +74,14 @@ class PriorEntry(_Part):
     components: int | None = None
 
 
+class RankerEntry(_Part):
+    """The reading ranker (inference.ranker): which of the search's candidate readings the model brings back
+    closest, predicted from their points, so that only the best two are encoded (reading pose "learned")."""
+
+    file: str = "ranker.npz"
+    kind: str
+
+
 class FrameSpec(_Part):
     """The plane the graphs' curves live in (the paper's 128×128, centred on (64, 64)) and the size of a posed
     curve's bounding box there (the training curves' median)."""
@@ -115,6 +123,7 @@ class Manifest(BaseModel):
     prior: PriorEntry | None = None
     frame: FrameSpec
     reading: ReadingSpec = ReadingSpec()
+    ranker: RankerEntry | None = None
     architecture: dict[str, Any] | None = Field(None, alias="model_config")  # the torch ModelConfig, as a dict
     training: dict[str, Any] | None = None
     metrics: dict[str, Any] | None = None
@@ -137,9 +146,11 @@ class Manifest(BaseModel):
         return float(((self.training or {}).get("data") or {}).get("radius", 64.0))
 
     def checked_files(self) -> list[str]:
-        """The files whose sha256 must match: both graphs and the prior (never vae.pt: serving does not read it)."""
+        """The files whose sha256 must match: both graphs, the prior and the ranker (never vae.pt: serving does not
+        read it)."""
         names = [self.graphs.encoder.file, self.graphs.decoder.file]
-        return names + ([self.prior.file] if self.prior is not None else [])
+        names += [self.prior.file] if self.prior is not None else []
+        return names + ([self.ranker.file] if self.ranker is not None else [])
 
     def to_json(self) -> dict[str, Any]:
         """As written to manifest.json (the ModelConfig under its own name, model_config)."""

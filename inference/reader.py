@@ -43,6 +43,7 @@ from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.prepared import Prepared, ReadCurve
+from curve_vae.inference.ranker import RANKED_READS, Ranker
 from curve_vae.inference.reading import Reading
 
 #: A natural reading whose parameters are all within this of the points' index fractions reads the curve as given:
@@ -67,9 +68,16 @@ class Reader:
     """Brings caller curves to a model's graphs and through them (see the module docstring)."""
 
     def __init__(
-        self, graphs: ModelGraphs, *, closest: bool, fitter: Fitter | None = None, cache: EncodingCache | None = None
+        self,
+        graphs: ModelGraphs,
+        *,
+        closest: bool,
+        fitter: Fitter | None = None,
+        cache: EncodingCache | None = None,
+        ranker: Ranker | None = None,
     ) -> None:
         self.graphs = graphs
+        self.ranker = ranker  # pose "learned": which candidates to encode
         self.closest = closest  # each caller point placed at its closest point on the decoded spline
         self.fitter = fitter
         self.cache = cache
@@ -81,7 +89,9 @@ class Reader:
         placed closest, place the caller's points on the spline (an encoding alone needs neither). shared: the
         curves are a set that is mixed together (interpolated, augmented), read in one pose (`_shared`)."""
         inputs = [np.asarray(c, np.float64) for c in curves]
-        shared = shared and len(inputs) > 1 and reading.frame != "model" and reading.pose in ("canonical", "search")
+        shared = (
+            shared and len(inputs) > 1 and reading.frame != "model" and reading.pose in ("canonical", "search", "learned")
+        )
         key = f"{reading.key}/{'closest' if self.closest else 'index'}"
         if shared:  # a curve's pose depends on its set: kept apart from its pose alone, per set
             key += "/set/" + EncodingCache.key(np.concatenate(inputs), str([len(c) for c in inputs])).hex()
@@ -117,6 +127,9 @@ class Reader:
         (shared: each curve's closest in the one pose whose candidates are closest over the whole set)."""
         stage = self._candidates(inputs, index, reading, shared=shared)
         models, fractions = self._model_points(inputs, index, stage)
+        if reading.pose == "learned" and stage:
+            keep = self._ranked(stage, models, shared=shared)
+            stage, models, fractions = [stage[k] for k in keep], models[keep], [fractions[k] for k in keep]
         if not stage:
             return []
         with np.errstate(all="ignore"):
@@ -134,6 +147,28 @@ class Reader:
             err = self._in_shared_pose(inputs, stage, err)
         best = [int(np.flatnonzero(owner == i)[err[owner == i].argmin()]) for i in range(len(inputs))]
         return [rows[b] for b in best]
+
+    def _ranked(self, stage: list[Candidate], models: np.ndarray, *, shared: bool) -> np.ndarray:
+        """Which candidates pose "learned" encodes: each curve's RANKED_READS the ranker expects closest; shared: in
+        the one pose whose expected errors (each curve's least, relative to its size) sum least over the set."""
+        if self.ranker is None:
+            raise InputError(("pose",), 'pose "learned" needs a model with a reading ranker; this one has none')
+        score = self.ranker.scores(models)
+        owner = np.array([c.curve for c in stage])
+        if shared:
+            pose = np.array([c.pose for c in stage])
+            curves = range(int(owner.max()) + 1)
+            expected = {
+                int(p): sum(float(np.exp(score[(pose == p) & (owner == i)].min())) for i in curves)
+                for p in np.unique(pose)
+            }
+            chosen = min(expected, key=expected.__getitem__)
+            score = np.where(pose == chosen, score, np.inf)
+        keep = [
+            rows[np.argsort(score[rows], kind="stable")[:RANKED_READS]]
+            for rows in (np.flatnonzero((owner == i) & (score < np.inf)) for i in np.unique(owner))
+        ]
+        return np.sort(np.concatenate(keep))
 
     @staticmethod
     def _in_shared_pose(inputs: list[np.ndarray], stage: list[Candidate], err: np.ndarray) -> np.ndarray:
@@ -176,7 +211,7 @@ class Reader:
                         frames = list(posed[c])
                     elif reading.pose == "canonical":
                         frames = [canonical_frame(pts)]
-                    elif reading.pose == "search":
+                    elif reading.pose in ("search", "learned"):
                         frames = list(pose_frames(pts, chords=POSE_CHORD_COUNT))
                     else:
                         frames = [fit_frame(pts)]

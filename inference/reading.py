@@ -33,7 +33,7 @@ class Reading:
     @property
     def searches(self) -> bool:
         """Whether several candidates are encoded per curve (the pose or the spacing searched)."""
-        return self.pose == "search" or self.spacing == "search"
+        return self.pose in ("search", "learned") or self.spacing == "search"
 
     @property
     def key(self) -> str:

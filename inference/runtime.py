@@ -47,6 +47,7 @@ from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.priors import NamedPrior, load_priors
 from curve_vae.inference.reader import Reader
+from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import Augmented, Curves, Encoding, Interpolation, Reconstruction, Sampled
 from curve_vae.inference.sampling import MAX_DRAWS, Sampler, fresh_seed
@@ -67,6 +68,7 @@ class CurveRuntime:
         cache: EncodingCache | None = None,
         model_dir: str | Path | None = None,
         priors: dict[str, NamedPrior] | None = None,
+        ranker: Ranker | None = None,
     ) -> None:
         self.graphs = graphs
         self.manifest: Manifest = graphs.manifest
@@ -76,7 +78,9 @@ class CurveRuntime:
         placed = bool(spline and spline.placement == "closest") if closest is None else closest
         self.fitter = Fitter(graphs) if graphs.has_splines else None
         self.cache = cache
-        self.reader = Reader(graphs, closest=placed and graphs.has_splines, fitter=self.fitter, cache=cache)
+        self.reader = Reader(
+            graphs, closest=placed and graphs.has_splines, fitter=self.fitter, cache=cache, ranker=ranker
+        )
         disc = np.asarray(self.manifest.frame.center, np.float64)
         self.priors = priors or {}
         self.sampler = Sampler(graphs, prior, disc, self.manifest.disc_radius, self.priors)
@@ -120,6 +124,13 @@ class CurveRuntime:
                     f"graphs do not match the manifest: the prior has {prior.latent_dim} latent dimensions, "
                     f"the model {manifest.latent_dim}"
                 )
+        ranker = None
+        if manifest.ranker is not None:
+            path = root / manifest.ranker.file
+            try:
+                ranker = Ranker.load(path)
+            except (OSError, ValueError, KeyError) as e:
+                raise ModelLoadError(f"{path}: not a usable reading ranker ({e})") from e
         config = sessions or SessionConfig(intra_op_threads=intra_op_threads)
         graphs = ModelGraphs.open(
             root, manifest, providers=providers, sessions=config, batch_size=batch_size, warm_up=warm_up
@@ -127,7 +138,7 @@ class CurveRuntime:
         closest = None if placement == "model" else placement == "closest"
         cache = EncodingCache(cache_bytes) if cache_bytes > 0 else None
         named = load_priors(priors_dir, manifest, manifest.latent_dim)
-        return cls(graphs, prior=prior, closest=closest, cache=cache, model_dir=root, priors=named)
+        return cls(graphs, prior=prior, closest=closest, cache=cache, model_dir=root, priors=named, ranker=ranker)
 
     # ----------------------------------------------------------------------- what the model is
 

@@ -153,7 +153,14 @@ class ModelInfo(BaseModel):
     model_size: float = Field(description='Bounding-box size curves are scaled to by frame "auto".')
     reading: dict[str, str] = Field(
         description='What pose and spacing "auto" mean for this model: the reading its encoder was trained for '
-        '("canonical" pose, "parameter" spacing: one encoding per curve; "search": the candidates searched).'
+        '("canonical" pose, "parameter" spacing: one encoding per curve; "search": the candidates searched; '
+        '"learned" pose: the search\'s candidates ranked by `ranker`, two encoded per curve).'
+    )
+    ranker: dict[str, Any] | None = Field(
+        None,
+        description='The reading ranker pose "learned" runs, when the model ships one: its file, kind, and how close '
+        "its picks came on curves held out of its training (best_of_2: the closer of its first two, ÷ the best of "
+        "all the search's candidates).",
     )
     cache: dict[str, int] | None = Field(
         None, description="The encoding cache of this worker: entries, bytes held and allowed, hits and misses."

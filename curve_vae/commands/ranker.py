@@ -1,0 +1,60 @@
+"""`curve-vae ranker`: the reading ranker (training/ranker.py) — label curves through the frozen model, train on the
+labels, export into a model directory. Every stage is time-budgeted and resumable: run it again to carry on."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def cmd_label(a: argparse.Namespace) -> int:
+    from curve_vae.training.ranker_labels import label_curves
+
+    files = label_curves(
+        a.model_dir, a.out, curves=a.curves, seed=a.seed, chunk=a.chunk, time_budget=a.time_budget
+    )
+    print(f"{len(files)} label files in {a.out} (train on them with curve-vae ranker train)")
+    return 0
+
+
+def cmd_train(a: argparse.Namespace) -> int:
+    from curve_vae.training.ranker import train_ranker
+
+    best = train_ranker(a.labels, a.run_dir, time_budget=a.time_budget, resume=a.resume, lr=a.lr, seed=a.seed)
+    print(f"best held-out epoch → {best} (export it with curve-vae ranker export)")
+    return 0
+
+
+def cmd_export(a: argparse.Namespace) -> int:
+    from curve_vae.training.ranker import export_ranker
+
+    path = export_ranker(a.checkpoint, a.model_dir)
+    print(f"wrote {path}; the model's reading is now pose \"learned\" (the manifest names it)")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    r = sub.add_parser("ranker", help="the reading ranker: label curves, train it, export it into a model")
+    stages = r.add_subparsers(dest="stage", required=True)
+
+    s = stages.add_parser("label", help="read user-like curves every way the search does, through the frozen model")
+    s.add_argument("--model-dir", default="models", help="the frozen model (default: models)")
+    s.add_argument("--out", default="data/ranker", help="label chunks go here (default: data/ranker)")
+    s.add_argument("--curves", type=int, default=12_000, help="curves to label (default: 12000)")
+    s.add_argument("--seed", type=int, default=1, help="seed of the curves; each seed its own files (default: 1)")
+    s.add_argument("--chunk", type=int, default=250, help="curves per file (default: 250)")
+    s.add_argument("--time-budget", type=float, default=0.0, help="seconds, then stop at a chunk's end (0: none)")
+    s.set_defaults(func=cmd_label)
+
+    s = stages.add_parser("train", help="train the ranker on the label chunks (time-budgeted, resumable)")
+    s.add_argument("--labels", default="data/ranker", help="the label chunks (default: data/ranker)")
+    s.add_argument("--run-dir", default="runs/ranker", help="checkpoints go here (default: runs/ranker)")
+    s.add_argument("--time-budget", type=float, default=600.0, help="seconds of training in all (default: 600)")
+    s.add_argument("--resume", action="store_true", help="carry on from RUN_DIR/ranker-last.pt")
+    s.add_argument("--lr", type=float, default=2e-3, help="peak learning rate, cosine over the budget (default: 2e-3)")
+    s.add_argument("--seed", type=int, default=0, help="held-out split and initial weights (default: 0)")
+    s.set_defaults(func=cmd_train)
+
+    s = stages.add_parser("export", help="write the ranker into a model directory; its reading becomes \"learned\"")
+    s.add_argument("checkpoint", help="a ranker checkpoint (RUN_DIR/ranker-best.pt)")
+    s.add_argument("--model-dir", required=True, help="the model directory whose graphs it was trained against")
+    s.set_defaults(func=cmd_export)

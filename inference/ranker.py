@@ -1,0 +1,73 @@
+"""The reading ranker in numpy: from each candidate reading's model-plane points, the natural log of the relative
+RMSE the model would bring it back at (trained by training/ranker.py against the frozen graphs; the service has no
+torch). Reading pose "learned" encodes only the two candidates it ranks first (inference.reader).
+
+The network: the points centred on the plane and their steps along the curve (4 channels), three convolutions of
+kernel 5 and stride 2 with ReLU, the mean and the maximum over the curve, a hidden layer, one output.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from curve_vae.geometry.frame import MODEL_CENTER
+
+RANKER_KIND = "conv1d-3x5s2-meanmax-v1"
+#: Readings pose "learned" encodes per curve: the ranker's first two.
+RANKED_READS = 2
+#: Scale of the plane (half its side) and of a step between neighbouring points in the ranker's inputs.
+PLANE_HALF = 64.0
+STEP_SCALE = 20.0
+
+
+def ranker_inputs(points: np.ndarray) -> np.ndarray:
+    """(k, n, 2) model-plane points -> (k, 4, n) float32: the points about the plane's centre, in half-sides, and
+    each point's step from the one before (the first repeats the second's), scaled to about unit size."""
+    p = (np.asarray(points, np.float32) - np.float32(MODEL_CENTER[0])) / np.float32(PLANE_HALF)
+    step = np.diff(p, axis=1)
+    step = np.concatenate([step[:, :1], step], axis=1) * np.float32(STEP_SCALE * (p.shape[1] - 1) / 160)
+    return np.ascontiguousarray(np.concatenate([p, step], axis=2).transpose(0, 2, 1))
+
+
+class Ranker:
+    """The ranker's weights (ranker.npz) and its forward pass."""
+
+    def __init__(self, weights: dict[str, np.ndarray]) -> None:
+        self.convs = []
+        i = 0
+        while f"conv{i}_w" in weights:
+            self.convs.append((weights[f"conv{i}_w"].astype(np.float32), weights[f"conv{i}_b"].astype(np.float32)))
+            i += 1
+        self.dense = []
+        i = 0
+        while f"dense{i}_w" in weights:
+            self.dense.append((weights[f"dense{i}_w"].astype(np.float32), weights[f"dense{i}_b"].astype(np.float32)))
+            i += 1
+        if not self.convs or len(self.dense) != 2:
+            raise ValueError("not a reading ranker: expected conv0… and dense0, dense1 weights")
+
+    @classmethod
+    def load(cls, path: str | Path) -> Ranker:
+        with np.load(path) as d:
+            kind = str(d["kind"]) if "kind" in d else ""
+            if kind != RANKER_KIND:
+                raise ValueError(f"{path}: a ranker of kind {kind!r}; this runtime reads {RANKER_KIND!r}")
+            return cls({k: d[k] for k in d.files if k != "kind"})
+
+    def scores(self, points: np.ndarray) -> np.ndarray:
+        """(k, n, 2) model-plane points -> (k,) predicted natural log of each reading's relative RMSE."""
+        if len(points) == 0:
+            return np.zeros(0)
+        h = ranker_inputs(points).transpose(0, 2, 1)  # (k, n, c): each step one matrix product
+        for w, b in self.convs:
+            padded = np.pad(h, ((0, 0), (2, 2), (0, 0)))
+            windows = sliding_window_view(padded, w.shape[2], axis=1)[:, ::2]  # (k, n_out, c, 5)
+            flat = windows.reshape(*windows.shape[:2], -1)  # (k, n_out, c·5), as w (o, c, 5) flattens
+            h = np.maximum(flat @ w.reshape(len(w), -1).T + b, 0.0)
+        z = np.concatenate([h.mean(1), h.max(1)], axis=1)
+        (w0, b0), (w1, b1) = self.dense
+        z = np.maximum(z @ w0.T + b0, 0.0)
+        return (z @ w1.T + b1)[:, 0].astype(np.float64)

@@ -1,0 +1,115 @@
+"""Reading pose "learned": the ranker's numpy forward pass, its file, and the reading it drives (only the ranked
+candidates encoded; a curve moved comes back moved)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
+from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, Ranker, ranker_inputs
+from curve_vae.inference.reading import Reading
+from curve_vae.inference.runtime import CurveRuntime
+from tests.helpers import bspline_curves
+
+
+def random_weights(seed: int = 0) -> dict[str, np.ndarray]:
+    """Weights of the ranker's shape (training/ranker.py's RankerNet), drawn at random."""
+    rng = np.random.default_rng(seed)
+    shapes = {"conv0_w": (32, 4, 5), "conv1_w": (64, 32, 5), "conv2_w": (96, 64, 5), "dense0_w": (96, 192)}
+    shapes["dense1_w"] = (1, 96)
+    out = {}
+    for name, shape in shapes.items():
+        out[name] = (rng.normal(size=shape) / np.sqrt(np.prod(shape[1:]))).astype(np.float32)
+        out[name.replace("_w", "_b")] = (0.1 * rng.normal(size=shape[0])).astype(np.float32)
+    return out
+
+
+def with_ranker(src: Path, out: Path, weights: dict[str, np.ndarray]) -> Path:
+    """A copy of a model directory with a ranker and the reading "learned" in its manifest."""
+    shutil.copytree(src, out, dirs_exist_ok=True)
+    np.savez(out / "ranker.npz", kind=RANKER_KIND, **weights)
+    manifest = json.loads((out / "manifest.json").read_text())
+    manifest["files"]["ranker.npz"] = file_entry(out / "ranker.npz").model_dump()
+    manifest["ranker"] = {"file": "ranker.npz", "kind": RANKER_KIND}
+    manifest["reading"] = {"pose": "learned", "spacing": "search"}
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    return out
+
+
+@pytest.fixture(scope="module")
+def ranked_dir(closest_model_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The untrained model placed closest (where the search keeps the candidate closest at the caller's points)."""
+    return with_ranker(closest_model_dir, tmp_path_factory.mktemp("ranked"), random_weights())
+
+
+@pytest.fixture(scope="module")
+def ranked(ranked_dir: Path) -> CurveRuntime:
+    return CurveRuntime.load(ranked_dir, providers="cpu", intra_op_threads=1, cache_bytes=0)
+
+
+def test_inputs_are_the_points_about_the_centre_and_their_steps():
+    pts = np.stack([np.linspace(0, 128, 161), np.full(161, 64.0)], axis=1)[None]
+    x = ranker_inputs(pts)
+    assert x.shape == (1, 4, 161)
+    np.testing.assert_allclose(x[0, 0, [0, 80, 160]], [-1.0, 0.0, 1.0], atol=1e-6)
+    np.testing.assert_allclose(x[0, 2], 0.8 / 64 * 20, rtol=1e-5)  # steps of 0.8 px, in half-sides, × 20
+    assert np.all(x[0, 3] == 0)
+
+
+def test_the_forward_pass_is_a_convolution_stack():
+    """Against a direct loop: conv (kernel 5, stride 2, padding 2) + ReLU three times, mean and max, two layers."""
+    w = random_weights(3)
+    pts = np.random.default_rng(1).uniform(20, 108, (3, 161, 2)).astype(np.float32)
+    h = ranker_inputs(pts).astype(np.float64)
+    for i in range(3):
+        k, b = w[f"conv{i}_w"], w[f"conv{i}_b"]
+        p = np.pad(h, ((0, 0), (0, 0), (2, 2)))
+        n_out = (h.shape[2] - 1) // 2 + 1
+        h = np.stack([np.einsum("bck,ock->bo", p[:, :, 2 * j : 2 * j + 5], k) for j in range(n_out)], axis=2)
+        h = np.maximum(h + b[None, :, None], 0)
+    z = np.concatenate([h.mean(2), h.max(2)], axis=1)
+    z = np.maximum(z @ w["dense0_w"].T + w["dense0_b"], 0) @ w["dense1_w"].T + w["dense1_b"]
+    np.testing.assert_allclose(Ranker(w).scores(pts), z[:, 0], rtol=1e-4, atol=1e-5)
+
+
+def test_a_file_of_another_kind_is_refused(tmp_path):
+    np.savez(tmp_path / "r.npz", kind="something-else", **random_weights())
+    with pytest.raises(ValueError, match="this runtime reads"):
+        Ranker.load(tmp_path / "r.npz")
+
+
+def test_the_manifest_names_the_ranker_and_checks_its_bytes(ranked_dir: Path, tmp_path: Path):
+    m = Manifest.read(ranked_dir)
+    assert m.ranker is not None and m.ranker.file == "ranker.npz" and m.reading.pose == "learned"
+    assert "ranker.npz" in m.checked_files()
+    broken = with_ranker(ranked_dir, tmp_path / "broken", random_weights())
+    (broken / "ranker.npz").write_bytes(b"not the ranker")
+    with pytest.raises(ModelLoadError, match="ranker.npz"):
+        CurveRuntime.load(broken, providers="cpu", intra_op_threads=1, cache_bytes=0)
+
+
+def test_learned_encodes_only_the_ranked_candidates(ranked: CurveRuntime):
+    curves = list(bspline_curves(5, seed=4))
+    before = ranked.graphs.rows["encoder"]
+    ranked.reconstruct(curves)  # the manifest's reading: learned
+    assert ranked.graphs.rows["encoder"] - before == RANKED_READS * len(curves)
+    before = ranked.graphs.rows["encoder"]
+    ranked.reconstruct(curves, Reading(pose="search"))
+    assert ranked.graphs.rows["encoder"] - before > 6 * len(curves)
+
+
+def test_a_set_is_read_in_one_pose(ranked: CurveRuntime):
+    curves = list(bspline_curves(3, seed=2))
+    prep = ranked.prepare(curves, together=True)
+    assert len({(round(f.rotation, 9), f.mirror) for f in prep.frames}) == 1
+
+
+def test_a_model_without_a_ranker_names_what_is_missing(runtime: CurveRuntime):
+    with pytest.raises(InputError, match="reading ranker"):
+        runtime.reconstruct(list(bspline_curves(1, seed=1)), Reading(pose="learned"))

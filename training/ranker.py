@@ -1,0 +1,225 @@
+"""The reading ranker: a small network that tells, from a candidate reading's model-plane points alone, how close the
+frozen model will bring it back, so that the runtime encodes only the two best of the search's candidates.
+
+    curve --the search's candidates (6 poses × as given / natural)--> (k, 161, 2) --ranker--> predicted log error
+        --the two lowest--> encoder, decoder --the closer kept--> the reading
+
+Trained on labels.npz chunks (training/ranker_labels.py): each candidate's relative RMSE through the frozen model.
+The loss ranks within each curve: the predicted log errors, centred per curve, regress the measured ones, and a
+softmax over each curve's candidates learns which one is closest (learned canonicalisation against a frozen model,
+as equiadapt trains its canonicalisers with a prior on the labels).
+
+Training is time-budgeted and resumable (`ranker-last.pt`, written atomically each epoch); `export_ranker` writes
+the weights as ranker.npz beside the model's graphs, which inference.ranker runs in numpy (the service has no torch).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from curve_vae.files import atomic_path, atomic_write_text
+from curve_vae.inference.manifest import file_sha256
+from curve_vae.inference.ranker import RANKER_KIND, ranker_inputs
+from curve_vae.training.checkpoint import atomic_save
+
+#: Channels of the three strided convolutions (kernel 5, stride 2) and the hidden layer of the head.
+CHANNELS = (32, 64, 96)
+HIDDEN = 96
+#: Temperature of the softmax over a curve's candidates (on natural-log errors: 0.1 tells 10% apart).
+TEMPERATURE = 0.1
+
+
+class RankerNet(nn.Module):
+    """(B, 4, n) ranker inputs -> (B,) predicted natural log of the relative RMSE."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        layers: list[nn.Module] = []
+        width = 4
+        for c in CHANNELS:
+            layers += [nn.Conv1d(width, c, 5, stride=2, padding=2), nn.ReLU()]
+            width = c
+        self.convs = nn.Sequential(*layers)
+        self.head = nn.Sequential(nn.Linear(2 * width, HIDDEN), nn.ReLU(), nn.Linear(HIDDEN, 1))
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        h = self.convs(x)
+        return self.head(torch.cat([h.mean(-1), h.amax(-1)], dim=1))[:, 0]
+
+    def weights(self) -> dict[str, np.ndarray]:
+        """The weights as inference.ranker reads them."""
+        out: dict[str, np.ndarray] = {}
+        convs = [m for m in self.convs if isinstance(m, nn.Conv1d)]
+        for i, m in enumerate(convs):
+            out[f"conv{i}_w"], out[f"conv{i}_b"] = _np(m.weight), _np(m.bias)
+        lin = [m for m in self.head if isinstance(m, nn.Linear)]
+        for i, m in enumerate(lin):
+            out[f"dense{i}_w"], out[f"dense{i}_b"] = _np(m.weight), _np(m.bias)
+        return out
+
+
+def _np(t: torch.Tensor | None) -> np.ndarray:
+    assert t is not None
+    return t.detach().cpu().numpy().astype(np.float32)
+
+
+# ----------------------------------------------------------------------------------------------- the labels
+
+
+class Labels:
+    """Every labelled curve's candidates, padded to the most any curve has: inputs (C, K, 4, n), log errors (C, K)
+    and which are real (C, K)."""
+
+    def __init__(self, files: list[Path]) -> None:
+        xs, ys, masks = [], [], []
+        for f in files:
+            with np.load(f) as d:
+                pts, owner, err = d["points"], d["curve"], d["error"]
+            inputs = ranker_inputs(pts)
+            for c in np.unique(owner):
+                rows = np.flatnonzero(owner == c)
+                xs.append(inputs[rows])
+                ys.append(np.log(np.maximum(err[rows], 1e-9)))
+        k = max(len(y) for y in ys)
+        self.x = np.zeros((len(xs), k, *xs[0].shape[1:]), np.float32)
+        self.y = np.zeros((len(ys), k), np.float32)
+        self.mask = np.zeros((len(ys), k), bool)
+        for i, (x, y) in enumerate(zip(xs, ys)):
+            self.x[i, : len(y)], self.y[i, : len(y)], self.mask[i, : len(y)] = x, y, True
+        self.y[~self.mask] = 0.0
+
+    def __len__(self) -> int:
+        return len(self.y)
+
+
+def _loss(net: RankerNet, x: torch.Tensor, y: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    c, k = y.shape
+    s = net(x.reshape(c * k, *x.shape[2:])).reshape(c, k)
+    m = mask.float()
+    count = m.sum(1, keepdim=True)
+    centred_s = s - (s * m).sum(1, keepdim=True) / count
+    centred_y = y - (y * m).sum(1, keepdim=True) / count
+    regression = (((centred_s - centred_y) ** 2) * m).sum() / m.sum()
+    neg = torch.finfo(s.dtype).min / 2
+    target = torch.softmax(torch.where(mask, -y / TEMPERATURE, neg), dim=1)
+    log_p = torch.log_softmax(torch.where(mask, -s / TEMPERATURE, neg), dim=1)
+    choice = -(target * torch.where(mask, log_p, 0.0)).sum(1).mean()
+    return regression + 0.1 * choice
+
+
+def pick_ratios(scores: np.ndarray, y: np.ndarray, mask: np.ndarray, reads: int = 2) -> dict[str, float]:
+    """How close the candidates a ranker keeps come, against the best of all: mean error of the kept (the best of
+    the `reads` lowest scores) ÷ mean of the best, as the tables measure sets; and the first pick's."""
+    err = np.where(mask, np.exp(y), np.inf)
+    order = np.argsort(np.where(mask, scores, np.inf), axis=1)
+    best = err.min(1).mean()
+    rows = np.arange(len(err))[:, None]
+    return {
+        "first": float(err[rows[:, 0], order[:, 0]].mean() / best),
+        f"best_of_{reads}": float(err[rows, order[:, :reads]].min(1).mean() / best),
+    }
+
+
+# ----------------------------------------------------------------------------------------------- training
+
+
+def train_ranker(
+    labels_dir: str | Path,
+    out_dir: str | Path,
+    *,
+    time_budget: float,
+    resume: bool = False,
+    lr: float = 2e-3,
+    batch_curves: int = 64,
+    val_share: float = 0.1,
+    seed: int = 0,
+    say: Callable[[str], None] = print,
+) -> Path:
+    """Train a ranker on every labels-*.npz in `labels_dir` for `time_budget` seconds (learning rate cosine over
+    the budget), holding out `val_share` of the curves; `ranker-last.pt` (atomic, each epoch) lets `resume` carry
+    on where a run stopped, with the time it had left; `ranker-best.pt` keeps the epoch whose held-out picks came
+    closest. Returns the best checkpoint's path."""
+    files = sorted(Path(labels_dir).glob("labels-*.npz"))
+    if not files:
+        raise FileNotFoundError(f"{labels_dir}: no labels-*.npz (curve-vae ranker label writes them)")
+    data = Labels(files)
+    rng = np.random.default_rng(seed)
+    order = rng.permutation(len(data))
+    n_val = max(1, int(len(data) * val_share))
+    val, train = order[:n_val], order[n_val:]
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    torch.manual_seed(seed)
+    net = RankerNet()
+    opt = torch.optim.AdamW(net.parameters(), lr=lr, weight_decay=1e-4)
+    state = {"epoch": 0, "spent": 0.0, "best": float("inf")}
+    last, best_path = out / "ranker-last.pt", out / "ranker-best.pt"
+    if resume and last.exists():
+        ck = torch.load(last, map_location="cpu", weights_only=False)
+        net.load_state_dict(ck["model"])
+        opt.load_state_dict(ck["optimizer"])
+        state = ck["state"]
+        say(f"resumed at epoch {state['epoch']}, {state['spent']:.0f} s of {time_budget:.0f} spent")
+    x, y, mask = (torch.from_numpy(a) for a in (data.x, data.y, data.mask))
+    start = time.monotonic() - state["spent"]
+    while time.monotonic() - start < time_budget:
+        net.train()
+        for batch in np.array_split(rng.permutation(train), max(1, len(train) // batch_curves)):
+            frac = min((time.monotonic() - start) / time_budget, 1.0)
+            for g in opt.param_groups:
+                g["lr"] = lr * 0.5 * (1 + np.cos(np.pi * frac))
+            b = torch.from_numpy(batch)
+            loss = _loss(net, x[b], y[b], mask[b])
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+        state["epoch"] += 1
+        state["spent"] = time.monotonic() - start
+        ratios = pick_ratios(_scores(net, data.x[val]), data.y[val], data.mask[val])
+        say(
+            f"epoch {state['epoch']}: loss {loss.item():.4f}, held-out picks {ratios['first']:.3f}× the best "
+            f"(best of two: {ratios['best_of_2']:.3f}×), {state['spent']:.0f}/{time_budget:.0f} s"
+        )
+        if ratios["best_of_2"] < state["best"]:
+            state["best"] = ratios["best_of_2"]
+            atomic_save({"model": net.state_dict(), "ratios": ratios, "epoch": state["epoch"]}, best_path)
+        atomic_save({"model": net.state_dict(), "optimizer": opt.state_dict(), "state": state}, last)
+    return best_path
+
+
+def _scores(net: RankerNet, x: np.ndarray) -> np.ndarray:
+    net.eval()
+    c, k = x.shape[:2]
+    with torch.no_grad():
+        return net(torch.from_numpy(x.reshape(c * k, *x.shape[2:]))).numpy().reshape(c, k)
+
+
+# ----------------------------------------------------------------------------------------------- export
+
+
+def export_ranker(checkpoint: str | Path, model_dir: str | Path, *, meta: dict[str, Any] | None = None) -> Path:
+    """Write the checkpoint's weights as `ranker.npz` in `model_dir` and name it in the manifest, whose reading
+    becomes pose "learned" (both written atomically). Returns the weights' path."""
+    ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
+    net = RankerNet()
+    net.load_state_dict(ck["model"])
+    root = Path(model_dir)
+    path = root / "ranker.npz"
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, kind=RANKER_KIND, **net.weights())
+    manifest_path = root / "manifest.json"
+    manifest = json.loads(manifest_path.read_text())
+    manifest["files"]["ranker.npz"] = {"sha256": file_sha256(path), "bytes": path.stat().st_size}
+    manifest["ranker"] = {"file": "ranker.npz", "kind": RANKER_KIND, **(meta or {}), "held_out": ck.get("ratios")}
+    manifest["reading"] = {"pose": "learned", "spacing": "search"}
+    atomic_write_text(manifest_path, json.dumps(manifest, indent=2) + "\n")
+    return path
