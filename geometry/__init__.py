@@ -45,7 +45,7 @@ from curve_vae.geometry.metrics import (
     turning_angles,
 )
 from curve_vae.geometry.mixing import simplex_grid, simplex_grid_size
-from curve_vae.geometry.natural import natural_params, natural_readings
+from curve_vae.geometry.natural import natural_params, natural_readings, natural_readings_of
 
 __all__ = [
     "arc_length_params",
@@ -67,6 +67,7 @@ __all__ = [
     "fit_bspline_auto",
     "natural_params",
     "natural_readings",
+    "natural_readings_of",
     "fit_frame",
     "mse_per_curve",
     "params_at_arc_fractions",

@@ -16,6 +16,8 @@ with the one from the arc-length fractions. The closest lands on a paper curve's
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
@@ -59,20 +61,44 @@ def natural_readings(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: i
     listed). Curves of fewer than 2·n_ctrl points keep their arc-length fractions; of a curve of more than
     NATURAL_FIT_POINTS points, that many are fitted and the rest interpolated by arc length between them.
     """
-    pts = np.asarray(points, np.float64)
-    extent = float(np.ptp(pts, axis=0).max()) if len(pts) else 0.0
-    if not extent > 0:
-        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
-    pts = (pts - pts[0]) / extent  # the shape alone, at a size where squares neither underflow nor overflow
-    u = arc_fractions(pts)
-    if len(pts) < 2 * n_ctrl:
-        return [u]
-    turn = turning_angles(pts)
-    if turn.sum() > 0 and (turn * u[1:-1]).sum() / turn.sum() > 0.5:
+    return natural_readings_of([points], n_ctrl=n_ctrl, steps=steps)[0]
+
+
+def natural_readings_of(
+    curves: Sequence[np.ndarray], *, n_ctrl: int = NATURAL_CTRL, steps: int = 40
+) -> list[list[np.ndarray]]:
+    """`natural_readings` of many polylines at once: the curves fitted with as many points are fitted together,
+    every start of every curve one row of one Levenberg–Marquardt (a batch costs about what its longest curve's
+    fit does, not the sum)."""
+    out: list[list[np.ndarray]] = [[] for _ in curves]
+    fits: dict[int, list[tuple[int, np.ndarray, bool, np.ndarray | None]]] = {}  # fitted length -> curves
+    for i, points in enumerate(curves):
+        pts = np.asarray(points, np.float64)
+        extent = float(np.ptp(pts, axis=0).max()) if len(pts) else 0.0
+        if not extent > 0:
+            raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+        pts = (pts - pts[0]) / extent  # the shape alone, at a size where squares neither underflow nor overflow
+        u = arc_fractions(pts)
+        if len(pts) < 2 * n_ctrl:
+            out[i] = [u]
+            continue
+        turn = turning_angles(pts)
         # fitted from the end where the curve turns most, whichever way it is listed: a curve and its reversal get
         # the same parameters to rounding (the fit's path from its start is not symmetric in the order)
-        return [(1.0 - r)[::-1] for r in _fit(pts[::-1], n_ctrl, steps)]
-    return _fit(pts, n_ctrl, steps)
+        flip = bool(turn.sum() > 0 and (turn * u[1:-1]).sum() / turn.sum() > 0.5)
+        pts = pts[::-1] if flip else pts
+        some = None
+        if len(pts) > NATURAL_FIT_POINTS:
+            some = np.unique(np.round(np.linspace(0, len(pts) - 1, NATURAL_FIT_POINTS)).astype(int))
+        fits.setdefault(len(pts) if some is None else len(some), []).append((i, pts, flip, some))
+    for group in fits.values():
+        fitted = _fit([pts if some is None else pts[some] for _, pts, _, some in group], n_ctrl, steps)
+        for (i, pts, flip, some), readings in zip(group, fitted):
+            if some is not None:
+                u = arc_fractions(pts)
+                readings = [np.interp(u, u[some], r) for r in readings]
+            out[i] = [(1.0 - r)[::-1] for r in readings] if flip else readings
+    return out
 
 
 def _starts(pts: np.ndarray) -> np.ndarray:
@@ -93,25 +119,33 @@ def _starts(pts: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-def _fit(pts: np.ndarray, n_ctrl: int, steps: int) -> list[np.ndarray]:
-    """`natural_readings`' fit of a polyline (n, 2) as listed, its points at most NATURAL_FIT_POINTS."""
-    if len(pts) > NATURAL_FIT_POINTS:
-        u = arc_fractions(pts)
-        some = np.unique(np.round(np.linspace(0, len(pts) - 1, NATURAL_FIT_POINTS)).astype(int))
-        return [np.interp(u, u[some], r) for r in _fit(pts[some], n_ctrl, steps)]
-    fit = _BatchFit(pts, _starts(pts), n_ctrl)
+def _fit(curves: list[np.ndarray], n_ctrl: int, steps: int) -> list[list[np.ndarray]]:
+    """`natural_readings_of`' fit of polylines of one length (n, 2) as listed, all at once: every start of every
+    curve scouts, then each curve carries on with its closest start and the arc-length one."""
+    starts = [_starts(pts) for pts in curves]
+    owner = np.concatenate([np.full(len(st), i) for i, st in enumerate(starts)])
+    first = np.concatenate([[0], np.cumsum([len(st) for st in starts])[:-1]])  # each curve's arc-length row
+    fit = _BatchFit(np.stack(curves)[owner], np.concatenate(starts), n_ctrl)
     fit.run(min(NATURAL_SCOUT_STEPS, steps))
-    best = int(fit.cost.argmin())
-    fit.keep([best, 0] if best else [0])
+    rows: list[int] = []
+    for i in range(len(curves)):
+        best = int(first[i] + fit.cost[owner == i].argmin())
+        rows += [best, int(first[i])] if best != first[i] else [best]
+    fit.keep(rows)
     fit.run(steps - min(NATURAL_SCOUT_STEPS, steps))
-    order = np.argsort(fit.cost, kind="stable")
-    if len(order) == 2 and np.abs(fit.u[0] - fit.u[1]).max() < 1e-6:  # both ended at the same fit
-        order = order[:1]
-    return [fit.u[i].copy() for i in order]
+    owner = owner[rows]
+    out = []
+    for i in range(len(curves)):
+        mine = np.flatnonzero(owner == i)
+        order = mine[np.argsort(fit.cost[mine], kind="stable")]
+        if len(order) == 2 and np.abs(fit.u[order[0]] - fit.u[order[1]]).max() < 1e-6:  # both ended at one fit
+            order = order[:1]
+        out.append([fit.u[k].copy() for k in order])
+    return out
 
 
 class _BatchFit:
-    """K Levenberg–Marquardt fits of one polyline (n, 2) at once, one per row of starting parameters (K, n): each
+    """K Levenberg–Marquardt fits at once, one per row of polylines (K, n, 2) and starting parameters (K, n): each
     a clamped uniform cubic B-spline (n_ctrl control points) and its points' parameters."""
 
     def __init__(self, pts: np.ndarray, u: np.ndarray, n_ctrl: int) -> None:
@@ -129,7 +163,7 @@ class _BatchFit:
         return b.reshape(*u.shape, self.n_ctrl), s.reshape(*u.shape, self.n_ctrl)
 
     def keep(self, rows: list[int]) -> None:
-        for name in ("u", "basis", "slope", "ctrl", "r", "cost", "damping"):
+        for name in ("pts", "u", "basis", "slope", "ctrl", "r", "cost", "damping"):
             setattr(self, name, getattr(self, name)[rows])
 
     def run(self, steps: int) -> None:

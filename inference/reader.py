@@ -22,8 +22,7 @@ from curve_vae.geometry import (
     Frame,
     canonical_frame,
     fit_frame,
-    natural_params,
-    natural_readings,
+    natural_readings_of,
     ordered_closest_params,
     pose_frames,
     to_model_plane,
@@ -49,6 +48,8 @@ from curve_vae.inference.reading import Reading
 #: A natural reading whose parameters are all within this of the points' index fractions reads the curve as given:
 #: spacing "search" does not try it beside "parameter".
 SAME_READING = 1e-4
+#: Curves whose natural readings are fitted together (a batch's fit holds ~9 starts × points × 10 per curve).
+NATURAL_BATCH = 32
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -90,7 +91,10 @@ class Reader:
         curves are a set that is mixed together (interpolated, augmented), read in one pose (`_shared`)."""
         inputs = [np.asarray(c, np.float64) for c in curves]
         shared = (
-            shared and len(inputs) > 1 and reading.frame != "model" and reading.pose in ("canonical", "search", "learned")
+            shared
+            and len(inputs) > 1
+            and reading.frame != "model"
+            and reading.pose in ("canonical", "search", "learned")
         )
         key = f"{reading.key}/{'closest' if self.closest else 'index'}"
         if shared:  # a curve's pose depends on its set: kept apart from its pose alone, per set
@@ -201,6 +205,7 @@ class Reader:
                 posed = [[f] for f in canonical_frames(inputs)]
         except ValueError:
             pass  # the curve whose points coincide is named below
+        natural = self._natural_readings(inputs, index) if reading.spacing in ("search", "natural") else None
         stage: list[Candidate] = []
         with np.errstate(all="ignore"):
             for c, (i, pts) in enumerate(zip(index, inputs)):
@@ -215,22 +220,40 @@ class Reader:
                         frames = list(pose_frames(pts, chords=POSE_CHORD_COUNT))
                     else:
                         frames = [fit_frame(pts)]
-                    if reading.spacing == "search":
-                        checkpoint()  # a natural fit per curve: an abandoned request stops between curves
+                    if reading.spacing == "search" and natural is not None:
                         spaced = [("parameter", None)] + [
                             ("natural", n)
-                            for n in natural_readings(pts)
+                            for n in natural[c]
                             if np.abs(n - np.linspace(0.0, 1.0, len(n))).max() > SAME_READING
                         ]
-                    elif reading.spacing == "natural":
-                        checkpoint()
-                        spaced = [("natural", natural_params(pts))]  # it does not depend on the pose: fitted once
+                    elif reading.spacing == "natural" and natural is not None:
+                        spaced = [("natural", natural[c][0])]  # it does not depend on the pose: fitted once
                     else:
                         spaced = [(reading.spacing, None)]
                 except ValueError as e:  # all points coincide
                     raise InputError(("curves", i), str(e)) from e
                 stage += [Candidate(c, f, s, n, p) for p, f in enumerate(frames) for s, n in spaced]
         return stage
+
+    @staticmethod
+    def _natural_readings(inputs: list[np.ndarray], index: list[int]) -> list[list[np.ndarray]]:
+        """Each curve's natural readings (geometry.natural_readings_of), NATURAL_BATCH curves fitted at once; an
+        abandoned request stops between batches."""
+        out: list[list[np.ndarray]] = []
+        for start in range(0, len(inputs), NATURAL_BATCH):
+            checkpoint()
+            part = inputs[start : start + NATURAL_BATCH]
+            try:
+                out += natural_readings_of(part)
+            except ValueError:  # all points of one coincide: name it
+                for k, pts in enumerate(part):
+                    if not np.ptp(pts, axis=0).max() > 0:
+                        raise InputError(
+                            ("curves", index[start + k]),
+                            "all points coincide: a curve needs at least 2 distinct points",
+                        ) from None
+                raise
+        return out
 
     def _model_points(
         self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]

@@ -35,6 +35,8 @@ CHANNELS = (32, 64, 96)
 HIDDEN = 96
 #: Temperature of the softmax over a curve's candidates (on natural-log errors: 0.1 tells 10% apart).
 TEMPERATURE = 0.1
+#: Weight of that softmax's cross-entropy beside the regression of the centred log errors.
+CHOICE_WEIGHT = 0.3
 
 
 class RankerNet(nn.Module):
@@ -79,7 +81,7 @@ class Labels:
     and which are real (C, K)."""
 
     def __init__(self, files: list[Path]) -> None:
-        xs, ys, masks = [], [], []
+        xs, ys = [], []
         for f in files:
             with np.load(f) as d:
                 pts, owner, err = d["points"], d["curve"], d["error"]
@@ -100,7 +102,7 @@ class Labels:
         return len(self.y)
 
 
-def _loss(net: RankerNet, x: torch.Tensor, y: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+def _loss(net: RankerNet, x: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, choice_weight: float) -> torch.Tensor:
     c, k = y.shape
     s = net(x.reshape(c * k, *x.shape[2:])).reshape(c, k)
     m = mask.float()
@@ -112,7 +114,7 @@ def _loss(net: RankerNet, x: torch.Tensor, y: torch.Tensor, mask: torch.Tensor) 
     target = torch.softmax(torch.where(mask, -y / TEMPERATURE, neg), dim=1)
     log_p = torch.log_softmax(torch.where(mask, -s / TEMPERATURE, neg), dim=1)
     choice = -(target * torch.where(mask, log_p, 0.0)).sum(1).mean()
-    return regression + 0.1 * choice
+    return regression + choice_weight * choice
 
 
 def pick_ratios(scores: np.ndarray, y: np.ndarray, mask: np.ndarray, reads: int = 2) -> dict[str, float]:
@@ -137,7 +139,9 @@ def train_ranker(
     *,
     time_budget: float,
     resume: bool = False,
+    init_from: str | Path | None = None,
     lr: float = 2e-3,
+    choice_weight: float = CHOICE_WEIGHT,
     batch_curves: int = 64,
     val_share: float = 0.1,
     seed: int = 0,
@@ -146,7 +150,8 @@ def train_ranker(
     """Train a ranker on every labels-*.npz in `labels_dir` for `time_budget` seconds (learning rate cosine over
     the budget), holding out `val_share` of the curves; `ranker-last.pt` (atomic, each epoch) lets `resume` carry
     on where a run stopped, with the time it had left; `ranker-best.pt` keeps the epoch whose held-out picks came
-    closest. Returns the best checkpoint's path."""
+    closest. `init_from`: a new run starting from a ranker checkpoint's weights. Returns the best checkpoint's
+    path."""
     files = sorted(Path(labels_dir).glob("labels-*.npz"))
     if not files:
         raise FileNotFoundError(f"{labels_dir}: no labels-*.npz (curve-vae ranker label writes them)")
@@ -159,6 +164,8 @@ def train_ranker(
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(seed)
     net = RankerNet()
+    if init_from is not None:
+        net.load_state_dict(torch.load(init_from, map_location="cpu", weights_only=False)["model"])
     opt = torch.optim.AdamW(net.parameters(), lr=lr, weight_decay=1e-4)
     state = {"epoch": 0, "spent": 0.0, "best": float("inf")}
     last, best_path = out / "ranker-last.pt", out / "ranker-best.pt"
@@ -177,7 +184,7 @@ def train_ranker(
             for g in opt.param_groups:
                 g["lr"] = lr * 0.5 * (1 + np.cos(np.pi * frac))
             b = torch.from_numpy(batch)
-            loss = _loss(net, x[b], y[b], mask[b])
+            loss = _loss(net, x[b], y[b], mask[b], choice_weight)
             opt.zero_grad()
             loss.backward()
             opt.step()

@@ -9,9 +9,7 @@ import argparse
 def cmd_label(a: argparse.Namespace) -> int:
     from curve_vae.training.ranker_labels import label_curves
 
-    files = label_curves(
-        a.model_dir, a.out, curves=a.curves, seed=a.seed, chunk=a.chunk, time_budget=a.time_budget
-    )
+    files = label_curves(a.model_dir, a.out, curves=a.curves, seed=a.seed, chunk=a.chunk, time_budget=a.time_budget)
     print(f"{len(files)} label files in {a.out} (train on them with curve-vae ranker train)")
     return 0
 
@@ -19,7 +17,16 @@ def cmd_label(a: argparse.Namespace) -> int:
 def cmd_train(a: argparse.Namespace) -> int:
     from curve_vae.training.ranker import train_ranker
 
-    best = train_ranker(a.labels, a.run_dir, time_budget=a.time_budget, resume=a.resume, lr=a.lr, seed=a.seed)
+    best = train_ranker(
+        a.labels,
+        a.run_dir,
+        time_budget=a.time_budget,
+        resume=a.resume,
+        init_from=a.init_from or None,
+        lr=a.lr,
+        choice_weight=a.choice_weight,
+        seed=a.seed,
+    )
     print(f"best held-out epoch → {best} (export it with curve-vae ranker export)")
     return 0
 
@@ -28,7 +35,7 @@ def cmd_export(a: argparse.Namespace) -> int:
     from curve_vae.training.ranker import export_ranker
 
     path = export_ranker(a.checkpoint, a.model_dir)
-    print(f"wrote {path}; the model's reading is now pose \"learned\" (the manifest names it)")
+    print(f'wrote {path}; the model\'s reading is now pose "learned" (the manifest names it)')
     return 0
 
 
@@ -50,11 +57,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--run-dir", default="runs/ranker", help="checkpoints go here (default: runs/ranker)")
     s.add_argument("--time-budget", type=float, default=600.0, help="seconds of training in all (default: 600)")
     s.add_argument("--resume", action="store_true", help="carry on from RUN_DIR/ranker-last.pt")
+    s.add_argument("--init-from", default="", help="start a new run from a ranker checkpoint's weights")
+    s.add_argument(
+        "--choice-weight",
+        type=float,
+        default=0.3,
+        help="weight of the cross-entropy on each curve's best (default: 0.3)",
+    )
     s.add_argument("--lr", type=float, default=2e-3, help="peak learning rate, cosine over the budget (default: 2e-3)")
     s.add_argument("--seed", type=int, default=0, help="held-out split and initial weights (default: 0)")
     s.set_defaults(func=cmd_train)
 
-    s = stages.add_parser("export", help="write the ranker into a model directory; its reading becomes \"learned\"")
+    s = stages.add_parser("export", help='write the ranker into a model directory; its reading becomes "learned"')
     s.add_argument("checkpoint", help="a ranker checkpoint (RUN_DIR/ranker-best.pt)")
     s.add_argument("--model-dir", required=True, help="the model directory whose graphs it was trained against")
     s.set_defaults(func=cmd_export)

@@ -1,0 +1,95 @@
+"""The reading ranker's training stages against a real (untrained, committed) model: labels written in chunks and
+resumed, training resumed where it stopped, the export read back by the runtime as the model's reading."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from curve_vae.inference.manifest import Manifest
+from curve_vae.inference.ranker import RANKED_READS, Ranker, ranker_inputs
+from curve_vae.inference.runtime import CurveRuntime
+from curve_vae.training.ranker import RankerNet, export_ranker, pick_ratios, train_ranker
+from curve_vae.training.ranker_labels import label_curves, user_curves
+from tests.helpers import bspline_curves
+
+
+@pytest.fixture(scope="module")
+def labels(closest_model_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("labels")
+    label_curves(closest_model_dir, out, curves=24, seed=5, chunk=8, say=lambda _: None)
+    return out
+
+
+def test_labels_hold_every_search_candidate_with_its_error(labels: Path):
+    files = sorted(labels.glob("labels-5-*.npz"))
+    assert [f.name for f in files] == [f"labels-5-{k:04d}.npz" for k in range(3)]
+    with np.load(files[0]) as d:
+        assert int(d["seed"]) == 5 and d["points"].shape[1:] == (161, 2)
+        per_curve = np.bincount(d["curve"])
+        assert len(per_curve) == 8 and np.all(per_curve >= 6)  # six poses, each as given (and natural readings)
+        assert set(np.unique(d["pose"])) == set(range(6)) and np.all(d["error"] > 0)
+
+
+def test_labelling_again_resumes_and_writes_only_what_is_missing(labels: Path, closest_model_dir: Path):
+    before = {f.name: f.stat().st_mtime_ns for f in labels.glob("*.npz")}
+    (labels / "labels-5-0001.npz").unlink()
+    said: list[str] = []
+    label_curves(closest_model_dir, labels, curves=24, seed=5, chunk=8, say=said.append)
+    after = {f.name: f.stat().st_mtime_ns for f in labels.glob("*.npz")}
+    assert set(after) == set(before) and len(said) == 1 and said[0].startswith("chunk 2/3")
+    assert after["labels-5-0000.npz"] == before["labels-5-0000.npz"]
+
+
+def test_user_curves_are_seeded_and_moved():
+    a, b = user_curves(6, seed=3), user_curves(6, seed=3)
+    assert all(np.array_equal(x, y) for x, y in zip(a, b)) and len({len(c) for c in a}) > 1
+
+
+def test_the_numpy_ranker_is_the_torch_net():
+    torch.manual_seed(1)
+    net = RankerNet().eval()
+    pts = np.asarray(bspline_curves(5, seed=2), np.float32)
+    with torch.no_grad():
+        expected = net(torch.from_numpy(ranker_inputs(pts))).numpy()
+    np.testing.assert_allclose(Ranker(net.weights()).scores(pts), expected, rtol=1e-4, atol=1e-5)
+
+
+def test_pick_ratios_measure_against_the_best():
+    y = np.log(np.array([[1.0, 2.0, 4.0], [3.0, 1.0, 9.0]]))
+    mask = np.ones_like(y, bool)
+    perfect = pick_ratios(-np.exp(-y), y, mask)
+    assert perfect == {"first": 1.0, "best_of_2": 1.0}
+    worst = pick_ratios(np.exp(-y), y, mask)  # ranked backwards: first picks 4 and 9, the best of two 2 and 3
+    assert worst["first"] == pytest.approx(13 / 2) and worst["best_of_2"] == pytest.approx(5 / 2)
+
+
+def test_training_resumes_where_it_stopped_and_exports_the_models_reading(
+    labels: Path, tmp_path: Path, closest_model_dir: Path
+):
+    said: list[str] = []
+    train_ranker(labels, tmp_path / "run", time_budget=2.0, say=said.append)
+    epochs = len(said)
+    assert epochs >= 1 and (tmp_path / "run" / "ranker-last.pt").is_file()
+    resumed: list[str] = []
+    best = train_ranker(labels, tmp_path / "run", time_budget=4.0, resume=True, say=resumed.append)
+    assert resumed[0].startswith(f"resumed at epoch {epochs}")
+    assert resumed[1].startswith(f"epoch {epochs + 1}:")
+
+    model = tmp_path / "model"
+    shutil.copytree(closest_model_dir, model)
+    export_ranker(best, model)
+    manifest = Manifest.read(model)
+    assert manifest.reading.pose == "learned" and manifest.ranker is not None
+    assert json.loads((model / "manifest.json").read_text())["ranker"]["held_out"]["best_of_2"] >= 1.0
+    runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
+    assert runtime.reading().pose == "learned"
+    curves = list(bspline_curves(3, seed=6))
+    before = runtime.graphs.rows["encoder"]
+    runtime.reconstruct(curves)
+    assert runtime.graphs.rows["encoder"] - before == RANKED_READS * len(curves)
