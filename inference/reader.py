@@ -169,7 +169,7 @@ class Reader:
             chosen = min(expected, key=expected.__getitem__)
             score = np.where(pose == chosen, score, np.inf)
         keep = [
-            rows[np.argsort(score[rows], kind="stable")[:RANKED_READS]]
+            _distinct(rows[np.argsort(score[rows], kind="stable")], models, RANKED_READS)
             for rows in (np.flatnonzero((owner == i) & (score < np.inf)) for i in np.unique(owner))
         ]
         return np.sort(np.concatenate(keep))
@@ -339,6 +339,22 @@ class Reader:
             curves = Ragged.of(inputs)
             return curves.split(FrameRows.of(frames).to_model(curves, self.graphs.model_size))  # type: ignore[arg-type]
         return [f.to_model(p, self.graphs.model_size) if f is not None else p for f, p in zip(frames, inputs)]
+
+
+#: Candidates whose model-plane points all lie within this (plane units; the plane is 128 across) are one reading:
+#: a symmetric curve reversed and mirrored end for end is itself again.
+SAME_POINTS = 1e-3
+
+
+def _distinct(ranked: np.ndarray, models: np.ndarray, count: int) -> np.ndarray:
+    """The first `count` of `ranked` (candidate rows, best first) whose model-plane points differ from those kept."""
+    kept = [int(ranked[0])]
+    for k in ranked[1:]:
+        if len(kept) == count:
+            break
+        if all(np.abs(models[k] - models[j]).max() > SAME_POINTS for j in kept):
+            kept.append(int(k))
+    return np.array(kept)
 
 
 def _beyond(framed: bool) -> str:

@@ -37,6 +37,8 @@ HIDDEN = 96
 TEMPERATURE = 0.1
 #: Weight of that softmax's cross-entropy beside the regression of the centred log errors.
 CHOICE_WEIGHT = 0.3
+#: Every VAL_EVERY-th labelled curve is held out of training: the picks are measured on them each epoch.
+VAL_EVERY = 10
 
 
 class RankerNet(nn.Module):
@@ -143,26 +145,24 @@ def train_ranker(
     lr: float = 2e-3,
     choice_weight: float = CHOICE_WEIGHT,
     batch_curves: int = 64,
-    val_share: float = 0.1,
     seed: int = 0,
     say: Callable[[str], None] = print,
 ) -> Path:
     """Train a ranker on every labels-*.npz in `labels_dir` for `time_budget` seconds (learning rate cosine over
-    the budget), holding out `val_share` of the curves; `ranker-last.pt` (atomic, each epoch) lets `resume` carry
-    on where a run stopped, with the time it had left; `ranker-best.pt` keeps the epoch whose held-out picks came
-    closest. `init_from`: a new run starting from a ranker checkpoint's weights. Returns the best checkpoint's
-    path."""
+    the budget), holding out every VAL_EVERY-th curve (in the files' order, so labels added later keep the split);
+    `ranker-last.pt` (atomic, each epoch) lets `resume` carry on where a run stopped, with the time it had left;
+    `ranker-best.pt` keeps the epoch whose held-out picks came closest. `init_from`: a new run starting from a
+    ranker checkpoint's weights. Returns the best checkpoint's path."""
     files = sorted(Path(labels_dir).glob("labels-*.npz"))
     if not files:
         raise FileNotFoundError(f"{labels_dir}: no labels-*.npz (curve-vae ranker label writes them)")
     data = Labels(files)
-    rng = np.random.default_rng(seed)
-    order = rng.permutation(len(data))
-    n_val = max(1, int(len(data) * val_share))
-    val, train = order[:n_val], order[n_val:]
+    held = np.arange(len(data)) % VAL_EVERY == 0
+    val, train = np.flatnonzero(held), np.flatnonzero(~held)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(seed)
+    rng = np.random.default_rng(seed)
     net = RankerNet()
     if init_from is not None:
         net.load_state_dict(torch.load(init_from, map_location="cpu", weights_only=False)["model"])
@@ -175,24 +175,15 @@ def train_ranker(
         opt.load_state_dict(ck["optimizer"])
         state = ck["state"]
         say(f"resumed at epoch {state['epoch']}, {state['spent']:.0f} s of {time_budget:.0f} spent")
-    x, y, mask = (torch.from_numpy(a) for a in (data.x, data.y, data.mask))
+    tensors = tuple(torch.from_numpy(a) for a in (data.x, data.y, data.mask))
     start = time.monotonic() - state["spent"]
     while time.monotonic() - start < time_budget:
-        net.train()
-        for batch in np.array_split(rng.permutation(train), max(1, len(train) // batch_curves)):
-            frac = min((time.monotonic() - start) / time_budget, 1.0)
-            for g in opt.param_groups:
-                g["lr"] = lr * 0.5 * (1 + np.cos(np.pi * frac))
-            b = torch.from_numpy(batch)
-            loss = _loss(net, x[b], y[b], mask[b], choice_weight)
-            opt.zero_grad()
-            loss.backward()
-            opt.step()
+        loss = _epoch(net, opt, tensors, rng.permutation(train), batch_curves, choice_weight, lr, start, time_budget)
         state["epoch"] += 1
         state["spent"] = time.monotonic() - start
         ratios = pick_ratios(_scores(net, data.x[val]), data.y[val], data.mask[val])
         say(
-            f"epoch {state['epoch']}: loss {loss.item():.4f}, held-out picks {ratios['first']:.3f}× the best "
+            f"epoch {state['epoch']}: loss {loss:.4f}, held-out picks {ratios['first']:.3f}× the best "
             f"(best of two: {ratios['best_of_2']:.3f}×), {state['spent']:.0f}/{time_budget:.0f} s"
         )
         if ratios["best_of_2"] < state["best"]:
@@ -200,6 +191,33 @@ def train_ranker(
             atomic_save({"model": net.state_dict(), "ratios": ratios, "epoch": state["epoch"]}, best_path)
         atomic_save({"model": net.state_dict(), "optimizer": opt.state_dict(), "state": state}, last)
     return best_path
+
+
+def _epoch(
+    net: RankerNet,
+    opt: torch.optim.Optimizer,
+    tensors: tuple[torch.Tensor, ...],
+    order: np.ndarray,
+    batch_curves: int,
+    choice_weight: float,
+    lr: float,
+    start: float,
+    time_budget: float,
+) -> float:
+    """One pass over the training curves in `order`, the learning rate cosine in the time spent; the last loss."""
+    x, y, mask = tensors
+    net.train()
+    loss = torch.zeros(())
+    for batch in np.array_split(order, max(1, len(order) // batch_curves)):
+        frac = min((time.monotonic() - start) / time_budget, 1.0)
+        for g in opt.param_groups:
+            g["lr"] = lr * 0.5 * (1 + np.cos(np.pi * frac))
+        b = torch.from_numpy(batch)
+        loss = _loss(net, x[b], y[b], mask[b], choice_weight)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+    return float(loss.item())
 
 
 def _scores(net: RankerNet, x: np.ndarray) -> np.ndarray:
