@@ -46,8 +46,8 @@ from curve_vae.inference.placing import (
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.priors import NamedPrior, load_priors
-from curve_vae.inference.reader import Reader
 from curve_vae.inference.ranker import Ranker
+from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import Augmented, Curves, Encoding, Interpolation, Reconstruction, Sampled
 from curve_vae.inference.sampling import MAX_DRAWS, Sampler, fresh_seed
