@@ -58,7 +58,7 @@ PoseMode = Annotated[
             'so all of them give the same curve back, at the cost of one encoding. "search": six poses (the chord '
             "turned to -90°, -45° or -135°, each also reversed and mirrored end for end) encoded and decoded, the "
             'reconstruction closest to the input kept (6× the inference). "learned": the same candidates (and, with '
-            'spacing "search", each one\'s natural reading) ranked by the model\'s reading ranker from their points, '
+            "spacing \"search\", each one's natural reading) ranked by the model's reading ranker from their points, "
             "only the first two encoded and the closer kept (2× the inference; needs a model with a ranker, GET "
             '/model: ranker). "as_is": the curve as it is listed. '
             'Results come back in the caller\'s pose. With frame "model" curves are taken as they are.'
