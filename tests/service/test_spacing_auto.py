@@ -29,7 +29,7 @@ def _each_reading(runtime, curves, monkeypatch, **options) -> dict[str, Reconstr
     fit's reading, and the reading of the fit from the arc-length fractions (where it ends elsewhere)."""
     out = {sp: runtime.reconstruct(curves, Reading(spacing=sp, **options)) for sp in ("parameter", "natural")}
     with monkeypatch.context() as m:
-        m.setattr(reader_module, "natural_params", lambda pts: natural_readings(pts)[-1])
+        m.setattr(reader_module, "natural_readings_of", lambda many: [natural_readings(pts)[-1:] for pts in many])
         out["natural, from arc length"] = runtime.reconstruct(curves, Reading(spacing="natural", **options))
     return out
 
