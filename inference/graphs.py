@@ -112,6 +112,11 @@ class ModelGraphs:
         return self.knots is not None
 
     @property
+    def onnxruntime_version(self) -> str:
+        """The onnxruntime release the graphs run on (GET /model states it)."""
+        return str(ort.__version__)
+
+    @property
     def providers(self) -> list[str]:
         """Providers the sessions actually run on (a fallback shows here)."""
         return list(self.encoder.get_providers())

@@ -18,10 +18,9 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
-import onnxruntime as ort
 
 MODELS = ("encoder", "decoder")
 PLATFORM = "onnxruntime_onnx"  # what Triton calls a model served by onnxruntime
@@ -66,7 +65,26 @@ class Signature:
     outputs: tuple[Tensor, ...]
 
 
-def tensors(args: list[ort.NodeArg]) -> tuple[Tensor, ...]:
+class NodeArg(Protocol):
+    """What a graph session says of one of its inputs or outputs (onnxruntime's NodeArg)."""
+
+    name: str
+    type: str
+    shape: list[Any]
+
+
+class Session(Protocol):
+    """The calls this module makes on a graph session (the runtime's onnxruntime sessions answer them): the HTTP layer
+    never imports onnxruntime itself."""
+
+    def get_inputs(self) -> list[NodeArg]: ...
+
+    def get_outputs(self) -> list[NodeArg]: ...
+
+    def run(self, output_names: list[str], input_feed: dict[str, np.ndarray]) -> list[Any]: ...
+
+
+def tensors(args: list[NodeArg]) -> tuple[Tensor, ...]:
     """The protocol's view of an onnxruntime session's inputs or outputs (symbolic axes such as "batch" → -1)."""
     return tuple(
         Tensor(a.name, DATATYPES.get(a.type, a.type), tuple(d if isinstance(d, int) else -1 for d in a.shape))
@@ -74,7 +92,7 @@ def tensors(args: list[ort.NodeArg]) -> tuple[Tensor, ...]:
     )
 
 
-def signature(session: ort.InferenceSession) -> Signature:
+def signature(session: Session) -> Signature:
     return Signature(tensors(session.get_inputs()), tensors(session.get_outputs()))
 
 
@@ -240,7 +258,7 @@ def _requested_outputs(requested: Any, model: str, sig: Signature) -> list[str]:
     return names or known
 
 
-def infer(session: ort.InferenceSession, req: Request, *, batch_size: int) -> dict[str, np.ndarray]:
+def infer(session: Session, req: Request, *, batch_size: int) -> dict[str, np.ndarray]:
     """Run the graph on the request in runs of `batch_size` rows; raises OipError where an output is not finite."""
     parts: list[list[np.ndarray]] = [[] for _ in req.outputs]
     for start in range(0, req.batch, batch_size):

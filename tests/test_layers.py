@@ -1,6 +1,7 @@
 """The import graph: geometry at the bottom, the inference package on it, the HTTP layer and training beside each other
 on top of inference, the command line on top of all. A module imports only from its own layer or below, so no cycle
-runs between layers; the service and inference never import torch."""
+runs between layers; the service and inference never import torch, and the service reaches onnxruntime only through
+inference."""
 
 from __future__ import annotations
 
@@ -80,6 +81,8 @@ def test_a_module_imports_only_its_own_layer_or_below(module):
     for line, name in _imports(MODULES[module]):
         if name.split(".")[0] == "torch":
             assert not module.startswith(NO_TORCH) or module in FOR_TORCH, f"{module}:{line} imports torch"
+        if name.split(".")[0] == "onnxruntime":  # the HTTP layer asks inference for what onnxruntime knows
+            assert not module.startswith("curve_vae.service"), f"{module}:{line} imports onnxruntime"
         if name.startswith(FOR_TORCH):
             assert module in FOR_TORCH or _part(module) == "curve_vae.commands", f"{module}:{line} imports {name}"
         if not name.startswith("curve_vae.") or name == "curve_vae.__version__":

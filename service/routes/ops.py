@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import onnxruntime as ort
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from starlette.exceptions import HTTPException
@@ -79,7 +78,7 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
         "cache": runtime.cache.stats() if runtime.cache is not None else None,
         "providers": runtime.graphs.providers,
         "requested_providers": runtime.graphs.requested_providers,
-        "onnxruntime": ort.__version__,
+        "onnxruntime": runtime.graphs.onnxruntime_version,
         "metrics": m.metrics,
         "limits": {
             "max_curves": settings.max_curves,
