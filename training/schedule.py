@@ -1,12 +1,14 @@
 """Learning-rate schedules of a run, by step or by training time: the clock of a time budget and the schedule's
-shape (one-cycle, cosine, constant, plateau)."""
+shape (one-cycle, cosine, constant, plateau); the bars that show a run's progress by either."""
 
 from __future__ import annotations
 
 import math
 import time
+from contextlib import AbstractContextManager, nullcontext
 
 import torch
+from tqdm import tqdm
 
 from curve_vae.training.config import TrainConfig
 
@@ -70,3 +72,30 @@ def make_schedule(opt: torch.optim.Optimizer, cfg: TrainConfig, steps_per_epoch:
     if cfg.schedule == "plateau":
         return torch.optim.lr_scheduler.ReduceLROnPlateau(opt, factor=0.5, patience=5)
     return None
+
+
+def time_budget_bar(budget: float, spent: float, shown: bool) -> tqdm | None:
+    """A time-budgeted run ends with its budget, not after an epoch count: its bar shows seconds (None: no budget)."""
+    if budget <= 0:
+        return None
+    return tqdm(
+        total=round(budget),
+        initial=round(min(spent, budget)),
+        desc="time budget",
+        unit="s",
+        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total:.0f} s{postfix}",
+        disable=not shown,
+        leave=False,
+        dynamic_ncols=True,
+    )
+
+
+def epoch_bar(
+    epoch: int, epochs: int, n_curves: int, shown: bool, budget_bar: tqdm | None
+) -> AbstractContextManager[tqdm]:
+    """The coming epoch's bar, closed with the epoch: the run's time-budget bar (left open), or the epoch's curves."""
+    if budget_bar is not None:
+        return nullcontext(budget_bar)
+    return tqdm(
+        total=n_curves, desc=f"epoch {epoch}/{epochs}", unit="curve", disable=not shown, leave=False, dynamic_ncols=True
+    )

@@ -5,8 +5,9 @@ twin: (N, 2, n_points, 2)): the model owns the architecture, `losses` owns the o
 picks. Run under `torchrun --nproc-per-node K` for data-parallel training (gloo on CPU, nccl on GPU); a single
 process needs no launcher. Checkpoint files are training/checkpoint.py's.
 
-The schedules and the clock of a time budget are training.schedule's, the process (device, DDP rank) is
-training.process'; `train()` reads top to bottom: set-up, then each epoch's pass, validation, record and stop rules.
+The schedules, the clock of a time budget and the progress bars are training.schedule's, the process (device, DDP
+rank) is training.process'; `train()` reads top to bottom: set-up, then each epoch's pass, validation, record and
+stop rules.
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ import json
 import math
 import random
 import time
-from contextlib import nullcontext
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -41,7 +41,7 @@ from curve_vae.training.data import DataConfig, load_or_generate
 from curve_vae.training.losses import closest_loss, mixed_loss, vae_loss
 from curve_vae.training.model import SAMPLES_PER_INTERVAL, VAE
 from curve_vae.training.process import Process, agree, autocast, start_process, wrap
-from curve_vae.training.schedule import Clock, make_schedule, schedule_factor
+from curve_vae.training.schedule import Clock, epoch_bar, make_schedule, schedule_factor, time_budget_bar
 from curve_vae.training.validation import validation_measure
 
 __all__ = ["SCHEDULES", "TrainConfig", "schedule_factor", "train", "train_one_epoch"]
@@ -201,22 +201,6 @@ def _restore(
     return RunState()
 
 
-def _budget_bar(cfg: TrainConfig, state: RunState, shown: bool) -> tqdm | None:
-    """A time-budgeted run ends with its budget, not after an epoch count: its bar shows seconds."""
-    if cfg.time_budget <= 0:
-        return None
-    return tqdm(
-        total=round(cfg.time_budget),
-        initial=round(min(state.trained_seconds, cfg.time_budget)),
-        desc="time budget",
-        unit="s",
-        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total:.0f} s{postfix}",
-        disable=not shown,
-        leave=False,
-        dynamic_ncols=True,
-    )
-
-
 def _validate(proc: Process, parts: _Parts, val: torch.Tensor, cfg: TrainConfig) -> float:
     """The validation MSE, rank 0's on every process, so that all stop together; a plateau schedule steps on it."""
     val_mse = validation_measure(cfg.match)(parts.model, val, device=proc.device)
@@ -263,20 +247,6 @@ def _epoch_order(gen: np.random.Generator, n_curves: int, proc: Process, per_epo
     """This process's share of a fresh permutation (the same on every rank), `per_epoch` curves."""
     perm = torch.from_numpy(gen.permutation(n_curves))
     return perm[proc.rank :: proc.world][:per_epoch]
-
-
-def _epoch_bar(cfg: TrainConfig, state: RunState, n_curves: int, shown: bool, budget_bar: tqdm | None):
-    """The coming epoch's bar, closed with the epoch: the run's time-budget bar (left open), or the epoch's curves."""
-    if budget_bar is not None:
-        return nullcontext(budget_bar)
-    return tqdm(
-        total=n_curves,
-        desc=f"epoch {state.epoch + 1}/{cfg.epochs}",
-        unit="curve",
-        disable=not shown,
-        leave=False,
-        dynamic_ncols=True,
-    )
 
 
 def _close_epoch(
@@ -328,6 +298,51 @@ def _stop_reason(cfg: TrainConfig, state: RunState, clock: Clock) -> str | None:
     return None
 
 
+def _check_match(model_cfg: ModelConfig, cfg: TrainConfig) -> None:
+    """A loss on the decoded spline needs the B-spline head; "mixed" needs it at even parameters."""
+    if cfg.match != "index" and not model_cfg.spline_ctrl:
+        raise ValueError(f"match {cfg.match!r} measures the decoded spline: it needs the B-spline head (--spline-ctrl)")
+    if cfg.match == "mixed" and model_cfg.spline_params:
+        # its index half measures the decoder's even parameters, which learned parameters would not serve
+        raise ValueError('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
+
+
+def _run_epochs(
+    run_dir: Path,
+    proc: Any,
+    net: Any,
+    parts: _Parts,
+    state: RunState,
+    splits: tuple[Any, Any],
+    configs: dict[str, Any],
+    cfg: TrainConfig,
+    *,
+    end: int,
+    progress: bool,
+) -> None:
+    """Epochs until `end` (or patience or the time budget runs out): train, validate, record, checkpoint."""
+    data, val = splits
+    steps_per_epoch = _steps_per_epoch(len(data), proc, cfg)
+    shown = progress and proc.rank == 0
+    budget_bar = time_budget_bar(cfg.time_budget, state.trained_seconds, shown)
+    while state.epoch < end:
+        t0 = time.perf_counter()
+        order = _epoch_order(parts.gen, len(data), proc, steps_per_epoch * (cfg.batch_size // proc.world))
+        with epoch_bar(state.epoch + 1, cfg.epochs, len(order), shown, budget_bar) as bar, parts.clock as clock:
+            terms = train_one_epoch(net, data, order, parts.opt, parts.sched, cfg, proc.device, bar=bar, clock=clock)
+        train_time = time.perf_counter() - t0
+        val_mse = _validate(proc, parts, val, cfg)
+        row, improved = _close_epoch(state, parts, terms, val_mse, train_time, cfg)
+        if proc.rank == 0:
+            _record_epoch(run_dir, _checkpoint(configs, parts, state), row, improved, cfg)
+        stop = _stop_reason(cfg, state, parts.clock)
+        if stop:
+            proc.say(stop)
+            break
+    if budget_bar is not None:
+        budget_bar.close()
+
+
 def train(
     run_dir: str | Path,
     model_cfg: ModelConfig,
@@ -349,11 +364,7 @@ def train(
     fresh optimiser and schedule: fine-tuning, or continuing the shipped model on a new machine.
     """
     run_dir = Path(run_dir)
-    if cfg.match != "index" and not model_cfg.spline_ctrl:
-        raise ValueError(f"match {cfg.match!r} measures the decoded spline: it needs the B-spline head (--spline-ctrl)")
-    if cfg.match == "mixed" and model_cfg.spline_params:
-        # its index half measures the decoder's even parameters, which learned parameters would not serve
-        raise ValueError('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
+    _check_match(model_cfg, cfg)
     proc = start_process(cfg)
     try:
         torch.manual_seed(cfg.seed)
@@ -370,26 +381,7 @@ def train(
             _write_config(run_dir, configs)
 
         end = cfg.epochs if not stop_after else min(cfg.epochs, state.epoch + stop_after)
-        shown = progress and proc.rank == 0
-        budget_bar = _budget_bar(cfg, state, shown)
-        while state.epoch < end:
-            t0 = time.perf_counter()
-            order = _epoch_order(parts.gen, len(data), proc, steps_per_epoch * (cfg.batch_size // proc.world))
-            with _epoch_bar(cfg, state, len(order), shown, budget_bar) as bar, parts.clock as clock:
-                terms = train_one_epoch(
-                    net, data, order, parts.opt, parts.sched, cfg, proc.device, bar=bar, clock=clock
-                )
-            train_time = time.perf_counter() - t0
-            val_mse = _validate(proc, parts, val, cfg)
-            row, improved = _close_epoch(state, parts, terms, val_mse, train_time, cfg)
-            if proc.rank == 0:
-                _record_epoch(run_dir, _checkpoint(configs, parts, state), row, improved, cfg)
-            stop = _stop_reason(cfg, state, parts.clock)
-            if stop:
-                proc.say(stop)
-                break
-        if budget_bar is not None:
-            budget_bar.close()
+        _run_epochs(run_dir, proc, net, parts, state, (data, val), configs, cfg, end=end, progress=progress)
         return state
     finally:
         if proc.distributed and dist.is_initialized():
