@@ -188,7 +188,19 @@ def train_ranker(
         )
         if ratios["best_of_2"] < state["best"]:
             state["best"] = ratios["best_of_2"]
-            atomic_save({"model": net.state_dict(), "ratios": ratios, "epoch": state["epoch"]}, best_path)
+            trained = {
+                "curves": len(train),
+                "held_out_curves": len(val),
+                "label_files": [f.name for f in files],
+                "epoch": state["epoch"],
+                "seconds": round(state["spent"], 1),
+                "lr": lr,
+                "choice_weight": choice_weight,
+                "seed": seed,
+                "init_from": str(init_from) if init_from is not None else None,
+            }
+            best_ck = {"model": net.state_dict(), "ratios": ratios, "epoch": state["epoch"], "trained": trained}
+            atomic_save(best_ck, best_path)
         atomic_save({"model": net.state_dict(), "optimizer": opt.state_dict(), "state": state}, last)
     return best_path
 
@@ -230,9 +242,18 @@ def _scores(net: RankerNet, x: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------- export
 
 
-def export_ranker(checkpoint: str | Path, model_dir: str | Path, *, meta: dict[str, Any] | None = None) -> Path:
-    """Write the checkpoint's weights as `ranker.npz` in `model_dir` and name it in the manifest, whose reading
-    becomes pose "learned" (both written atomically). Returns the weights' path."""
+def export_ranker(
+    checkpoint: str | Path,
+    model_dir: str | Path,
+    *,
+    meta: dict[str, Any] | None = None,
+    default: bool = True,
+    version: str | None = None,
+) -> Path:
+    """Write the checkpoint's weights as `ranker.npz` in `model_dir` and name it in the manifest with how it was
+    trained and how it measured (both written atomically). `default`: the model's reading becomes pose "learned"
+    (else it stays as it was and "learned" is there to ask for); `version`: the model's new version. Returns the
+    weights' path."""
     ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
     net = RankerNet()
     net.load_state_dict(ck["model"])
@@ -244,7 +265,16 @@ def export_ranker(checkpoint: str | Path, model_dir: str | Path, *, meta: dict[s
     manifest_path = root / "manifest.json"
     manifest = json.loads(manifest_path.read_text())
     manifest["files"]["ranker.npz"] = {"sha256": file_sha256(path), "bytes": path.stat().st_size}
-    manifest["ranker"] = {"file": "ranker.npz", "kind": RANKER_KIND, **(meta or {}), "held_out": ck.get("ratios")}
-    manifest["reading"] = {"pose": "learned", "spacing": "search"}
+    manifest["ranker"] = {
+        "file": "ranker.npz",
+        "kind": RANKER_KIND,
+        **(meta or {}),
+        "held_out": ck.get("ratios"),
+        "trained": ck.get("trained"),
+    }
+    if default:
+        manifest["reading"] = {"pose": "learned", "spacing": "search"}
+    if version is not None:
+        manifest["version"] = version
     atomic_write_text(manifest_path, json.dumps(manifest, indent=2) + "\n")
     return path

@@ -34,8 +34,10 @@ def cmd_train(a: argparse.Namespace) -> int:
 def cmd_export(a: argparse.Namespace) -> int:
     from curve_vae.training.ranker import export_ranker
 
-    path = export_ranker(a.checkpoint, a.model_dir)
-    print(f'wrote {path}; the model\'s reading is now pose "learned" (the manifest names it)')
+    meta = {"note": a.note} if a.note else None
+    path = export_ranker(a.checkpoint, a.model_dir, meta=meta, default=not a.not_default, version=a.version or None)
+    reading = 'pose "learned" is there to ask for' if a.not_default else 'the model\'s reading is now pose "learned"'
+    print(f"wrote {path}; {reading} (the manifest names it)")
     return 0
 
 
@@ -71,4 +73,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s = stages.add_parser("export", help='write the ranker into a model directory; its reading becomes "learned"')
     s.add_argument("checkpoint", help="a ranker checkpoint (RUN_DIR/ranker-best.pt)")
     s.add_argument("--model-dir", required=True, help="the model directory whose graphs it was trained against")
+    s.add_argument("--not-default", action="store_true", help='keep the model\'s reading; "learned" only on request')
+    s.add_argument("--version", default="", help="the model's new version (default: unchanged)")
+    s.add_argument("--note", default="", help="how the ranker was trained, in words, kept in the manifest")
     s.set_defaults(func=cmd_export)

@@ -13,6 +13,7 @@ import torch
 
 from curve_vae.inference.manifest import Manifest
 from curve_vae.inference.ranker import RANKED_READS, Ranker, ranker_inputs
+from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.ranker import RankerNet, export_ranker, pick_ratios, train_ranker
 from curve_vae.training.ranker_labels import label_curves, user_curves
@@ -83,13 +84,34 @@ def test_training_resumes_where_it_stopped_and_exports_the_models_reading(
 
     model = tmp_path / "model"
     shutil.copytree(closest_model_dir, model)
-    export_ranker(best, model)
+    export_ranker(best, model, version="9.9.9")
     manifest = Manifest.read(model)
-    assert manifest.reading.pose == "learned" and manifest.ranker is not None
-    assert json.loads((model / "manifest.json").read_text())["ranker"]["held_out"]["best_of_2"] >= 1.0
+    assert manifest.reading.pose == "learned" and manifest.ranker is not None and manifest.version == "9.9.9"
+    named = json.loads((model / "manifest.json").read_text())["ranker"]
+    assert named["held_out"]["best_of_2"] >= 1.0
+    assert named["trained"]["label_files"] == [f.name for f in sorted(labels.glob("labels-*.npz"))]
+    trained = named["trained"]
+    assert 0 < trained["seconds"] <= 4.0 + 60 and trained["curves"] > trained["held_out_curves"] > 0
     runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
     assert runtime.reading().pose == "learned"
     curves = list(bspline_curves(3, seed=6))
     before = runtime.graphs.rows["encoder"]
     runtime.reconstruct(curves)
     assert runtime.graphs.rows["encoder"] - before == RANKED_READS * len(curves)
+
+
+def test_export_can_leave_the_models_reading_and_version_as_they_were(
+    labels: Path, tmp_path: Path, closest_model_dir: Path
+):
+    best = train_ranker(labels, tmp_path / "run", time_budget=1.0, say=lambda _: None)
+    model = tmp_path / "model"
+    shutil.copytree(closest_model_dir, model)
+    before = Manifest.read(model)
+    export_ranker(best, model, default=False)
+    after = Manifest.read(model)
+    assert after.ranker is not None and after.reading == before.reading and after.version == before.version
+    runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
+    curves = list(bspline_curves(2, seed=7))
+    before_rows = runtime.graphs.rows["encoder"]
+    runtime.reconstruct(curves, Reading(pose="learned", spacing="search"))  # there when asked for
+    assert runtime.graphs.rows["encoder"] - before_rows == RANKED_READS * len(curves)
