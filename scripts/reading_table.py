@@ -5,7 +5,10 @@ mirrored and reversed at random; 40 moved as drawn; 20 real UIUC airfoils (none 
 10 analytic shapes, moved. Each cell: mean relative RMSE (% of the bounding-box diagonal, at the curve's own
 points) and, last, milliseconds of one core per curve (one onnxruntime thread, encoding cache off, whole sets).
 
-    .venv/bin/python scripts/reading_table.py [--model-dir models] [--json out.json]
+    .venv/bin/python scripts/reading_table.py [--model-dir models] [--json out.json] [--morphs 40]
+
+`--morphs N`: also the morph suite (training/morphs.py: N pairs of paper curves drawn in one pose, swept in 7 steps)
+with the search and the learned reading, as a Markdown table: how far in-betweens turn and drift.
 """
 
 from __future__ import annotations
@@ -72,6 +75,7 @@ def main() -> None:
     p.add_argument("--model-dir", default="models")
     p.add_argument("--json", default="", help="also write the table here")
     p.add_argument("--readings", nargs="*", default=list(READINGS), help="rows (default: all)")
+    p.add_argument("--morphs", type=int, default=0, help="pairs of the morph suite per reading (default: none)")
     a = p.parse_args()
     rt = CurveRuntime.load(a.model_dir, intra_op_threads=1, cache_bytes=0)
     sets = table_sets()
@@ -88,6 +92,12 @@ def main() -> None:
         row["ms_per_curve"] = 1000 * spent / count
         out[name] = row
         print(f"{name:34s}" + "".join(f"{row[k]:20.3f}%" for k in sets) + f"{row['ms_per_curve']:10.1f}", flush=True)
+    if a.morphs:
+        from curve_vae.training.morphs import format_morphs, morph_pairs, run_morphs
+
+        swept = {k: READINGS[k] for k in list(READINGS)[:2]}  # the search and the learned reading
+        out["morphs"] = run_morphs(rt, morph_pairs(paper_test_split(), a.morphs), readings=swept)
+        print(format_morphs(out["morphs"]))
     if a.json:
         with open(a.json, "w") as fh:
             json.dump(out, fh, indent=2)

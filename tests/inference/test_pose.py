@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from curve_vae.geometry import sample_bspline
+from curve_vae.geometry import resample, sample_bspline
 from curve_vae.inference.reading import Reading
+from tests.helpers import bspline_curves
 
 
 def _rot(a: float) -> np.ndarray:
@@ -31,6 +32,26 @@ def test_reconstruction_does_not_care_about_the_move(shipped_runtime, move):
     (own,) = shipped_runtime.reconstruct([c]).curves
     (moved,) = shipped_runtime.reconstruct([there(c)]).curves
     np.testing.assert_allclose(back(moved), own, atol=1e-3 * np.ptp(c))
+
+
+@pytest.mark.parametrize("move", MOVES)
+def test_the_learned_reading_does_not_care_about_the_move(shipped_runtime, move):
+    """Pose "learned": the ranker scores the search's candidates from their model-plane points, which a curve and
+    its reversal, mirror image or rotation share to rounding, so each comes back as the same curve, moved (within
+    1e-3 of its size); curves of several kinds, as drawn and by arc length."""
+    t = np.linspace(0.0, 1.0, 90)
+    curves = [
+        _stroke(),
+        *bspline_curves(2, seed=41),
+        resample(bspline_curves(1, seed=42)[0], 70),
+        np.c_[np.cos(np.pi * t), 0.6 * np.sin(np.pi * t)],  # half an ellipse: symmetric, two readings alike
+    ]
+    there, back = MOVES[move]
+    learned = Reading(pose="learned", spacing="search")
+    own = shipped_runtime.reconstruct(curves, learned).curves
+    moved = shipped_runtime.reconstruct([there(c) for c in curves], learned).curves
+    for c, a, b in zip(curves, own, moved):
+        np.testing.assert_allclose(back(b), a, atol=1e-3 * np.ptp(c))
 
 
 def test_pose_auto_beats_as_is_on_a_stroke_unlike_the_papers_curves(shipped_runtime):
