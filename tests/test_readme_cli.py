@@ -3,9 +3,11 @@ few flags appended that shrink the data set and the number of epochs (argparse k
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -23,6 +25,10 @@ TINY = {
     "evaluate": ["--fresh-seed", "-1", "--suite-count", "8", "--morph-count", "2"],
     "average": ["--bn-curves", "128"],
     "augment": ["--count", "300"],
+    "ranker label": ["--curves", "24", "--chunk", "12"],
+    "ranker train": ["--time-budget", "3"],
+    # the shipped model stays as it is: the ranker is exported into a copy (the last --model-dir wins)
+    "ranker export": ["--model-dir", "model-copy"],
 }
 ORDER = ["dataset", "train", "average", "export", "evaluate", "prior", "sample", "augment", "fit", "revolve"]
 
@@ -65,14 +71,21 @@ def _inputs(cwd: Path) -> None:
         else:
             (mine / f"c{i}.json").write_text(json.dumps(c))
     (cwd / "models").symlink_to(ROOT / "models")  # --init-from models/vae.pt, as in the repository
+    shutil.copytree(ROOT / "models", cwd / "model-copy", ignore=shutil.ignore_patterns("paper", "vae.pt"))
+
+
+def _tiny(argv: list[str]) -> list[str]:
+    """The flags that shrink a command to seconds (a `ranker` stage by its stage)."""
+    return TINY.get(" ".join(argv[:2]) if argv[0] == "ranker" else argv[0], [])
 
 
 @pytest.mark.slow
 def test_readme_cli_commands_run_as_written(tmp_path):
     _inputs(tmp_path)
+    shipped = {f.name: hashlib.sha256(f.read_bytes()).hexdigest() for f in (ROOT / "models").glob("*") if f.is_file()}
     commands = sorted(readme_commands(), key=lambda argv: ORDER.index(argv[0]) if argv[0] in ORDER else len(ORDER))
     for argv in commands:
-        full = [sys.executable, "-m", "curve_vae.cli", *argv, *TINY.get(argv[0], [])]
+        full = [sys.executable, "-m", "curve_vae.cli", *argv, *_tiny(argv)]
         run = subprocess.run(full, cwd=tmp_path, capture_output=True, text=True, timeout=600)
         assert run.returncode == 0, f"{shlex.join(argv)} failed:\n{run.stderr[-3000:]}"
         assert "Traceback" not in run.stderr and "Warning" not in run.stderr, run.stderr[-3000:]
@@ -88,6 +101,10 @@ def test_readme_cli_commands_run_as_written(tmp_path):
         "vase.obj",
         "priors/mine.npz",
         "mine_samples.json",
+        "runs/ranker/ranker-best.pt",
+        "model-copy/ranker.npz",
     ]:
         assert (tmp_path / made).is_file(), made
+    now = {f.name: hashlib.sha256(f.read_bytes()).hexdigest() for f in (ROOT / "models").glob("*") if f.is_file()}
+    assert now == shipped, "a documented command changed the shipped model"
     assert np.load(tmp_path / "batch.npy").shape[0] == 300

@@ -4,6 +4,7 @@ labels, export into a model directory. Every stage is time-budgeted and resumabl
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 
 def cmd_label(a: argparse.Namespace) -> int:
@@ -32,8 +33,10 @@ def cmd_train(a: argparse.Namespace) -> int:
 
 
 def cmd_export(a: argparse.Namespace) -> int:
+    from curve_vae.files import refuse_overwrite
     from curve_vae.training.ranker import export_ranker
 
+    refuse_overwrite(Path(a.model_dir) / "ranker.npz", a.force, flag="--model-dir")
     meta = {"note": a.note} if a.note else None
     path = export_ranker(a.checkpoint, a.model_dir, meta=meta, default=not a.not_default, version=a.version or None)
     reading = 'pose "learned" is there to ask for' if a.not_default else 'the model\'s reading is now pose "learned"'
@@ -76,4 +79,5 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--not-default", action="store_true", help='keep the model\'s reading; "learned" only on request')
     s.add_argument("--version", default="", help="the model's new version (default: unchanged)")
     s.add_argument("--note", default="", help="how the ranker was trained, in words, kept in the manifest")
+    s.add_argument("--force", action="store_true", help="replace the model directory's ranker if it has one")
     s.set_defaults(func=cmd_export)

@@ -115,3 +115,17 @@ def test_export_can_leave_the_models_reading_and_version_as_they_were(
     before_rows = runtime.graphs.rows["encoder"]
     runtime.reconstruct(curves, Reading(pose="learned", spacing="search"))  # there when asked for
     assert runtime.graphs.rows["encoder"] - before_rows == RANKED_READS * len(curves)
+
+
+def test_the_command_line_keeps_a_models_ranker_unless_forced(labels: Path, tmp_path: Path, closest_model_dir: Path):
+    from curve_vae.cli import main
+
+    best = train_ranker(labels, tmp_path / "run", time_budget=1.0, say=lambda _: None)
+    model = tmp_path / "model"
+    shutil.copytree(closest_model_dir, model)
+    assert main(["ranker", "export", str(best), "--model-dir", str(model)]) == 0
+    kept = (model / "ranker.npz").read_bytes(), (model / "manifest.json").read_text()
+    assert main(["ranker", "export", str(best), "--model-dir", str(model), "--version", "2.0.0"]) == 2
+    assert ((model / "ranker.npz").read_bytes(), (model / "manifest.json").read_text()) == kept
+    assert main(["ranker", "export", str(best), "--model-dir", str(model), "--version", "2.0.0", "--force"]) == 0
+    assert Manifest.read(model).version == "2.0.0"
