@@ -18,6 +18,7 @@ from typing import TextIO
 
 from curve_vae import __version__
 from curve_vae.commands import curves, data, design, generate, model, priors, ranker, train
+from curve_vae.errors import CurveVaeError
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -86,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         _show_file_warnings(args.command)
         try:
             return int(args.func(args) or 0)
-        except (ValueError, FileNotFoundError, RuntimeError) as e:
+        except (CurveVaeError, ValueError, FileNotFoundError, RuntimeError) as e:
             print(f"curve-vae {args.command}: error: {e}", file=sys.stderr)
             return 2
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline, sample_bspline
 from curve_vae.geometry.frame import Frame, arc_fractions, at_fractions, resample
 from curve_vae.geometry.natural import natural_params
@@ -29,7 +30,7 @@ from curve_vae.geometry.natural import natural_params
 F32_MAX = float(np.finfo(np.float32).max)
 
 
-class BeyondFloat32(ValueError):
+class BeyondFloat32(InvalidInput):
     """A curve whose model-plane points are not finite float32 numbers (its frame's scale under- or overflows, or
     its own coordinates are that large)."""
 

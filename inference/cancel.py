@@ -16,8 +16,10 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from curve_vae.errors import CancelledWork
 
-class Cancelled(Exception):
+
+class Cancelled(CancelledWork):
     """The work was abandoned: its client went away, or it passed its time limit."""
 
 

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from curve_vae.errors import InvalidInput
 
-class InputError(ValueError):
+
+class InputError(InvalidInput):
     """A well-formed request the model cannot process; `loc` names the field, curve and point."""
 
     def __init__(self, loc: Sequence[str | int], msg: str) -> None:

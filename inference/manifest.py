@@ -17,6 +17,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from curve_vae.errors import ModelError
 from curve_vae.files import atomic_write_text
 from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.inference.choices import ModelPose, ModelSpacing
@@ -26,7 +27,7 @@ MANIFEST_VERSION = 1
 MANIFEST_FILE = "manifest.json"
 
 
-class ModelLoadError(RuntimeError):
+class ModelLoadError(ModelError):
     """The model directory or the providers cannot serve: raised at startup, never per request."""
 
 

@@ -22,6 +22,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from curve_vae.errors import ProtocolError
+
 MODELS = ("encoder", "decoder")
 PLATFORM = "onnxruntime_onnx"  # what Triton calls a model served by onnxruntime
 #: onnxruntime's tensor types → the protocol's data types
@@ -39,7 +41,7 @@ REQUEST_FIELDS = ("id", "parameters", "inputs", "outputs")
 TENSOR_FIELDS = ("name", "shape", "datatype", "data", "parameters")
 
 
-class OipError(Exception):
+class OipError(ProtocolError):
     """A request the protocol answers with `{"error": msg}` and `status` (400: bad request, 404: no such model)."""
 
     def __init__(self, msg: str, status: int = 400) -> None:

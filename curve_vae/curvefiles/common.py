@@ -10,11 +10,13 @@ from typing import Any
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
+
 #: Fewest points of a curve: what the service takes (four [x, y] pairs).
 MIN_POINTS = 4
 
 
-class CurveFileError(ValueError):
+class CurveFileError(InvalidInput):
     """A curve file that cannot be read; the message names the file, and the line or element where it helps."""
 
 
