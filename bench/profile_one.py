@@ -1,9 +1,11 @@
-"""Where a single-curve one-pass request's time goes in-process: `CurveRuntime.reconstruct` of one caller curve with
-pose "canonical", spacing "parameter" (one encoding, one decoding), no cache, one 1-thread session pair, under
-cProfile; each stage's share of the time, and the wall time per request without the profiler.
+"""Where a single-curve request's time goes in-process: `CurveRuntime.reconstruct` of one caller curve, no cache,
+one 1-thread session pair, under cProfile; each stage's share of the time, and the wall time per request without
+the profiler. `--reading one-pass` (the default): pose "canonical", spacing "parameter" (one encoding, one
+decoding); `--reading default`: what a request with default fields gets (the shipped model's learned reading).
 
     .venv/bin/python -m bench.profile_one                 # 300 requests
     .venv/bin/python -m bench.profile_one --markdown      # the table docs/BENCHMARKS.md shows
+    .venv/bin/python -m bench.profile_one --reading default --markdown
 
 Stages are named by the functions they run (cumulative time), so the same script measures an older checkout too.
 """
@@ -33,25 +35,37 @@ STAGES = {
     "back to the caller, MSE": [("placing.py", "to_caller"), ("placing.py", "placed_to_caller")],
 }
 ONE_PASS = Reading(pose="canonical", spacing="parameter")
+#: the default request's stages: the candidates' poses and natural spacings, the ranker, then as one pass
+DEFAULT_STAGES = {
+    "the two graphs (onnxruntime)": STAGES["the two graphs (onnxruntime)"],
+    "natural-spacing fit": [("natural.py", "natural_readings_of")],
+    "candidate poses": [("frame.py", "pose_frames")],
+    "reading ranker": [("ranker.py", "scores")],
+    "to the model plane": STAGES["to the model plane"],
+    "placement on the spline": STAGES["placement on the spline"],
+    "back to the caller, MSE": STAGES["back to the caller, MSE"],
+}
+READINGS = {"one-pass": (ONE_PASS, STAGES), "default": (Reading(), DEFAULT_STAGES)}
 
 
-def measure(model_dir: Path, requests: int) -> dict[str, float]:
+def measure(model_dir: Path, requests: int, reading: str = "one-pass") -> dict[str, float]:
+    asked, stages = READINGS[reading]
     rt = CurveRuntime.load(model_dir, sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
     one = list(ceiling.callers_curves(ceiling.curves(1, seed=1), seed=1))
-    rt.reconstruct(one, ONE_PASS)
+    rt.reconstruct(one, asked)
     start = time.perf_counter()
     for _ in range(requests):
-        rt.reconstruct(one, ONE_PASS)
+        rt.reconstruct(one, asked)
     wall = (time.perf_counter() - start) / requests * 1e3
     prof = cProfile.Profile()
     prof.enable()
     for _ in range(requests):
-        rt.reconstruct(one, ONE_PASS)
+        rt.reconstruct(one, asked)
     prof.disable()
     stats = pstats.Stats(prof).stats  # type: ignore[attr-defined]
     total = max(ct for (_, _, name), (_, _, _, ct, _) in stats.items() if name == "reconstruct")
     out = {"wall_ms_per_request": wall}
-    for stage, functions in STAGES.items():
+    for stage, functions in stages.items():
         out[stage] = (
             sum(
                 ct
@@ -68,9 +82,10 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--model-dir", default=str(ROOT / "models"), help="the model (default: the shipped one)")
     p.add_argument("--requests", type=int, default=300, help="single-curve requests (default: 300)")
+    p.add_argument("--reading", choices=list(READINGS), default="one-pass", help="the request's reading")
     p.add_argument("--markdown", action="store_true", help="print a Markdown table")
     a = p.parse_args()
-    r = measure(Path(a.model_dir), a.requests)
+    r = measure(Path(a.model_dir), a.requests, a.reading)
     if a.markdown:
         print("| stage | share of the request |\n|---|---|")
         for k, v in r.items():

@@ -1,5 +1,6 @@
-"""bench.profile_one's smoke run: a few single-curve one-pass requests profiled, every stage found, so the script
-that BENCHMARKS' profile table comes from does not rot. The numbers mean nothing here (the suite shares the CPU)."""
+"""bench.profile_one's smoke run: a few single-curve requests profiled (one-pass and default), every stage found, so
+the script that BENCHMARKS' profile tables come from does not rot. The numbers mean nothing here (the suite shares
+the CPU)."""
 
 from __future__ import annotations
 
@@ -13,12 +14,14 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.skipif(not (ROOT / "models" / "manifest.json").is_file(), reason="no shipped model")
-def test_the_profile_names_each_stage_and_they_add_up():
-    from bench.profile_one import STAGES, measure
+@pytest.mark.parametrize("reading", ["one-pass", "default"])
+def test_the_profile_names_each_stage_and_they_add_up(reading):
+    from bench.profile_one import READINGS, measure
 
-    shares = measure(ROOT / "models", requests=5)
-    assert set(STAGES) <= set(shares) and shares["wall_ms_per_request"] > 0
-    for stage in STAGES:  # every stage's functions ran: a renamed function would show as 0
+    stages = READINGS[reading][1]
+    shares = measure(ROOT / "models", requests=5, reading=reading)
+    assert set(stages) <= set(shares) and shares["wall_ms_per_request"] > 0
+    for stage in stages:  # every stage's functions ran: a renamed function would show as 0
         assert 0 < shares[stage] < 1, stage
     assert sum(v for k, v in shares.items() if k != "wall_ms_per_request") == pytest.approx(1.0)
 
