@@ -24,6 +24,8 @@ ALLOWED: dict[str, set[str]] = {
     "curve_vae.training": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
     "curve_vae.triton": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
     "curve_vae.distributed": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
+    # generation metrics and prior reports: evaluation, beside the serving core, not in it
+    "curve_vae.evaluation": {"curve_vae.geometry", "curve_vae.base", "curve_vae.inference"},
     "curve_vae.commands": {
         "curve_vae.geometry",
         "curve_vae.base",
@@ -32,11 +34,19 @@ ALLOWED: dict[str, set[str]] = {
         "curve_vae.training",
         "curve_vae.triton",
         "curve_vae.distributed",
+        "curve_vae.evaluation",
     },
 }
 #: `curve-vae serve` is the one command that starts the HTTP layer.
 SERVE_ENTRY = ("curve_vae.cli", "curve_vae.service.cli")
-NO_TORCH = ("curve_vae.geometry", "curve_vae.base", "curve_vae.inference", "curve_vae.service", "curve_vae.client")
+NO_TORCH = (
+    "curve_vae.geometry",
+    "curve_vae.base",
+    "curve_vae.inference",
+    "curve_vae.service",
+    "curve_vae.client",
+    "curve_vae.evaluation",
+)
 #: Modules of those parts that exist for torch users: imported only by them, never by the rest.
 FOR_TORCH = ("curve_vae.client.dataset",)
 

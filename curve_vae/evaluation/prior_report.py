@@ -1,4 +1,4 @@
-"""A prior's samples against held-out curves, with the field's metrics (inference.generation) and their intervals
+"""A prior's samples against held-out curves, with the field's metrics (evaluation.generation) and their intervals
 over seeds: what `curve-vae evaluate-prior` prints and docs/RESULTS.md tabulates.
 
 Samples come from `CurveRuntime.sample(prior=…)` exactly as /sample makes them (in the frame of their nearest
@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from curve_vae.evaluation import generation as g
 from curve_vae.geometry import resample
-from curve_vae.inference import generation as g
 
 #: BézierGAN's airfoils have 192 points; MMD compares 2000 samples against the test set.
 POINTS = 192
@@ -39,7 +39,7 @@ def evaluate_prior(
     likelihood_samples: int = 500,
     lsc_lines: int = 100,
 ) -> dict[str, Any]:
-    """Every metric of inference.generation per seed, and its mean ± 1.96·σ/√n over the seeds."""
+    """Every metric of evaluation.generation per seed, and its mean ± 1.96·σ/√n over the seeds."""
     ref, tr = resampled(held_out, points), resampled(train, points)
     named = runtime.priors.get(prior)
     runs: dict[str, list[float]] = {}

@@ -1,4 +1,4 @@
-"""inference.generation: each metric on sets whose answer is known — identical sets, shifted sets, a set and its
+"""evaluation.generation: each metric on sets whose answer is known — identical sets, shifted sets, a set and its
 copy, a linear decoder."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from curve_vae.inference import generation as g
+from curve_vae.evaluation import generation as g
 from tests.helpers import bspline_curves
 
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from curve_vae.inference.evaluate_prior import real_yardstick, resampled
+from curve_vae.evaluation.prior_report import real_yardstick, resampled
 
 
 def _waves(count: int, shift: float = 0.0) -> np.ndarray:
