@@ -8,6 +8,7 @@ hadolint and kubernetes-validate (the `test` extra) lint them too where they are
 from __future__ import annotations
 
 import fnmatch
+import json
 import re
 import shlex
 import shutil
@@ -29,7 +30,10 @@ K8S = ROOT / "deploy" / "k8s"
 #: Where a readiness check may look: 200 only once the model is loaded (service/routes/ops.py, routes/oip.py).
 READINESS = {"/ready", "/v2/health/ready"}
 LIVENESS = {"/health", "/v2/health/live"}
-MODEL_FILES = ["manifest.json", "encoder.onnx", "decoder.onnx", "prior.npz"]
+#: what the service reads from the baked-in model: every file its manifest names but the torch weights
+MODEL_FILES = sorted(set(json.loads((ROOT / "models" / "manifest.json").read_text())["files"]) - {"vae.pt"})
+#: every source folder the package installs from (pyproject's package-dir), which `pip install .` needs
+PACKAGE_DIRS = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-dir"].values())
 
 
 # ------------------------------------------------------------------------------------------- reading Dockerfiles
@@ -194,7 +198,8 @@ def test_what_the_images_copy_exists_and_is_in_the_build_context(path):
                 continue
             *sources, _dest = [a for a in shlex.split(args) if not a.startswith("--")]
             copied += sources
-    assert {"pyproject.toml", "README.md", "curve_vae", "geometry", "service", "models"} <= set(copied), copied
+    missing = ({"pyproject.toml", "README.md", "curve_vae"} | PACKAGE_DIRS) - set(copied)
+    assert not missing, f"{path.name} does not COPY {sorted(missing)}: pip install . fails without them"
     for src in copied:
         assert (ROOT / src).exists(), f"{path.name}: COPY {src}: not in the repository"
         assert not ignored(src, patterns), f"{path.name}: COPY {src}, but {path.name}.dockerignore leaves it out"
