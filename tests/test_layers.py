@@ -37,6 +37,9 @@ ALLOWED: dict[str, set[str]] = {
         "curve_vae.evaluation",
     },
 }
+for _part_name, _allowed in ALLOWED.items():  # the exceptions' root is beneath every layer
+    if _part_name != "curve_vae.errors":
+        _allowed.add("curve_vae.errors")
 #: `curve-vae serve` is the one command that starts the HTTP layer.
 SERVE_ENTRY = ("curve_vae.cli", "curve_vae.service.cli")
 NO_TORCH = (
@@ -101,8 +104,6 @@ def test_a_module_imports_only_its_own_layer_or_below(module):
         if (module, name) == SERVE_ENTRY:
             continue
         theirs = _part(name)
-        if theirs == "curve_vae.errors":
-            continue
         assert theirs == mine or theirs in ALLOWED[mine], f"{module}:{line} imports {name} ({theirs} above {mine})"
 
 

@@ -163,18 +163,17 @@ def train_ranker(
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
-    net = RankerNet()
-    if init_from is not None:
-        net.load_state_dict(torch.load(init_from, map_location="cpu", weights_only=False)["model"])
-    opt = torch.optim.AdamW(net.parameters(), lr=lr, weight_decay=1e-4)
-    state = {"epoch": 0, "spent": 0.0, "best": float("inf")}
     last, best_path = out / "ranker-last.pt", out / "ranker-best.pt"
-    if resume and last.exists():
-        ck = torch.load(last, map_location="cpu", weights_only=False)
-        net.load_state_dict(ck["model"])
-        opt.load_state_dict(ck["optimizer"])
-        state = ck["state"]
-        say(f"resumed at epoch {state['epoch']}, {state['spent']:.0f} s of {time_budget:.0f} spent")
+    net, opt, state = _start(last if resume else None, init_from, lr, time_budget, say)
+    run = {  # how the kept checkpoint was trained: export writes it into the manifest
+        "curves": len(train),
+        "held_out_curves": len(val),
+        "label_files": [f.name for f in files],
+        "lr": lr,
+        "choice_weight": choice_weight,
+        "seed": seed,
+        "init_from": str(init_from) if init_from is not None else None,
+    }
     tensors = tuple(torch.from_numpy(a) for a in (data.x, data.y, data.mask))
     start = time.monotonic() - state["spent"]
     while time.monotonic() - start < time_budget:
@@ -188,21 +187,30 @@ def train_ranker(
         )
         if ratios["best_of_2"] < state["best"]:
             state["best"] = ratios["best_of_2"]
-            trained = {
-                "curves": len(train),
-                "held_out_curves": len(val),
-                "label_files": [f.name for f in files],
-                "epoch": state["epoch"],
-                "seconds": round(state["spent"], 1),
-                "lr": lr,
-                "choice_weight": choice_weight,
-                "seed": seed,
-                "init_from": str(init_from) if init_from is not None else None,
-            }
+            trained = {**run, "epoch": state["epoch"], "seconds": round(state["spent"], 1)}
             best_ck = {"model": net.state_dict(), "ratios": ratios, "epoch": state["epoch"], "trained": trained}
             atomic_save(best_ck, best_path)
         atomic_save({"model": net.state_dict(), "optimizer": opt.state_dict(), "state": state}, last)
     return best_path
+
+
+def _start(
+    last: Path | None, init_from: str | Path | None, lr: float, time_budget: float, say: Callable[[str], None]
+) -> tuple[RankerNet, torch.optim.Optimizer, dict[str, Any]]:
+    """The net, its optimiser and the run's state: resumed from `last` where it exists, else new (from
+    `init_from`'s weights if given)."""
+    net = RankerNet()
+    if init_from is not None:
+        net.load_state_dict(torch.load(init_from, map_location="cpu", weights_only=False)["model"])
+    opt = torch.optim.AdamW(net.parameters(), lr=lr, weight_decay=1e-4)
+    state: dict[str, Any] = {"epoch": 0, "spent": 0.0, "best": float("inf")}
+    if last is not None and last.exists():
+        ck = torch.load(last, map_location="cpu", weights_only=False)
+        net.load_state_dict(ck["model"])
+        opt.load_state_dict(ck["optimizer"])
+        state = ck["state"]
+        say(f"resumed at epoch {state['epoch']}, {state['spent']:.0f} s of {time_budget:.0f} spent")
+    return net, opt, state
 
 
 def _epoch(

@@ -89,8 +89,8 @@ def test_training_resumes_where_it_stopped_and_exports_the_models_reading(
     assert manifest.reading.pose == "learned" and manifest.ranker is not None and manifest.version == "9.9.9"
     named = json.loads((model / "manifest.json").read_text())["ranker"]
     assert named["held_out"]["best_of_2"] >= 1.0
-    assert named["trained"]["label_files"] == [f.name for f in sorted(labels.glob("labels-*.npz"))]
     trained = named["trained"]
+    assert trained["label_files"] == [f.name for f in sorted(labels.glob("labels-*.npz"))]
     assert 0 < trained["seconds"] <= 4.0 + 60 and trained["curves"] > trained["held_out_curves"] > 0
     runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
     assert runtime.reading().pose == "learned"
