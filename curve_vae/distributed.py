@@ -15,6 +15,7 @@ curve_vae.client.writers uses, so `read_parquet_dir` reads them back in order. N
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -104,7 +105,7 @@ def augment_on_ray(
         "seed": seed,
         "mode": mode,
         "neighbours": neighbours,
-        "reading": {"frame": r.frame, "pose": r.pose, "spacing": r.spacing, "refine": r.refine},
+        "reading": asdict(r),
         "n_points": n_points,
     }
     ds = ray.data.from_items(blocks, override_num_blocks=len(blocks)).map_batches(

@@ -3,24 +3,97 @@ the command line take their values from here (`typing.get_args(Spacing)` gives a
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Literal, get_args
 
-#: "auto": each curve shifted and uniformly scaled into the model's plane, results mapped back; "model": the points
-#: are in the paper's 128×128 plane already.
+
+@dataclass(frozen=True)
+class Option:
+    """One reading option's documentation, value by value: the request schema's description, the command line's
+    help and the error naming the values are all made of it, so adding a value means one line here beside its
+    Literal (a test checks the two agree) and its implementation."""
+
+    summary: str  # one line: the command line's help
+    values: Mapping[str, str]  # each value and what it does, in the order they are shown
+    before: str = ""  # the description's opening, before the values
+    after: str = ""  # its closing, after them
+    ge: int | None = None  # an integer option's bounds
+    le: int | None = None
+
+    def description(self, default: object) -> str:
+        """The full description, the default value marked "(default)"."""
+        parts = [f'"{v}"{" (default)" if v == default else ""}: {what}' for v, what in self.values.items()]
+        return " ".join(p for p in (self.before, *parts, self.after) if p)
+
+
 FrameMode = Literal["auto", "model"]
+FRAME = Option(
+    "frame of the curves: auto, anywhere at any size; model, already in the paper's 128×128 plane",
+    {
+        "auto": "each curve is shifted and uniformly scaled into the model's frame and results are mapped back, so "
+        "curves may be anywhere at any size.",
+        "model": "coordinates are already in the paper's 128×128 plane (curves about 100 units across, centred on "
+        "(64, 64)) and pass untouched.",
+    },
+)
 
-#: How a curve is turned before it is encoded. "canonical": the one pose geometry.canonical_frame gives the curve
-#: and its reversal, mirror image and rotations alike (one encoding); "search": six candidate poses encoded and
-#: decoded, the closest reconstruction kept (geometry.pose_frames); "learned": the search's candidates ranked by
-#: the model's reading ranker (inference.ranker) and only its first two encoded; "as_is": as it is listed; "auto":
-#: the reading the model was trained for (its manifest's `reading.pose`).
 Pose = Literal["auto", "canonical", "search", "learned", "as_is"]
+POSE = Option(
+    "how each curve is turned before it is encoded, as the service's `pose`; results come back in the caller's pose",
+    {
+        "auto": "the reading the model was trained for (GET /model: reading.pose).",
+        "canonical": "one pose the curve, its reversal, its mirror image and every rotation of it share — mirrored "
+        "if it turns clockwise, its chord (first point to last) turned straight down, and reversed and mirrored end "
+        "for end where its centre of mass lies towards its start — so all of them give the same curve back, at the "
+        "cost of one encoding.",
+        "search": "six poses (the chord turned to -90°, -45° or -135°, each also reversed and mirrored end for end) "
+        "encoded and decoded, the reconstruction closest to the input kept (6× the inference).",
+        "learned": 'the same candidates (and, with spacing "search", each one\'s natural reading) ranked by the '
+        "model's reading ranker from their points, only the first two encoded and the closer kept (2× the "
+        "inference; needs a model with a ranker, GET /model: ranker).",
+        "as_is": "the curve as it is listed.",
+    },
+    before='How a curve is turned before it is encoded (frame "auto").',
+    after='Results come back in the caller\'s pose. With frame "model" curves are taken as they are.',
+)
 
-#: How a curve's points are read along it. "parameter": as given, interpolated along their order; "natural": at
-#: even steps of the parameters of the cubic B-spline fitted to it (geometry.natural_params); "arc_length": evenly
-#: by arc length; "search": "parameter" and each natural reading tried, the closest reconstruction kept; "auto":
-#: the model's own reading (its manifest's `reading.spacing`).
 Spacing = Literal["auto", "parameter", "natural", "arc_length", "search"]
+SPACING = Option(
+    "how each curve's points are read along it, as the service's `spacing`",
+    {
+        "auto": "the model's own reading (GET /model: reading.spacing).",
+        "parameter": "the points as given, interpolated along their order (50, 161 or 500 samples of a curve give "
+        "the same result).",
+        "natural": "the curve read at even steps of the parameters of the cubic B-spline with 10 control points "
+        "fitted to it closest (the paper's curves' own spacing, whatever spacing they came in).",
+        "arc_length": "every curve resampled evenly by arc length, and returned curves spaced so.",
+        "search": '"parameter" and each natural reading tried, the reconstruction closest to the input kept (2–3× '
+        "the inference).",
+    },
+    before="How the points of a curve are read along it.",
+    after="Returned curves of `n_points` are at the model's own spacing (evenly in its spline parameter) except "
+    'with "arc_length".',
+)
+
+#: Most fitting steps a request may ask for (each costs about 7 decoder runs per curve: a Jacobian of 32 runs every
+#: 5th step, one run per step; inference/fitting.py).
+MAX_REFINE_STEPS = 30
+
+REFINE = Option(
+    "Levenberg–Marquardt fitting steps on each latent after encoding, as the service's `refine`",
+    {},
+    before="Fitting steps (default 0: none). After encoding, each curve's latent is refined by this many "
+    "Levenberg–Marquardt steps that bring the decoded curve closer to the input's own points, each point "
+    "measured to its closest point on the curve, and the returned points are those closest points: a closer "
+    "fit for several times the compute of a plain reconstruction (docs/RESULTS.md has the trade-off). "
+    "Needs a model with a B-spline head; a request's work, steps × (input points + 300 per curve), is "
+    "limited by the server (GET /model: limits.max_refine_work). In /encode, the returned means are the "
+    "refined latents; in /interpolate the refined latents are mixed, so the ends of a sweep are the refined "
+    "reconstructions.",
+    ge=0,
+    le=MAX_REFINE_STEPS,
+)
 
 #: The poses and spacings a model's manifest may name as its own reading (everything but "auto").
 ModelPose = Literal["canonical", "search", "learned", "as_is"]

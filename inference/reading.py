@@ -11,18 +11,33 @@ concrete, so everything past it sees one of the explicit values.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, fields, replace
+from functools import cache
+from typing import Any, get_args, get_type_hints
 
-from curve_vae.inference.choices import FrameMode, Pose, Spacing
+from curve_vae.inference.choices import FRAME, POSE, REFINE, SPACING, FrameMode, Option, Pose, Spacing
+from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ReadingSpec
 
 
 @dataclass(frozen=True)
 class Reading:
-    frame: FrameMode = "auto"
-    pose: Pose = "auto"
-    spacing: Spacing = "auto"
-    refine: int = 0  # Levenberg–Marquardt steps on each latent after encoding (inference.fitting)
+    """The one definition of the reading options: the request schema (service.schemas.ReadingIn), the command line's
+    flags (commands.options.add_reading_options) and the client's typed parameters are derived from these fields
+    and the `Option` each carries (inference.choices)."""
+
+    frame: FrameMode = field(default="auto", metadata={"option": FRAME})
+    pose: Pose = field(default="auto", metadata={"option": POSE})
+    spacing: Spacing = field(default="auto", metadata={"option": SPACING})
+    refine: int = field(default=0, metadata={"option": REFINE})  # Levenberg–Marquardt steps (inference.fitting)
+
+    def __post_init__(self) -> None:
+        for o in reading_options():
+            value = getattr(self, o.name)
+            if o.values and value not in o.values:
+                raise InputError((o.name,), f"{value!r} is not one of {', '.join(map(repr, o.values))}")
+            if not o.values and not _within(value, o.doc):
+                raise InputError((o.name,), f"expected an integer from {o.doc.ge} to {o.doc.le}, got {value!r}")
 
     def resolved(self, model: ReadingSpec) -> Reading:
         """The reading with "auto" replaced by the model's own; with frame "model" curves keep their pose."""
@@ -39,3 +54,32 @@ class Reading:
     def key(self) -> str:
         """The reading as a cache key."""
         return f"{self.frame}/{self.pose}/{self.spacing}/{self.refine}"
+
+
+def _within(value: object, doc: Option) -> bool:
+    """An integer (not a bool) within the option's bounds."""
+    if type(value) is not int:
+        return False
+    return (doc.ge is None or value >= doc.ge) and (doc.le is None or value <= doc.le)
+
+
+@dataclass(frozen=True)
+class ReadingOption:
+    """One field of `Reading` as a front end needs it: its name, type, default, values (none for an integer) and
+    documentation."""
+
+    name: str
+    kind: Any  # the Literal of its values, or int
+    default: Any
+    values: tuple[str, ...]
+    doc: Option
+
+
+@cache
+def reading_options() -> tuple[ReadingOption, ...]:
+    """`Reading`'s fields, in order."""
+    hints = get_type_hints(Reading)
+    return tuple(
+        ReadingOption(f.name, hints[f.name], f.default, get_args(hints[f.name]), f.metadata["option"])
+        for f in fields(Reading)
+    )

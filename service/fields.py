@@ -1,5 +1,5 @@
 """The field types of the v1 request bodies, each with the documentation the OpenAPI page shows: numbers, points,
-curves, the reading's choices, seeds, frames (service.schemas builds the requests of them)."""
+curves, the reading's options (made from inference.reading), seeds, frames (service.schemas builds the requests)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from pydantic_core import PydanticCustomError
 
 from curve_vae.geometry import Frame
 from curve_vae.inference import choices
+from curve_vae.inference.reading import ReadingOption
 
 FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # numbers only: no "1.5", no true
 
@@ -36,74 +37,14 @@ Curve = Annotated[
     AfterValidator(_distinct),
 ]
 
-FrameMode = Annotated[
-    choices.FrameMode,
-    Field(
-        description=(
-            '"auto": each curve is shifted and uniformly scaled into the model\'s frame and results are '
-            'mapped back, so curves may be anywhere at any size. "model": coordinates are already in the '
-            "paper's 128×128 plane (curves about 100 units across, centred on (64, 64)) and pass untouched."
-        )
-    ),
-]
 
-PoseMode = Annotated[
-    choices.Pose,
-    Field(
-        description=(
-            'How a curve is turned before it is encoded (frame "auto"). "auto" (default): the reading the model was '
-            'trained for (GET /model: reading.pose). "canonical": one pose the curve, its reversal, its mirror image '
-            "and every rotation of it share — mirrored if it turns clockwise, its chord (first point to last) turned "
-            "straight down, and reversed and mirrored end for end where its centre of mass lies towards its start — "
-            'so all of them give the same curve back, at the cost of one encoding. "search": six poses (the chord '
-            "turned to -90°, -45° or -135°, each also reversed and mirrored end for end) encoded and decoded, the "
-            'reconstruction closest to the input kept (6× the inference). "learned": the same candidates (and, with '
-            "spacing \"search\", each one's natural reading) ranked by the model's reading ranker from their points, "
-            "only the first two encoded and the closer kept (2× the inference; needs a model with a ranker, GET "
-            '/model: ranker). "as_is": the curve as it is listed. '
-            'Results come back in the caller\'s pose. With frame "model" curves are taken as they are.'
-        )
-    ),
-]
+def reading_field(option: ReadingOption) -> tuple[Any, Any]:
+    """A request field for one of the reading's options (inference.reading): its values or bounds and its
+    description, as `pydantic.create_model` takes them (service.schemas.ReadingIn)."""
+    doc = option.doc
+    bounds = {"ge": doc.ge, "le": doc.le, "strict": True} if not option.values else {}
+    return Annotated[option.kind, Field(description=doc.description(option.default), **bounds)], option.default
 
-SpacingMode = Annotated[
-    choices.Spacing,
-    Field(
-        description=(
-            'How the points of a curve are read along it. "auto" (default): the model\'s own reading (GET /model: '
-            'reading.spacing). "parameter": the points as given, interpolated along their order (50, 161 or 500 '
-            'samples of a curve give the same result). "natural": the curve read at even steps of the parameters '
-            "of the cubic B-spline with 10 control points fitted to it closest (the paper's curves' own spacing, "
-            'whatever spacing they came in). "arc_length": every curve resampled evenly by arc length, and returned '
-            'curves spaced so. "search": "parameter" and each natural reading tried, the reconstruction closest to '
-            "the input kept (2–3× the inference). Returned curves of `n_points` are at the model's own spacing "
-            '(evenly in its spline parameter) except with "arc_length".'
-        )
-    ),
-]
-
-#: Most fitting steps a request may ask for (each costs about 7 decoder runs per curve: a Jacobian of 32 runs every
-#: 5th step, one run per step; inference/fitting.py).
-MAX_REFINE_STEPS = 30
-
-RefineSteps = Annotated[
-    int,
-    Field(
-        ge=0,
-        le=MAX_REFINE_STEPS,
-        strict=True,
-        description=(
-            "Fitting steps (default 0: none). After encoding, each curve's latent is refined by this many "
-            "Levenberg–Marquardt steps that bring the decoded curve closer to the input's own points, each point "
-            "measured to its closest point on the curve, and the returned points are those closest points: a closer "
-            "fit for several times the compute of a plain reconstruction (docs/RESULTS.md has the trade-off). "
-            "Needs a model with a B-spline head; a request's work, steps × (input points + 300 per curve), is "
-            "limited by the server (GET /model: limits.max_refine_work). In /encode, the returned means are the "
-            "refined latents; in /interpolate the refined latents are mixed, so the ends of a sweep are the refined "
-            "reconstructions."
-        ),
-    ),
-]
 
 NPoints = Annotated[
     int | None,

@@ -9,26 +9,25 @@ request shares are written once: `CurvesIn` (the curves), `ReadingIn` (how they 
 
 from __future__ import annotations
 
-from pydantic import BaseModel, Field, model_validator
+from typing import TYPE_CHECKING
+
+from pydantic import BaseModel, Field, create_model, model_validator
 from pydantic_core import PydanticCustomError
 
 from curve_vae.inference import choices
-from curve_vae.inference.reading import Reading
-from curve_vae.service.fields import (  # noqa: F401  (MAX_REFINE_STEPS, FrameInfo: part of the schemas' API)
-    MAX_REFINE_STEPS,
+from curve_vae.inference.choices import MAX_REFINE_STEPS  # noqa: F401  (part of the schemas' API)
+from curve_vae.inference.reading import Reading, reading_options
+from curve_vae.service.fields import (  # noqa: F401  (FrameInfo: part of the schemas' API)
     MAX_SAFE_INTEGER,
     Curve,
     FiniteFloat,
     FrameInfo,
-    FrameMode,
     MetricsFlag,
     NPoints,
     OutputMode,
-    PoseMode,
-    RefineSteps,
     Seed,
-    SpacingMode,
     _Request,
+    reading_field,
 )
 
 
@@ -38,16 +37,25 @@ class CurvesIn(_Request):
     curves: list[Curve] = Field(min_length=1, description="One or more curves (at most CURVE_VAE_MAX_CURVES).")
 
 
-class ReadingIn(BaseModel):
-    """How a request's curves are read into the model."""
-
-    frame: FrameMode = "auto"
-    pose: PoseMode = "auto"
-    spacing: SpacingMode = "auto"
-    refine: RefineSteps = 0
+class _ReadingFields(BaseModel):
+    """How a request's curves are read into the model: one field per option of inference.reading.Reading."""
 
     def reading(self) -> Reading:
-        return Reading(self.frame, self.pose, self.spacing, self.refine)
+        return Reading(**{o.name: getattr(self, o.name) for o in reading_options()})
+
+
+# The fields are Reading's, made here rather than written again (frame, pose, spacing, refine: their values, bounds,
+# defaults and descriptions); the type checker sees the base, and reads the options through `reading()`.
+if TYPE_CHECKING:
+    ReadingIn = _ReadingFields
+else:
+    ReadingIn = create_model(
+        "ReadingIn",
+        __base__=_ReadingFields,
+        __doc__=_ReadingFields.__doc__,
+        __module__=__name__,
+        **{o.name: reading_field(o) for o in reading_options()},
+    )
 
 
 class OutputIn(BaseModel):
@@ -72,7 +80,7 @@ class DecodeRequest(_Request, OutputIn):
     latents: list[list[FiniteFloat]] = Field(
         min_length=1, description="One or more latent vectors, each of the model's latent_dim (see GET /model)."
     )
-    spacing: SpacingMode = "parameter"
+    spacing: choices.Spacing = Field("parameter", description=choices.SPACING.description("parameter"))
     frames: list[FrameInfo] | None = Field(
         None,
         description="Optional frame per latent (as /encode returns them): curves are mapped into it. "
@@ -147,7 +155,7 @@ class SampleRequest(_Request, OutputIn):
         "paper's generator rejects self-intersecting curves), at most 10 draws per curve; the seed still decides "
         "every curve. false: keep every draw.",
     )
-    spacing: SpacingMode = "parameter"
+    spacing: choices.Spacing = Field("parameter", description=choices.SPACING.description("parameter"))
     frame: FrameInfo | None = Field(
         None,
         description="Map every curve into this frame (centre and size, e.g. one /encode returned). Omitted: the "

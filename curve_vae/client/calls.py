@@ -21,6 +21,7 @@ from curve_vae.client.results import (
     Sampled,
     curves_of,
 )
+from curve_vae.inference.choices import FrameMode, Pose, Spacing
 
 NPY = "application/x-npy"
 JSON_OPTIONS = orjson.OPT_SERIALIZE_NUMPY
@@ -134,7 +135,8 @@ def parse_bytes(body: bytes, _model: ModelRef) -> bytes:
 # ------------------------------------------------------------------------------------------ the endpoints
 
 
-def reading(frame: str | None, pose: str | None, spacing: str | None, refine: int | None) -> dict[str, Any]:
+def reading(frame: FrameMode | None, pose: Pose | None, spacing: Spacing | None, refine: int | None) -> dict[str, Any]:
+    """The reading's fields the caller set (inference.reading.Reading's options; the server's defaults for the rest)."""
     return _fields(frame=frame, pose=pose, spacing=spacing, refine=refine)
 
 

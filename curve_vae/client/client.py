@@ -23,151 +23,18 @@ import httpx
 import numpy as np
 
 from curve_vae.client import calls as k
+from curve_vae.client.endpoints import Endpoints, augment_fields
 from curve_vae.client.errors import ApiError, RetriesExhausted
 from curve_vae.client.results import Augmented, ModelRef
+from curve_vae.inference.choices import FrameMode, Pose, Spacing
 
 RETRY_STATUS = (429, 503)
-#: A batch of curves of one length with at least this many points in all goes as a .npy body.
-NPY_POINTS = 2048
 DEFAULT_CHUNK = 2048
 
 
 def fresh_seed() -> int:
     """A seed for a sequence the caller gave none for: every chunk of it is drawn with this one."""
     return int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(11))
-
-
-class _Api:
-    """The endpoints, each building a `calls.Call` that the concrete client sends (`_call`)."""
-
-    npy_points = NPY_POINTS
-
-    def _call(self, call: k.Call) -> Any:
-        raise NotImplementedError
-
-    def encode(self, curves: Sequence[Any], *, frame=None, pose=None, spacing=None, refine=None) -> Any:
-        """Latent means and log-variances (`Encoded`) of curves (each (n, 2))."""
-        fields = k.reading(frame, pose, spacing, refine)
-        return self._call(k.curves_call("/encode", curves, fields, k.parse_encoded, npy_points=self.npy_points))
-
-    def decode(self, latents: Any, *, n_points=None, frames=None, spacing=None, output=None, metrics=None) -> Any:
-        """Curves (`Curves`) of latents (B, latent_dim): the model's plane, or mapped into `frames` (from encode)."""
-        return self._call(
-            k.decode_call(latents, {**k.output(n_points, output, metrics), **k._fields(frames=frames, spacing=spacing)})
-        )
-
-    def reconstruct(
-        self,
-        curves: Sequence[Any],
-        *,
-        frame=None,
-        pose=None,
-        spacing=None,
-        refine=None,
-        n_points=None,
-        output=None,
-        metrics=None,
-    ) -> Any:
-        """Each curve through the model (`Reconstructed`: curves, mse, splines)."""
-        fields = {**k.reading(frame, pose, spacing, refine), **k.output(n_points, output, metrics)}
-        return self._call(
-            k.curves_call("/reconstruct", curves, fields, k.parse_reconstructed, npy_points=self.npy_points)
-        )
-
-    def interpolate(
-        self,
-        curves: Sequence[Any],
-        *,
-        steps=None,
-        weights=None,
-        frame=None,
-        pose=None,
-        spacing=None,
-        refine=None,
-        n_points=None,
-        output=None,
-        metrics=None,
-    ) -> Any:
-        """Curves between curves (`Interpolated`): an even sweep of `steps`, or one curve per row of `weights`."""
-        fields = {
-            **k.reading(frame, pose, spacing, refine),
-            **k.output(n_points, output, metrics),
-            **k._fields(steps=steps, weights=None if weights is None else np.asarray(weights, np.float64)),
-        }
-        return self._call(
-            k.curves_call("/interpolate", curves, fields, k.parse_interpolated, npy_points=self.npy_points)
-        )
-
-    def sample(
-        self,
-        count: int,
-        *,
-        seed=None,
-        temperature=None,
-        prior=None,
-        valid=None,
-        offset=None,
-        n_points=None,
-        spacing=None,
-        frame=None,
-        output=None,
-        metrics=None,
-    ) -> Any:
-        """New curves from a latent prior (`Sampled`); the same seed gives the same curves."""
-        fields = {
-            **k.output(n_points, output, metrics),
-            **k._fields(
-                seed=seed,
-                temperature=temperature,
-                prior=prior,
-                valid=valid,
-                offset=offset,
-                spacing=spacing,
-                frame=frame,
-            ),
-        }
-        return self._call(k.sample_call(count, fields))
-
-    def augment(
-        self,
-        curves: Sequence[Any],
-        count: int,
-        *,
-        mode=None,
-        seed=None,
-        neighbours=None,
-        offset=None,
-        frame=None,
-        pose=None,
-        spacing=None,
-        n_points=None,
-        output=None,
-        metrics=None,
-    ) -> Any:
-        """One page of new curves between `curves` (`Augmented`, with sources and weights); see `augment_chunks`
-        for any count."""
-        fields = {
-            **_augment_fields(mode, seed, neighbours, frame, pose, spacing, n_points),
-            **k._fields(offset=offset, output=output, metrics=metrics),
-        }
-        return self._call(k.augment_call(curves, {"count": count, **fields}, npy=False))
-
-    def fit(self, curves: Sequence[Any], *, n_ctrl=None, tolerance=None, param=None, n_points=None) -> Any:
-        """Least-squares cubic B-splines of the curves: the service's JSON body ({"fits": [...]})."""
-        return self._call(
-            k.fit_call(curves, k._fields(n_ctrl=n_ctrl, tolerance=tolerance, param=param, n_points=n_points))
-        )
-
-    def revolve(self, curve: Any, *, segments=None, axis=None, axis_position=None, format=None) -> Any:
-        """A surface of revolution of a profile curve: the mesh file's bytes (OBJ text, or binary STL)."""
-        fields = k._fields(segments=segments, axis=axis, axis_position=axis_position, format=format)
-        return self._call(k.revolve_call(curve, fields))
-
-
-def _augment_fields(mode, seed, neighbours, frame, pose, spacing, n_points) -> dict[str, Any]:
-    return k._fields(
-        mode=mode, seed=seed, neighbours=neighbours, frame=frame, pose=pose, spacing=spacing, n_points=n_points
-    )
 
 
 class _Policy:
@@ -200,7 +67,7 @@ def _request(call: k.Call) -> dict[str, Any]:
     }
 
 
-class Client(_Api):
+class Client(Endpoints):
     """A curve-vae service over HTTP, synchronously (httpx). `transport`: an httpx transport in place of the
     network's (tests use it to drop connections)."""
 
@@ -281,9 +148,10 @@ class Client(_Api):
         offset: int = 0,
         mode=None,
         neighbours=None,
-        frame=None,
-        pose=None,
-        spacing=None,
+        frame: FrameMode | None = None,
+        pose: Pose | None = None,
+        spacing: Spacing | None = None,
+        refine: int | None = None,
         n_points=None,
     ) -> Iterator[Augmented]:
         """Items offset … offset + count - 1 of a seeded augmentation sequence, `chunk` curves at a time, each a .npy
@@ -291,7 +159,7 @@ class Client(_Api):
         is asked again from its offset; the curves are the same whatever the chunk size (item i depends on the seed
         and i alone). Without a seed one is drawn, and every chunk carries it."""
         seed = fresh_seed() if seed is None else seed
-        fields = _augment_fields(mode, seed, neighbours, frame, pose, spacing, n_points)
+        fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points)
         for start in range(offset, offset + count, chunk):
             n = min(chunk, offset + count - start)
             call = k.augment_call(curves, {"count": n, "offset": start, **fields}, npy=True)
@@ -299,7 +167,7 @@ class Client(_Api):
             yield Augmented(self.model_ref(), out, seed=seed, offset=start)
 
 
-class AsyncClient(_Api):
+class AsyncClient(Endpoints):
     """The same as `Client`, for asyncio: every endpoint method is a coroutine, `augment_chunks` an async
     iterator."""
 
@@ -379,14 +247,15 @@ class AsyncClient(_Api):
         offset: int = 0,
         mode=None,
         neighbours=None,
-        frame=None,
-        pose=None,
-        spacing=None,
+        frame: FrameMode | None = None,
+        pose: Pose | None = None,
+        spacing: Spacing | None = None,
+        refine: int | None = None,
         n_points=None,
     ) -> AsyncIterator[Augmented]:
         """See `Client.augment_chunks`."""
         seed = fresh_seed() if seed is None else seed
-        fields = _augment_fields(mode, seed, neighbours, frame, pose, spacing, n_points)
+        fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points)
         for start in range(offset, offset + count, chunk):
             n = min(chunk, offset + count - start)
             out = await self._call(k.augment_call(curves, {"count": n, "offset": start, **fields}, npy=True))

@@ -10,26 +10,30 @@ from typing import Any
 
 import numpy as np
 
-from curve_vae.commands.options import add_model_options, add_server_option, model_runtime, server_client
+from curve_vae.commands.options import (
+    add_model_options,
+    add_reading_options,
+    add_server_option,
+    model_runtime,
+    reading_fields,
+    server_client,
+)
 from curve_vae.curvefiles.help import INPUT_HELP, OUTPUT_HELP
 from curve_vae.files import refuse_overwrite
-from curve_vae.inference.choices import FrameMode, Output, Pose, Spacing, choices
-
-
-def _reading(a: argparse.Namespace) -> dict[str, Any]:
-    return {"frame": a.frame, "pose": a.pose, "spacing": a.spacing, "refine": a.refine}
+from curve_vae.inference.choices import Output, choices
+from curve_vae.inference.reading import Reading
 
 
 def cmd_reconstruct(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
     from curve_vae.inference.bodies import with_metrics, with_output
-    from curve_vae.inference.reading import Reading
 
     refuse_overwrite(a.output, a.force)
+    reading = reading_fields(a)
     curves = read_curves(a.input)
     if a.server:
         with server_client(a) as c:
-            rec = c.reconstruct(curves, **_reading(a), n_points=a.n_points, output=a.output_as, metrics=a.metrics)
+            rec = c.reconstruct(curves, **reading, n_points=a.n_points, output=a.output_as, metrics=a.metrics)
             body: dict[str, Any] = {}
             if a.output_as != "bspline":
                 body["curves"] = [np.asarray(x).tolist() for x in rec.curves]
@@ -39,7 +43,7 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
             if a.metrics:
                 body["metrics"] = rec.metrics
     else:
-        rec = model_runtime(a).reconstruct(curves, Reading(**_reading(a)), n_points=a.n_points)
+        rec = model_runtime(a).reconstruct(curves, Reading(**reading), n_points=a.n_points)
         body = with_metrics(
             {"curves": [c.tolist() for c in rec.curves], "mse": rec.mse.tolist()}, rec.curves, a.metrics
         )
@@ -53,18 +57,18 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
 def cmd_encode(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
     from curve_vae.inference.bodies import frames_json
-    from curve_vae.inference.reading import Reading
 
     refuse_overwrite(a.output, a.force)
     if a.output != "-" and Path(a.output).suffix.lower() not in ("", ".json"):
         raise ValueError(f"{a.output}: encode writes latents as JSON (a .json file, or - for stdout)")
+    reading = reading_fields(a)
     curves = read_curves(a.input)
     if a.server:
         with server_client(a) as c:
-            enc = c.encode(curves, **_reading(a))
+            enc = c.encode(curves, **reading)
             frames = enc.frames
     else:
-        enc = model_runtime(a).encode(curves, Reading(**_reading(a)))
+        enc = model_runtime(a).encode(curves, Reading(**reading))
         frames = frames_json(enc.frames)
     body = {
         "mean": np.asarray(enc.mean, np.float64).tolist(),
@@ -79,12 +83,7 @@ def cmd_encode(a: argparse.Namespace) -> int:
 def _add_reading(s: argparse.ArgumentParser, output: str) -> None:
     s.add_argument("input", help=INPUT_HELP)
     s.add_argument("-o", "--output", default="-", help=f"{output} (default: - = stdout)")
-    s.add_argument("--frame", choices=choices(FrameMode), default="auto", help="frame of the curves (default: auto)")
-    s.add_argument("--pose", choices=choices(Pose), default="auto", help="as the service's `pose` (default: auto)")
-    s.add_argument(
-        "--spacing", choices=choices(Spacing), default="auto", help="as the service's `spacing` (default: auto)"
-    )
-    s.add_argument("--refine", type=int, default=0, help="fitting steps on each latent (default: 0)")
+    add_reading_options(s)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

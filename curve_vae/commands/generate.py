@@ -12,13 +12,16 @@ import numpy as np
 from curve_vae.commands.options import (
     add_generate_options,
     add_model_options,
+    add_reading_options,
     add_server_option,
     model_runtime,
+    reading_fields,
+    reading_of,
     server_client,
 )
 from curve_vae.curvefiles.help import INPUT_HELP
 from curve_vae.files import refuse_overwrite
-from curve_vae.inference.choices import AugmentMode, FrameMode, Output, Pose, choices
+from curve_vae.inference.choices import AugmentMode, Output, choices
 from curve_vae.progress import bar, counted, shown
 
 
@@ -70,6 +73,7 @@ def cmd_augment(a: argparse.Namespace) -> int:
     from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
+    reading_fields(a)  # a reading outside its options is named before the seed curves are read
     seeds = read_curves(a.input)
     seed = fresh_seed() if a.seed is None else a.seed
     if a.output.endswith(".npy") and a.metrics:
@@ -90,9 +94,7 @@ def cmd_augment(a: argparse.Namespace) -> int:
 
 def _local_chunks(a: argparse.Namespace, runtime: Any, seeds: list, seed: int) -> Any:
     """(count, chunks of Augmented): the local model's sequence, batch_size items a chunk."""
-    from curve_vae.inference.reading import Reading
-
-    reading = Reading(frame=a.frame, pose=a.pose, spacing=a.spacing)
+    reading = reading_of(a)
     plan = runtime.plan_augment(seeds, mode=a.mode, seed=seed, neighbours=a.neighbours, reading=reading)
     spacing, step = runtime.reading(reading).spacing, runtime.graphs.batch_size
     length = runtime.mix_length(plan.prep, a.n_points)
@@ -109,9 +111,7 @@ def _remote_chunks(a: argparse.Namespace, c: Any, seeds: list, seed: int) -> Any
     fields = {
         "mode": a.mode,
         "neighbours": a.neighbours,
-        "frame": a.frame,
-        "pose": a.pose,
-        "spacing": a.spacing,
+        **reading_fields(a),
         "n_points": a.n_points,
     }
     if a.output.endswith(".npy"):
@@ -219,16 +219,7 @@ def _add_augment(sub: argparse._SubParsersAction) -> None:
         help="mix each curve only with its k nearest in latent space (default: any)",
     )
     s.add_argument("--offset", type=int, default=0, help="index of the first curve in the seeded sequence (default: 0)")
-    s.add_argument(
-        "--frame", choices=choices(FrameMode), default="auto", help="frame of the seed curves (default: auto)"
-    )
-    s.add_argument(
-        "--pose",
-        choices=choices(Pose),
-        default="auto",
-        help="how each seed curve is turned before it is encoded, as the service's `pose` (auto: the model's own "
-        "reading; new curves come back in their sources' poses) (default: auto)",
-    )
+    add_reading_options(s, of="seed curves")
     add_model_options(s)
     add_server_option(s)
     s.set_defaults(func=cmd_augment)

@@ -7,8 +7,9 @@ from pathlib import Path
 from typing import Any
 
 from curve_vae.curvefiles.help import OUTPUT_HELP
-from curve_vae.inference.choices import Providers, Spacing, choices
+from curve_vae.inference.choices import Providers, choices
 from curve_vae.inference.cpus import available_cpus
+from curve_vae.inference.reading import Reading, reading_options
 from curve_vae.training.families import MIX_VERSION, MIXES
 
 DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
@@ -135,15 +136,30 @@ def add_generate_options(p: argparse.ArgumentParser) -> None:
         "--n-points", type=int, default=None, help="points per curve (default: the model's 161, or the inputs' length)"
     )
     p.add_argument(
-        "--spacing",
-        choices=choices(Spacing),
-        default="auto",
-        help="how the seed curves' points are read, as the service's `spacing` (default: auto, the model's own)",
-    )
-    p.add_argument(
         "--metrics", action="store_true", help="add smoothness, self-intersection and length per curve (JSON only)"
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar (none either when not on a terminal)")
+
+
+def add_reading_options(p: argparse.ArgumentParser, *, of: str = "curves") -> None:
+    """--frame, --pose, --spacing, --refine: one flag per option of inference.reading.Reading, its values, default
+    and help taken from there."""
+    g = p.add_argument_group(f"reading (how the {of} are read into the model, as the service's fields)")
+    for o in reading_options():
+        kind: dict[str, Any] = {"choices": o.values} if o.values else {"type": int}
+        g.add_argument(f"--{o.name}", default=o.default, help=f"{o.doc.summary} (default: {o.default})", **kind)
+
+
+def reading_of(a: argparse.Namespace) -> Reading:
+    """The reading the flags of add_reading_options ask for."""
+    return Reading(**reading_fields(a))
+
+
+def reading_fields(a: argparse.Namespace) -> dict[str, Any]:
+    """The same as the client's (and the service's) fields, checked: {"frame": …, "pose": …, …}."""
+    fields = {o.name: getattr(a, o.name) for o in reading_options()}
+    Reading(**fields)  # an out-of-range --refine is named here, before any file is read or server called
+    return fields
 
 
 def model_runtime(a: argparse.Namespace, priors_dir: Path | None = None):
