@@ -87,8 +87,8 @@ def main(argv: list[str] | None = None) -> int:
         _show_file_warnings(args.command)
         try:
             return int(args.func(args) or 0)
-        except (CurveVaeError, ValueError, FileNotFoundError, RuntimeError) as e:
-            print(f"curve-vae {args.command}: error: {e}", file=sys.stderr)
+        except (CurveVaeError, OSError) as e:  # what curve-vae raises on purpose, and files it cannot open or write:
+            print(f"curve-vae {args.command}: error: {e}", file=sys.stderr)  # anything else is a bug: its traceback
             return 2
 
 

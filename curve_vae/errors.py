@@ -10,6 +10,9 @@ still a `ValueError`), so code that caught those before still does.
     ├── ProtocolError               service.oip.OipError
     └── ClientError (RuntimeError)  client.errors.ApiError, RetriesExhausted
 
+Raise these, not bare builtins, for anything a user can cause: `curve-vae` prints a CurveVaeError (or an OSError: a
+file it cannot open or write) as one line and exits 2, and lets anything else, a bug, show its traceback.
+
 This module imports nothing of the project: every layer, geometry included, may use it.
 """
 

@@ -11,11 +11,13 @@ from pathlib import Path
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
+
 
 def refuse_overwrite(path: str | Path, force: bool, flag: str = "-o") -> None:
     """Stop before any work when `path` exists and the user did not pass --force: nothing of theirs is replaced."""
     if str(path) != "-" and Path(path).exists() and not force:
-        raise ValueError(f"{path} exists and is left as it is: pass --force to replace it, or give another {flag}")
+        raise InvalidInput(f"{path} exists and is left as it is: pass --force to replace it, or give another {flag}")
 
 
 def write_npy_chunks(path: str, shape: tuple[int, ...], chunks: Iterable[np.ndarray]) -> None:

@@ -12,6 +12,8 @@ from collections.abc import Iterable, Iterator
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
+
 DTYPE = np.dtype("<f4")  # float32, the model's own precision: half the bytes of float64
 MEDIA_TYPE = "application/octet-stream"
 
@@ -37,12 +39,12 @@ def npy_chunks(shape: tuple[int, ...], chunks: Iterable[np.ndarray], dtype: np.d
         rows += len(chunk)
         yield chunk_bytes(chunk, shape, dtype)
     if rows != shape[0]:
-        raise ValueError(f"chunks gave {rows} rows, the header promised {shape[0]}")
+        raise InvalidInput(f"chunks gave {rows} rows, the header promised {shape[0]}")
 
 
 def chunk_bytes(chunk: np.ndarray, shape: tuple[int, ...], dtype: np.dtype = DTYPE) -> bytes:
     """The data bytes of a chunk of rows of an array of `shape`."""
     a = np.ascontiguousarray(chunk, dtype=dtype)
     if a.shape[1:] != tuple(shape[1:]):
-        raise ValueError(f"chunk of shape {a.shape} does not fit an array of shape {shape}")
+        raise InvalidInput(f"chunk of shape {a.shape} does not fit an array of shape {shape}")
     return a.tobytes()

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import onnxruntime as ort
 
+from curve_vae.errors import InvalidInput
 from curve_vae.inference.manifest import Manifest
 
 #: onnxruntime's tensor types → Triton's data types
@@ -33,7 +34,7 @@ def _tensors(items: list, kind: str) -> str:
     rows = []
     for t in items:
         if t.type not in TRITON_TYPES:
-            raise ValueError(f"{kind} {t.name}: type {t.type} has no Triton data type here")
+            raise InvalidInput(f"{kind} {t.name}: type {t.type} has no Triton data type here")
         dims = [d if isinstance(d, int) else -1 for d in t.shape[1:]]  # the batch dimension is Triton's own
         rows.append(f'  {{\n    name: "{t.name}"\n    data_type: {TRITON_TYPES[t.type]}\n    dims: {dims}\n  }}')
     return f"{kind} [\n" + ",\n".join(rows) + "\n]"
@@ -71,7 +72,9 @@ def write_repository(
     for graph in ("encoder", "decoder"):
         folder = out / f"{prefix}_{graph}"
         if folder.exists() and not force:
-            raise ValueError(f"{folder} exists and is left as it is: pass --force to replace it, or give another --out")
+            raise InvalidInput(
+                f"{folder} exists and is left as it is: pass --force to replace it, or give another --out"
+            )
         src = Path(model_dir) / getattr(manifest.graphs, graph).file
         session = ort.InferenceSession(str(src), providers=["CPUExecutionProvider"])
         (folder / "1").mkdir(parents=True, exist_ok=True)

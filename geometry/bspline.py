@@ -13,11 +13,13 @@ from functools import lru_cache
 import numpy as np
 from scipy.interpolate import BSpline, make_lsq_spline
 
+from curve_vae.errors import InvalidInput
+
 
 def clamped_uniform_knots(n_ctrl: int, degree: int = 3) -> np.ndarray:
     """Knot vector on [0, 1] of an open uniform B-spline: end knots repeated degree+1 times."""
     if n_ctrl <= degree:
-        raise ValueError(f"need more than {degree} control points for degree {degree}, got {n_ctrl}")
+        raise InvalidInput(f"need more than {degree} control points for degree {degree}, got {n_ctrl}")
     interior = np.linspace(0.0, 1.0, n_ctrl - degree + 1)[1:-1]
     return np.concatenate([np.zeros(degree + 1), interior, np.ones(degree + 1)])
 
@@ -245,10 +247,10 @@ def _lsq(u: np.ndarray, pts: np.ndarray, knots: np.ndarray, degree: int) -> BSpl
     try:
         spline = make_lsq_spline(u, pts, knots, k=degree)
     except (ValueError, np.linalg.LinAlgError) as e:
-        raise ValueError(f"cannot fit {n_ctrl} control points to these points: {e}") from e
+        raise InvalidInput(f"cannot fit {n_ctrl} control points to these points: {e}") from e
     if not np.isfinite(spline.c).all():
         # Schoenberg-Whitney fails: some knot span holds too few points (bunched points).
-        raise ValueError(
+        raise InvalidInput(
             f"cannot fit {n_ctrl} control points: the points bunch up along the curve, leaving "
             "a knot span empty; use fewer control points or resample the curve"
         )
@@ -270,18 +272,18 @@ def fit_bspline(
     """
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
-        raise ValueError(f"points must have shape (n, 2), got {pts.shape}")
+        raise InvalidInput(f"points must have shape (n, 2), got {pts.shape}")
     if len(pts) < n_ctrl:
-        raise ValueError(f"need at least n_ctrl={n_ctrl} points to fit, got {len(pts)}")
+        raise InvalidInput(f"need at least n_ctrl={n_ctrl} points to fit, got {len(pts)}")
     if param == "uniform":
         u = np.linspace(0.0, 1.0, len(pts))
     elif param == "chord":
         cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
         if cum[-1] <= 0:
-            raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+            raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
         u = cum / cum[-1]  # ends exactly at 1 (dividing by a separately summed total may not)
     else:
-        raise ValueError(f"param must be 'uniform' or 'chord', got {param!r}")
+        raise InvalidInput(f"param must be 'uniform' or 'chord', got {param!r}")
     knots = clamped_uniform_knots(n_ctrl, degree)
     spline = _lsq(u, pts, knots, degree)
     for _ in range(refine if refine is not None else (20 if param == "chord" else 0)):
@@ -313,7 +315,7 @@ def fit_bspline_auto(
     """
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 4:
-        raise ValueError(f"points must have shape (n ≥ 4, 2), got {pts.shape}")
+        raise InvalidInput(f"points must have shape (n ≥ 4, 2), got {pts.shape}")
     goal = tolerance * float(np.linalg.norm(np.ptp(pts, axis=0)))
     limit = min(len(pts), max_ctrl)
     best: BSplineFit | None = None
@@ -327,5 +329,5 @@ def fit_bspline_auto(
         if fit.rms_error <= goal:
             return fit
     if best is None:
-        raise ValueError("no B-spline fits these points with 4 or more control points")
+        raise InvalidInput("no B-spline fits these points with 4 or more control points")
     return best

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
+
 #: Centre of the model's plane (paper §3.1: a radius-64 circle in a 128×128 plane).
 MODEL_CENTER = (64.0, 64.0)
 
@@ -68,7 +70,7 @@ def fit_frame(points: np.ndarray) -> Frame:
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     size = float((hi - lo).max())
     if not size > 0:
-        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+        raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
     center = (lo + hi) / 2
     return Frame(center=(float(center[0]), float(center[1])), size=size)
 
@@ -216,7 +218,7 @@ def arc_fractions(points: np.ndarray) -> np.ndarray:
     """Where each point of a polyline (n, 2) sits along its arc length, from 0 to 1."""
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
     if s[-1] <= 0:
-        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+        raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
     return s / s[-1]
 
 
@@ -255,13 +257,13 @@ def resample(points: np.ndarray, n_points: int, *, spacing: str = "arc_length") 
     if spacing == "parameter":
         return pts.copy() if len(pts) == n_points else at_fractions(pts, np.linspace(0.0, 1.0, n_points))
     if spacing != "arc_length":
-        raise ValueError(f"spacing must be 'arc_length' or 'parameter', got {spacing!r}")
+        raise InvalidInput(f"spacing must be 'arc_length' or 'parameter', got {spacing!r}")
     seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     if len(pts) == n_points and np.ptp(seg) <= 1e-9 * max(seg.mean(), 1e-300):
         return pts.copy()  # already evenly spaced: untouched, so a round trip is exact
     s = np.concatenate([[0.0], np.cumsum(seg)])
     if s[-1] <= 0:
-        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+        raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
     keep = np.concatenate([[True], seg > 0])  # np.interp needs strictly increasing abscissae
     s, pts = s[keep], pts[keep]
     target = np.linspace(0.0, s[-1], n_points)

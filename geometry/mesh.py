@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
+
 
 @dataclass(frozen=True)
 class Mesh:
@@ -55,11 +57,11 @@ def revolve(
     """
     p = np.asarray(profile, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 2 or len(p) < 2:
-        raise ValueError(f"profile must have shape (n ≥ 2, 2), got {p.shape}")
+        raise InvalidInput(f"profile must have shape (n ≥ 2, 2), got {p.shape}")
     if segments < 3:
-        raise ValueError(f"segments must be ≥ 3, got {segments}")
+        raise InvalidInput(f"segments must be ≥ 3, got {segments}")
     if axis not in ("x", "y"):
-        raise ValueError(f"axis must be 'x' or 'y', got {axis!r}")
+        raise InvalidInput(f"axis must be 'x' or 'y', got {axis!r}")
     pos, r, h, pole = _about_axis(p, axis, axis_position, pole_tolerance)
     local, index = _rings(r, h, pole, segments)
     faces = _outwards(local, _bands(index, pole, segments))
@@ -77,7 +79,7 @@ def _about_axis(
     size = float(np.ptp(p, axis=0).max()) or 1.0
     if (r < -pole_tolerance * size).any() and (r > pole_tolerance * size).any():
         i = int(np.argmin(r) if r.min() < 0 else 0)
-        raise ValueError(
+        raise InvalidInput(
             f"profile crosses the axis (point {i} lies on the other side); move the axis or split the profile"
         )
     r = np.abs(r)
@@ -117,7 +119,7 @@ def _bands(index: list[np.ndarray], pole: np.ndarray, segments: int) -> np.ndarr
             faces.append(np.stack([a, a[nxt], b[nxt]], axis=1))
             faces.append(np.stack([a, b[nxt], b], axis=1))
     if not faces:
-        raise ValueError("the profile lies on the axis: nothing to revolve")
+        raise InvalidInput("the profile lies on the axis: nothing to revolve")
     return np.concatenate(faces).astype(np.int64)
 
 

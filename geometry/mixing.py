@@ -9,6 +9,8 @@ import math
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
+
 
 def simplex_grid(n_curves: int, steps: int) -> np.ndarray:
     """Evenly spaced affine weights, one column per curve: all (i_1, …, i_n)/(steps-1) summing to 1.
@@ -18,7 +20,7 @@ def simplex_grid(n_curves: int, steps: int) -> np.ndarray:
     the first curve; last row: all on the last.
     """
     if n_curves < 2 or steps < 2:
-        raise ValueError(f"need ≥ 2 curves and ≥ 2 steps, got {n_curves} and {steps}")
+        raise InvalidInput(f"need ≥ 2 curves and ≥ 2 steps, got {n_curves} and {steps}")
 
     def compositions(total: int, parts: int) -> list[list[int]]:
         if parts == 1:

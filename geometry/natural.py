@@ -21,6 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry.bspline import basis_and_slope
 from curve_vae.geometry.frame import arc_fractions
 from curve_vae.geometry.metrics import turning_angles
@@ -76,7 +77,7 @@ def natural_readings_of(
         pts = np.asarray(points, np.float64)
         extent = float(np.ptp(pts, axis=0).max()) if len(pts) else 0.0
         if not extent > 0:
-            raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+            raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
         pts = (pts - pts[0]) / extent  # the shape alone, at a size where squares neither underflow nor overflow
         u = arc_fractions(pts)
         if len(pts) < 2 * n_ctrl:

@@ -28,6 +28,9 @@ from curve_vae.inference.prepared import ReadCurve
 if TYPE_CHECKING:
     from curve_vae.inference.graphs import ModelGraphs
 
+#: A decoding: curves (B, n_points, 2), control points (B, n_ctrl, 2), learned parameters (B, n_points) or None.
+Decoding = tuple[np.ndarray, np.ndarray, np.ndarray | None]
+
 #: Forward-difference step in latent units (the latent prior is a unit Gaussian; the decoder runs in float32).
 FD_STEP = 1e-2
 #: How far along the spline (in its parameter) a point's match may move in one step.
@@ -64,9 +67,9 @@ class Fitter:
         decoded = all(r.decoded_yet for r in rows) and bool(rows)
         known = (
             (
-                np.stack([r.decoded for r in rows]),
-                np.stack([r.ctrl for r in rows]),
-                None if rows[0].params is None else np.stack([r.params for r in rows]),
+                np.stack([r.decoded for r in rows if r.decoded is not None]),  # every row's: all decoded
+                np.stack([r.ctrl for r in rows if r.ctrl is not None]),  # a B-spline head's: every row has them
+                None if rows[0].params is None else np.stack([r.params for r in rows if r.params is not None]),
             )  # fmt: skip
             if decoded
             else None
@@ -93,8 +96,8 @@ class Fitter:
         around: Sequence[np.ndarray],
         steps: int,
         *,
-        decoded: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None,
-    ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray | None], list[np.ndarray]]:
+        decoded: Decoding | None = None,
+    ) -> tuple[np.ndarray, Decoding, list[np.ndarray]]:
         """`steps` damped Gauss–Newton steps on each latent (B, latent_dim) towards its curve `targets[i]` (n_i, 2),
         model plane, whose points start matched to spline parameters `around[i]` (n_i,).
 
@@ -107,35 +110,35 @@ class Fitter:
         assert self.knots is not None, "refinement needs a B-spline head"
         z = np.array(latents, np.float64)
         count, dim = z.shape
-        decoded = _float64(decoded if decoded is not None else self.graphs.decode(z))
+        fit = _float64(decoded if decoded is not None else self.graphs.decode(z))
         # the start: two guesses of where the target's points sit (its positions as given, and the same fractions of
         # the spline's length as of the target's); the closest points searched near the closer guess, or a guess
         # itself where closer still (pooling points into order can cost more than it gains), so that the fit is
         # never further than the plain reconstruction
-        feet, cost = self._start(decoded[1], targets, around)
+        feet, cost = self._start(fit[1], targets, around)
         damping = np.full(count, 1e-2)
         jac = np.zeros(0)
         for step in range(steps if count else 0):
             if step % JACOBIAN_EVERY == 0:
                 shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
                 moved = self.graphs.decode(shifted)[1].astype(np.float64)
-                jac = (moved.reshape(count, dim, -1, 2) - decoded[1][:, None]) / FD_STEP
-            trial = self._step(z, decoded[1], jac, targets, feet, damping)
+                jac = (moved.reshape(count, dim, -1, 2) - fit[1][:, None]) / FD_STEP
+            trial = self._step(z, fit[1], jac, targets, feet, damping)
             with np.errstate(all="ignore"):
                 tried = _float64(self.graphs.decode(trial))
             tried_feet, tried_cost = self._placed(tried[1], targets, feet)
             # Broyden's update of each curve's Jacobian by the step just tried (accepted or not)
-            dz, dc = trial - z, tried[1] - decoded[1]
+            dz, dc = trial - z, tried[1] - fit[1]
             norm = (dz**2).sum(1)
             ok = (norm > 0) & np.isfinite(dc).reshape(count, -1).all(1)
             miss = dc - np.einsum("bl,blkd->bkd", dz, jac)
             jac[ok] += dz[ok, :, None, None] * miss[ok, None] / norm[ok, None, None, None]
             better = tried_cost < cost
             z[better], cost[better] = trial[better], tried_cost[better]
-            decoded = tuple(None if d is None else np.where(_rows(better, d), t, d) for d, t in zip(decoded, tried))
+            fit = _kept(better, fit, tried)
             feet = [tf if b else f for b, tf, f in zip(better, tried_feet, feet)]
             damping = np.where(better, damping / 3, damping * 4)
-        return z, decoded, feet  # type: ignore[return-value]
+        return z, fit, feet
 
     def _start(
         self, ctrl: np.ndarray, targets: Sequence[np.ndarray], around: Sequence[np.ndarray]
@@ -220,9 +223,23 @@ def _along(ctrl: np.ndarray, target: np.ndarray) -> list[np.ndarray]:
         return []
 
 
-def _float64(decoded: tuple[np.ndarray | None, ...]) -> tuple[np.ndarray | None, ...]:
-    """A decoding (curves, control points, parameters or None) in float64, for the differences of the fit."""
-    return tuple(None if d is None else d.astype(np.float64) for d in decoded)
+def _float64(decoded: tuple[np.ndarray, np.ndarray | None, np.ndarray | None]) -> Decoding:
+    """A decoding (curves, control points, parameters or None) in float64, for the differences of the fit; the
+    control points are there (refinement needs a B-spline head)."""
+    out, ctrl, params = decoded
+    assert ctrl is not None, "refinement needs a B-spline head"
+    return out.astype(np.float64), ctrl.astype(np.float64), None if params is None else params.astype(np.float64)
+
+
+def _kept(better: np.ndarray, old: Decoding, new: Decoding) -> Decoding:
+    """Each row of the decoding `new` where `better` (B,) says so, of `old` elsewhere (one graph decoded both, so
+    both have learned parameters or neither has)."""
+
+    def pick(o: np.ndarray, n: np.ndarray) -> np.ndarray:
+        return np.where(_rows(better, o), n, o)
+
+    params = None if old[2] is None or new[2] is None else pick(old[2], new[2])
+    return pick(old[0], new[0]), pick(old[1], new[1]), params
 
 
 def _rows(mask: np.ndarray, like: np.ndarray) -> np.ndarray:

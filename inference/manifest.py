@@ -17,7 +17,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from curve_vae.errors import ModelError
+from curve_vae.errors import InvalidInput, ModelError
 from curve_vae.files import atomic_write_text
 from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.inference.choices import ModelPose, ModelSpacing
@@ -65,7 +65,7 @@ class SplineHead(_Part):
     @classmethod
     def _placement(cls, v: str) -> str:
         if v not in ("closest", "index"):
-            raise ValueError(f'placement must be "closest" or "index", got {v!r}')
+            raise InvalidInput(f'placement must be "closest" or "index", got {v!r}')
         return v
 
 
@@ -94,7 +94,7 @@ class FrameSpec(_Part):
     @classmethod
     def _finite(cls, v: float) -> float:
         if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"must be a finite positive size, got {v}")
+            raise InvalidInput(f"must be a finite positive size, got {v}")
         return v
 
 
@@ -133,7 +133,7 @@ class Manifest(BaseModel):
     @classmethod
     def _plane(cls, v: FrameSpec) -> FrameSpec:
         if tuple(float(c) for c in v.center) != MODEL_CENTER:  # frames map to this centre (geometry.frame)
-            raise ValueError(
+            raise InvalidInput(
                 f"the model's plane is centred at {list(v.center)}, but curves are mapped to {list(MODEL_CENTER)}; "
                 "export the model with the paper's plane (ModelConfig.center 64)"
             )

@@ -14,7 +14,7 @@ from curve_vae.geometry.bspline import spline_values
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.prepared import Prepared
-from curve_vae.inference.results import Curves, Spline
+from curve_vae.inference.results import Curves, Spline, head_splines
 
 
 def to_caller(
@@ -65,10 +65,11 @@ def placed_to_caller(g: ModelGraphs, prep: Prepared) -> tuple[list[np.ndarray], 
     pts = curves.points
     extent = (np.maximum.reduceat(pts, starts) - np.minimum.reduceat(pts, starts)).max(axis=1)
     closed = np.abs(pts[ends] - pts[starts]).max(axis=1) <= 1e-9 * extent  # geometry.adapt.is_closed, per curve
-    ctrl = np.stack([r.ctrl for r in rows]).astype(np.float64)  # type: ignore[misc]
+    # every row has its frame, control points and feet (checked above): the `is not None`s only narrow the types
+    ctrl = np.stack([r.ctrl for r in rows if r.ctrl is not None]).astype(np.float64)
     ctrl[closed, 0] = ctrl[closed, -1] = (ctrl[closed, 0] + ctrl[closed, -1]) / 2  # joined: a loop comes back a loop
-    frames = FrameRows.of([r.frame for r in rows])  # type: ignore[misc]
-    feet = np.concatenate([r.feet for r in rows])  # type: ignore[misc]
+    frames = FrameRows.of([r.frame for r in rows if r.frame is not None])
+    feet = np.concatenate([r.feet for r in rows if r.feet is not None])
     model = spline_values(ctrl, feet, curves.owner, degree=g.spline_degree)[0]
     back = frames.from_model(Ragged(model, curves.lengths), g.model_size)
     n_ctrl = ctrl.shape[1]
@@ -143,8 +144,9 @@ def decoded_to_caller(
         ]
     curves = np.stack([c for c, _ in placed]) if placed else np.zeros((0, n_points or g.n_points, 2))
     check_finite(curves, "frames" if frames else field, "the result does not fit in float64")
-    splines = [s for _, s in placed] if g.has_splines else None
-    return Curves(curves, list(frames) if frames else [None] * len(curves), splines)  # type: ignore[arg-type]
+    splines = head_splines([s for _, s in placed], g.has_splines)
+    own_frames: list[Frame | None] = list(frames) if frames else [None] * len(curves)
+    return Curves(curves, own_frames, splines)
 
 
 def joined(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
@@ -169,4 +171,4 @@ def closed_rows(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, n
     """Decoded rows (and control points) each with its ends joined (placing.joined)."""
     rows = [joined(o, None if ctrl is None else ctrl[i]) for i, o in enumerate(out)]
     closed_out = np.stack([o for o, _ in rows]).astype(np.float32)
-    return closed_out, None if ctrl is None else np.stack([c for _, c in rows]).astype(np.float32)
+    return closed_out, None if ctrl is None else np.stack([c for _, c in rows if c is not None]).astype(np.float32)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path
 
 PRIOR_FILE = "prior.npz"
@@ -32,14 +33,14 @@ class LatentPrior:
     def __post_init__(self) -> None:
         k, z = self.means.shape
         if self.weights.shape != (k,) or self.cholesky.shape != (k, z, z):
-            raise ValueError(
+            raise InvalidInput(
                 f"prior shapes disagree: weights {self.weights.shape}, means {self.means.shape}, "
                 f"cholesky {self.cholesky.shape}"
             )
         if not (np.isfinite(self.means).all() and np.isfinite(self.cholesky).all() and np.all(self.weights >= 0)):
-            raise ValueError("prior parameters must be finite, with non-negative weights")
+            raise InvalidInput("prior parameters must be finite, with non-negative weights")
         if not np.isclose(self.weights.sum(), 1.0, atol=1e-6):
-            raise ValueError(f"prior weights sum to {self.weights.sum()}, not 1")
+            raise InvalidInput(f"prior weights sum to {self.weights.sum()}, not 1")
 
     @property
     def latent_dim(self) -> int:

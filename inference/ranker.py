@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry.frame import MODEL_CENTER
 
 RANKER_KIND = "conv1d-3x5s2-meanmax-v1"
@@ -47,14 +48,14 @@ class Ranker:
             self.dense.append((weights[f"dense{i}_w"].astype(np.float32), weights[f"dense{i}_b"].astype(np.float32)))
             i += 1
         if not self.convs or len(self.dense) != 2:
-            raise ValueError("not a reading ranker: expected conv0… and dense0, dense1 weights")
+            raise InvalidInput("not a reading ranker: expected conv0… and dense0, dense1 weights")
 
     @classmethod
     def load(cls, path: str | Path) -> Ranker:
         with np.load(path) as d:
             kind = str(d["kind"]) if "kind" in d else ""
             if kind != RANKER_KIND:
-                raise ValueError(f"{path}: a ranker of kind {kind!r}; this runtime reads {RANKER_KIND!r}")
+                raise InvalidInput(f"{path}: a ranker of kind {kind!r}; this runtime reads {RANKER_KIND!r}")
             return cls({k: d[k] for k in d.files if k != "kind"})
 
     def scores(self, points: np.ndarray) -> np.ndarray:

@@ -108,21 +108,22 @@ class Reader:
             todo = list(range(len(inputs)))
         for i, row in zip(todo, self._fresh([inputs[i] for i in todo], todo, reading, shared=shared)):
             rows[i] = row
+        read = [r for r in rows if r is not None]  # every row now: cached or read just now
         if reading.refine > 0 and todo:  # cached rows were cached refined: the reading's key counts the steps
             if self.fitter is None or not self.graphs.has_splines:
                 raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
             for i, row in zip(
-                todo, self.fitter.refine([inputs[i] for i in todo], [rows[i] for i in todo], reading.refine)
+                todo, self.fitter.refine([inputs[i] for i in todo], [read[i] for i in todo], reading.refine)
             ):
-                rows[i] = row
+                read[i] = row
         if decoded or self.closest:
-            missing = [i for i, r in enumerate(rows) if r is not None and not r.decoded_yet]
-            for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [rows[i] for i in missing])[0]):
-                rows[i] = row
+            missing = [i for i, r in enumerate(read) if not r.decoded_yet]
+            for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [read[i] for i in missing])[0]):
+                read[i] = row
         if self.cache is not None:
-            for k, row in zip(keys, rows):
-                self.cache.put(k, row)  # type: ignore[arg-type]
-        return Prepared(inputs, rows)  # type: ignore[arg-type]
+            for k, row in zip(keys, read):
+                self.cache.put(k, row)
+        return Prepared(inputs, read)
 
     # ----------------------------------------------------------------------------------- candidates
 
@@ -286,8 +287,9 @@ class Reader:
         curves = Ragged.of([inputs[c.curve] for c in stage])
         framed = [c.frame for c in stage]
         with np.errstate(all="ignore"):
-            if all(f is not None for f in framed):
-                flat = FrameRows.of(framed).to_model(curves, g.model_size)  # type: ignore[arg-type]
+            frames = [f for f in framed if f is not None]
+            if len(frames) == len(framed):  # every candidate has a frame
+                flat = FrameRows.of(frames).to_model(curves, g.model_size)
             else:
                 flat = np.concatenate(
                     [
@@ -335,9 +337,10 @@ class Reader:
 
     def _targets(self, inputs: list[np.ndarray], frames: list[Frame | None]) -> list[np.ndarray]:
         """Each caller curve in the model plane, through its frame: all at once where every curve has one."""
-        if frames and all(f is not None for f in frames):
+        given = [f for f in frames if f is not None]
+        if frames and len(given) == len(frames):  # every curve has a frame
             curves = Ragged.of(inputs)
-            return curves.split(FrameRows.of(frames).to_model(curves, self.graphs.model_size))  # type: ignore[arg-type]
+            return curves.split(FrameRows.of(given).to_model(curves, self.graphs.model_size))
         return [f.to_model(p, self.graphs.model_size) if f is not None else p for f, p in zip(frames, inputs)]
 
 

@@ -4,6 +4,7 @@ in the model's plane (frames None)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -39,6 +40,12 @@ class Encoding:
     mean: np.ndarray
     log_var: np.ndarray
     frames: list[Frame | None]
+
+
+def head_splines(splines: Sequence[Spline | None], has_splines: bool) -> list[Spline] | None:
+    """A result's splines: each curve's from a model with a B-spline head (which returns one for every curve), None
+    from a model without one."""
+    return [s for s in splines if s is not None] if has_splines else None
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry import Frame, blend_frames
 from curve_vae.geometry.adapt import is_closed
 from curve_vae.inference.augmenting import AugmentPlan, neighbour_pools
@@ -49,7 +50,16 @@ from curve_vae.inference.priors import NamedPrior, load_priors
 from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
-from curve_vae.inference.results import Augmented, Curves, Encoding, Interpolation, Reconstruction, Sampled
+from curve_vae.inference.results import (
+    Augmented,
+    Curves,
+    Encoding,
+    Interpolation,
+    Reconstruction,
+    Sampled,
+    Spline,
+    head_splines,
+)
 from curve_vae.inference.sampling import MAX_DRAWS, Sampler, fresh_seed
 from curve_vae.inference.sessions import SessionConfig
 
@@ -109,7 +119,7 @@ class CurveRuntime:
         root = Path(model_dir)
         manifest = Manifest.read(root)
         if placement not in ("model", "closest", "index"):
-            raise ValueError(f"placement must be model, closest or index, got {placement!r}")
+            raise InvalidInput(f"placement must be model, closest or index, got {placement!r}")
         if placement == "closest" and manifest.spline is None:
             raise ModelLoadError(f"{root}: placement closest needs a model with a B-spline head; this one has none")
         prior = None
@@ -229,11 +239,12 @@ class CurveRuntime:
         r = self.reading(reading)
         prep = self.reader.read(curves, r, shared=together)
         with np.errstate(all="ignore"):
+            placed: tuple[list[np.ndarray], Sequence[Spline | None], np.ndarray] | None
             placed = placed_to_caller(self.graphs, prep) if n_points is None else None  # every curve at once
             if placed is None:  # curve by curve: n_points asked, no frames, or a head without closest placement
                 placed = each_to_caller(self.graphs, prep, n_points=n_points, spacing=r.spacing)
         curves_out, splines, mse = placed
-        return Reconstruction(curves_out, mse, prep.mean, prep.frames, splines if self.has_splines else None)  # type: ignore[arg-type]
+        return Reconstruction(curves_out, mse, prep.mean, prep.frames, head_splines(splines, self.has_splines))
 
     def interpolate(
         self,
@@ -289,7 +300,7 @@ class CurveRuntime:
                     o, c = joined(o, c)
                 if blend:  # placed: blend the spline parameters of the input points (not the head's)
                     at, head = (prep.fractions, u) if not prep.placed else (prep.feet, None)
-                    positions = w[k] @ np.stack(at)  # type: ignore[arg-type]
+                    positions = w[k] @ np.stack([a for a in at if a is not None])  # every input's (`placed`)
                     positions = np.maximum.accumulate(np.clip(positions, 0.0, 1.0))  # extrapolating rows stay ordered
                     curve, spline = to_caller(g, o, frames[k], n_points=None, fractions=positions, ctrl=c, params=head)
                 else:
@@ -298,7 +309,7 @@ class CurveRuntime:
                 splines.append(spline)
             result = np.stack(results) if results else np.zeros((0, self.mix_length(prep, n_points), 2))
         check_finite(result, "weights", "the interpolant does not fit in float64")
-        return Interpolation(result, frames, splines if g.has_splines else None, weights=w)  # type: ignore[arg-type]
+        return Interpolation(result, frames, head_splines(splines, g.has_splines), weights=w)
 
     def mix_length(self, prep: Prepared, n_points: int | None) -> int:
         """Points per curve that mixing `prep`'s curves returns: n_points, else their common length, else 161."""

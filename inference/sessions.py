@@ -18,6 +18,7 @@ from typing import Any
 
 import onnxruntime as ort
 
+from curve_vae.errors import InvalidInput
 from curve_vae.inference.manifest import ModelLoadError
 
 CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
@@ -68,7 +69,7 @@ class SessionPool:
 
     def __init__(self, pairs: list[tuple[ort.InferenceSession, ort.InferenceSession]]) -> None:
         if not pairs:
-            raise ValueError("a session pool needs at least one encoder/decoder pair")
+            raise InvalidInput("a session pool needs at least one encoder/decoder pair")
         self.pairs = pairs
         self._next = itertools.count()
         self._local = threading.local()

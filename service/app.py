@@ -204,7 +204,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     app.add_exception_handler(InputError, on_input_error)
     app.add_exception_handler(HTTPException, on_http_error)
     _add_request_middleware(app, settings)
-    app.openapi = _openapi_of(app, settings)  # type: ignore[method-assign]
+    app.openapi = _openapi_of(app, settings)  # type: ignore[method-assign]  # FastAPI's documented override
     routes = (
         *curves_router.routes,
         *generate_router.routes,

@@ -12,7 +12,7 @@ import copy
 import json
 import os
 import sys
-from typing import Any
+from typing import Any, TypedDict
 
 from pydantic import ValidationError
 
@@ -70,7 +70,7 @@ def configure_parser(parser: argparse.ArgumentParser) -> None:
     fields = Settings.model_fields
     for flag, name, kind, text in _OPTIONS:
         field = fields[name]
-        default = field.default_factory() if field.default_factory is not None else field.default  # type: ignore[call-arg]
+        default = field.get_default(call_default_factory=True)
         default_text = ",".join(default) if isinstance(default, list) else default
         default_text = "none" if default_text in ("", None) else default_text
         parser.add_argument(
@@ -122,12 +122,22 @@ def _graceful_server_class() -> type:
         orchestrator."""
 
         @contextlib.contextmanager
-        def capture_signals(self):  # type: ignore[override]
+        def capture_signals(self):
             with super().capture_signals():
                 yield
                 self._captured_signals.clear()
 
     return GracefulServer
+
+
+class _ServerOptions(TypedDict):
+    """The uvicorn options both ways of starting pass (uvicorn.Config, uvicorn.run)."""
+
+    host: str
+    port: int
+    log_level: str
+    log_config: dict[str, Any]
+    access_log: bool
 
 
 def run(args: argparse.Namespace) -> int:
@@ -149,7 +159,7 @@ def run(args: argparse.Namespace) -> int:
     except ModelLoadError as e:
         print(f"curve-vae serve: error: {e}", file=sys.stderr)
         return 2
-    common = dict(
+    common = _ServerOptions(
         host=settings.host,
         port=settings.port,
         log_level=settings.log_level,
@@ -160,7 +170,7 @@ def run(args: argparse.Namespace) -> int:
         if settings.workers == 1:
             from curve_vae.service.app import create_app
 
-            config = uvicorn.Config(create_app(settings), **common)  # type: ignore[arg-type]
+            config = uvicorn.Config(create_app(settings), **common)
             server = _graceful_server_class()(config)
             server.run()
             if not server.started:
@@ -168,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
         else:
             # Workers are fresh processes: they rebuild the same settings from the environment.
             os.environ.update(_as_env(settings))
-            uvicorn.run("curve_vae.service.app:create_app_from_env", factory=True, workers=settings.workers, **common)  # type: ignore[arg-type]
+            uvicorn.run("curve_vae.service.app:create_app_from_env", factory=True, workers=settings.workers, **common)
     except SystemExit as e:  # uvicorn exits 3 when the app fails to start
         return e.code if isinstance(e.code, int) else 1
     return 0

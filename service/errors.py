@@ -6,7 +6,7 @@ Paths under /v2 (the Open Inference Protocol, service/routes/oip.py) answer in t
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from fastapi import Request
@@ -24,7 +24,7 @@ def error_response(
     errors: Sequence[tuple[str, str]],
     *,
     detail: str | None = None,
-    headers: dict[str, str] | None = None,
+    headers: Mapping[str, str] | None = None,
     path: str = "",
 ) -> JSONResponse:
     """The one error body of the API: a line naming the first problem, and the list of all of them. Under /v2 (the
@@ -43,7 +43,7 @@ def speaks_oip(path: str) -> bool:
     return path == "/v2" or path.startswith("/v2/")
 
 
-def oip_error(status: int, msg: str, *, headers: dict[str, str] | None = None) -> JSONResponse:
+def oip_error(status: int, msg: str, *, headers: Mapping[str, str] | None = None) -> JSONResponse:
     """The Open Inference Protocol's error body: `{"error": "..."}`."""
     return JSONResponse({"error": msg}, status_code=status, headers=headers)
 

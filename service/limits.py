@@ -5,8 +5,9 @@ both checks a request (`check`, a 422 naming the field) and states each limit in
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from pydantic import BaseModel
@@ -87,9 +88,16 @@ def check_shape(model: str, count: int, points: int, settings: Any) -> None:
                 raise InputError(("curves",), _message(bound, limit, got))
 
 
-def curves_of(req: BaseModel) -> list[np.ndarray]:
+class WithCurves(Protocol):
+    """A request that carries curves (`curves`: a list of curves of [x, y] points)."""
+
+    @property
+    def curves(self) -> Sequence[Any]: ...
+
+
+def curves_of(req: WithCurves) -> list[np.ndarray]:
     """A checked request's curves as float64 arrays."""
-    return [np.asarray(c, dtype=np.float64) for c in req.curves]  # type: ignore[attr-defined]
+    return [np.asarray(c, dtype=np.float64) for c in req.curves]
 
 
 def state_bounds(schema: dict[str, Any], settings: Any, latent_dim: int | None) -> dict[str, Any]:

@@ -76,6 +76,7 @@ def curve_route(
 
         endpoint.__name__, endpoint.__doc__ = handler.__name__, handler.__doc__
         body = Annotated[model, Body(openapi_examples=examples)] if examples else model
+        # a function declares no __signature__, but inspect.signature (so FastAPI) reads the one set here
         endpoint.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
             [
                 inspect.Parameter("request", inspect.Parameter.POSITIONAL_OR_KEYWORD, annotation=Request),
@@ -83,7 +84,7 @@ def curve_route(
             ]
         )
         router.post(path, openapi_extra=OPENAPI_BODY | (openapi_extra or {}), **route)(endpoint)
-        router.routes[-1].npy = NpyRoute(model, handler)  # type: ignore[attr-defined]
+        router.routes[-1].npy = NpyRoute(model, handler)  # type: ignore[attr-defined]  # our mark on the route
         return handler
 
     return register

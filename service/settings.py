@@ -24,41 +24,46 @@ class Settings(BaseSettings):
     model_config = SettingsConfigDict(env_prefix="CURVE_VAE_", extra="ignore", frozen=True)
 
     host: str = "127.0.0.1"  # loopback by default; "0.0.0.0" to listen on every interface
-    port: int = Field(8000, ge=0, le=65535)  # 0 picks a free port
-    workers: int = Field(1, ge=1)  # uvicorn worker processes, each with its own ONNX sessions
+    port: int = Field(default=8000, ge=0, le=65535)  # 0 picks a free port
+    workers: int = Field(default=1, ge=1)  # uvicorn worker processes, each with its own ONNX sessions
     log_level: Literal["critical", "error", "warning", "info", "debug", "trace"] = "info"
     # encoder.onnx, decoder.onnx and manifest.json; or a shipped model's name: "default", "paper" (inference/models.py)
     model_dir: Path = SHIPPED
     providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
     # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among
     # workers × inference_concurrency (inference/cpus.py), so a container never runs more threads than its quota
-    intra_op_threads: int = Field(0, ge=0)
-    inter_op_threads: int = Field(1, ge=0)  # onnxruntime's inter-op pool; the graphs run sequentially; 0: its default
+    intra_op_threads: int = Field(default=0, ge=0)
+    # onnxruntime's inter-op pool; the graphs run sequentially; 0: its default
+    inter_op_threads: int = Field(default=1, ge=0)
     spinning: bool = False  # onnxruntime threads spin-wait between runs: CPU stolen from the other inferences
     # inferences running at once = threads of the inference executor; 0: one per CPU of this worker (cpus ÷ workers)
-    inference_concurrency: int = Field(0, ge=0)
-    sessions: int = Field(0, ge=0)  # encoder/decoder session pairs per worker; 0: one per inference running at once
+    inference_concurrency: int = Field(default=0, ge=0)
+    # encoder/decoder session pairs per worker; 0: one per inference running at once
+    sessions: int = Field(default=0, ge=0)
     # Micro-batching (inference/batching.py): concurrent requests' graph runs gathered into one run of at most
     # micro_batch_rows rows, waiting at most micro_batch_wait_ms for company. Off: slower on this CPU
     # (docs/BENCHMARKS.md); on a GPU turn it on.
     micro_batch: bool = False
-    micro_batch_rows: int = Field(32, ge=1)
-    micro_batch_wait_ms: float = Field(2.0, ge=0, le=1000)
+    micro_batch_rows: int = Field(default=32, ge=1)
+    micro_batch_wait_ms: float = Field(default=2.0, ge=0, le=1000)
     access_log: bool = False  # uvicorn's line per request: log volume (its CPU cost is within noise, BENCHMARKS)
-    max_queue: int = Field(64, ge=0)  # requests waiting for an inference slot; beyond them: 503 with Retry-After
-    request_timeout: float = Field(60.0, ge=0)  # seconds a request may take, queueing included (504); 0: no limit
-    batch_size: int = Field(64, ge=1)  # curves per ONNX run: large requests are split to bound memory
-    max_curves: int = Field(256, ge=1)  # curves (or latents, or interpolants) in one request or response
-    max_points: int = Field(4096, ge=4)  # points per curve, in and out
-    max_body_bytes: int = Field(8 << 20, ge=1024)  # larger request bodies get 413
-    max_stream_curves: int = Field(100_000, ge=1)  # curves of one streamed .npy (/augment format npy): ~13 MB per 10k
-    max_mesh_triangles: int = Field(1_000_000, ge=1)  # triangles of one /revolve mesh: 50 MB of STL
+    # requests waiting for an inference slot; beyond them: 503 with Retry-After
+    max_queue: int = Field(default=64, ge=0)
+    # seconds a request may take, queueing included (504); 0: no limit
+    request_timeout: float = Field(default=60.0, ge=0)
+    batch_size: int = Field(default=64, ge=1)  # curves per ONNX run: large requests are split to bound memory
+    max_curves: int = Field(default=256, ge=1)  # curves (or latents, or interpolants) in one request or response
+    max_points: int = Field(default=4096, ge=4)  # points per curve, in and out
+    max_body_bytes: int = Field(default=8 << 20, ge=1024)  # larger request bodies get 413
+    # curves of one streamed .npy (/augment format npy): ~13 MB per 10k
+    max_stream_curves: int = Field(default=100_000, ge=1)
+    max_mesh_triangles: int = Field(default=1_000_000, ge=1)  # triangles of one /revolve mesh: 50 MB of STL
     # Fitting work of one request, steps × (input points + 300 per curve) (service/deps.py check_refine): about 35 s
     # of one CPU core here, under request_timeout; 256 curves of 161 points may take 10 steps.
-    max_refine_work: int = Field(1_200_000, ge=0)
+    max_refine_work: int = Field(default=1_200_000, ge=0)
     # Bytes the encoding cache may hold (inference/cache.py): curves posted again — the page's slider, a pipeline's
     # seed curves and retries — skip the encoder; 0 turns it off. ~3.4 KB a curve of 161 points.
-    cache_bytes: int = Field(64 << 20, ge=0)
+    cache_bytes: int = Field(default=64 << 20, ge=0)
     # Priors fitted to users' curves (`curve-vae prior -o DIR/NAME.npz`), loaded at start: /sample's prior "NAME".
     # One fitted to another model than the one served stops the start with a message naming both.
     priors_dir: Path | None = None

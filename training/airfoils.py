@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.curvefiles import CurveFileWarning, parse_dat
+from curve_vae.errors import InvalidInput
 
 DATABASE = "aerosandbox/geometry/airfoil/airfoil_database/"
 
@@ -32,7 +33,7 @@ def airfoil_texts(source: str | Path) -> dict[str, str]:
         with zipfile.ZipFile(src) as z:
             names = sorted(n for n in z.namelist() if n.startswith(DATABASE) and n.endswith(".dat"))
             return {Path(n).name: z.read(n).decode(errors="replace") for n in names}
-    raise ValueError(f"{source}: expected a directory of .dat files or aerosandbox's wheel (.whl)")
+    raise InvalidInput(f"{source}: expected a directory of .dat files or aerosandbox's wheel (.whl)")
 
 
 def load_airfoils(source: str | Path, count: int = 200, *, seed: int = 0, min_points: int = 20) -> list[np.ndarray]:
@@ -49,6 +50,6 @@ def load_airfoils(source: str | Path, count: int = 200, *, seed: int = 0, min_po
         if len(c) >= min_points and np.ptp(c, axis=0).min() > 0:
             curves.append(c)
     if not curves:
-        raise ValueError(f"{source}: no airfoil coordinate files found")
+        raise InvalidInput(f"{source}: no airfoil coordinate files found")
     pick = np.sort(np.random.default_rng(seed).choice(len(curves), size=min(count, len(curves)), replace=False))
     return [curves[i] for i in pick]

@@ -17,6 +17,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from curve_vae.errors import InvalidInput
 from curve_vae.training.checkpoint import CHECKPOINT_VERSION, load_checkpoint
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.model import VAE
@@ -28,11 +29,11 @@ __all__ = ["average_state_dicts", "recompute_batchnorm", "average_checkpoints"]
 def average_state_dicts(states: Sequence[dict[str, torch.Tensor]]) -> dict[str, torch.Tensor]:
     """Element-wise mean of floating-point entries; other entries (counters) from the last state."""
     if not states:
-        raise ValueError("nothing to average: no state dicts given")
+        raise InvalidInput("nothing to average: no state dicts given")
     keys = list(states[-1])
     for i, s in enumerate(states):
         if list(s) != keys or any(s[k].shape != states[-1][k].shape for k in keys):
-            raise ValueError(f"state dict {i} has other entries than the last one: not the same architecture")
+            raise InvalidInput(f"state dict {i} has other entries than the last one: not the same architecture")
     out: dict[str, torch.Tensor] = {}
     for k in keys:
         ref = states[-1][k]
@@ -76,7 +77,7 @@ def average_checkpoints(
     ckpts = [load_checkpoint(p) for p in paths]
     cfgs = {tuple(sorted(c["model_config"].items())) for c in ckpts}
     if len(cfgs) != 1:
-        raise ValueError(f"the checkpoints hold different models: {[c['model_config'] for c in ckpts]}")
+        raise InvalidInput(f"the checkpoints hold different models: {[c['model_config'] for c in ckpts]}")
     model = VAE(ModelConfig(**ckpts[0]["model_config"]))
     validation_mse = validation_measure(ckpts[-1]["train_config"].get("match", "index"))  # the run's own measure
     record: dict[str, Any] = {"sources": [], "bn_curves": 0 if train_curves is None else len(train_curves)}

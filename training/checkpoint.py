@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import torch
 
+from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.model import VAE
@@ -50,9 +51,9 @@ def _read(path: str | Path) -> dict[str, Any]:
     except FileNotFoundError:
         raise
     except Exception as e:  # a truncated file, another program's pickle, …
-        raise ValueError(f"{path}: not a curve-vae checkpoint ({type(e).__name__}: {e})") from e
+        raise InvalidInput(f"{path}: not a curve-vae checkpoint ({type(e).__name__}: {e})") from e
     if not isinstance(obj, dict) or "model_config" not in obj or "model" not in obj:
-        raise ValueError(f"{path}: not a curve-vae checkpoint (no model_config and model in it)")
+        raise InvalidInput(f"{path}: not a curve-vae checkpoint (no model_config and model in it)")
     return obj
 
 
@@ -60,11 +61,11 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     """A training checkpoint (last.pt, best.pt, a snapshot or an average), its version checked."""
     ckpt = _read(path)
     if ckpt.get("format") == WEIGHTS_FORMAT or "version" not in ckpt:
-        raise ValueError(
+        raise InvalidInput(
             f"{path}: shipped weights (vae.pt), not a training checkpoint; start a run from it with --init-from"
         )
     if ckpt["version"] != CHECKPOINT_VERSION:
-        raise ValueError(f"{path}: checkpoint version {ckpt['version']}, expected {CHECKPOINT_VERSION}")
+        raise InvalidInput(f"{path}: checkpoint version {ckpt['version']}, expected {CHECKPOINT_VERSION}")
     return ckpt
 
 
@@ -73,11 +74,11 @@ def load_weights(path: str | Path) -> tuple[ModelConfig, dict[str, torch.Tensor]
     ckpt = _read(path)
     if ckpt.get("format") == WEIGHTS_FORMAT:
         if ckpt.get("version", 0) > WEIGHTS_VERSION:
-            raise ValueError(
+            raise InvalidInput(
                 f"{path}: weights version {ckpt['version']}, newer than this curve-vae reads ({WEIGHTS_VERSION})"
             )
     elif "version" in ckpt and ckpt["version"] != CHECKPOINT_VERSION:
-        raise ValueError(f"{path}: checkpoint version {ckpt['version']}, expected {CHECKPOINT_VERSION}")
+        raise InvalidInput(f"{path}: checkpoint version {ckpt['version']}, expected {CHECKPOINT_VERSION}")
     return ModelConfig(**ckpt["model_config"]), ckpt["model"]
 
 
@@ -141,7 +142,7 @@ def check_resumed_data(last: Path, data_cfg: DataConfig, resume: bool) -> None:
     differ = {k: (stored[k], v) for k, v in asked.items() if k in stored and stored[k] != v}
     if differ:
         said = ", ".join(f"{k} {old!r} (run) vs {new!r} (asked)" for k, (old, new) in differ.items())
-        raise ValueError(
+        raise InvalidInput(
             f"{last} was trained on other data: {said}; resume it with the same data options "
             "(e.g. --mix-version, --n-train, --data-seed), or start a new run directory (--init-from for its weights)"
         )

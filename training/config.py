@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from curve_vae.errors import InvalidInput
+
 # Table 1's shallow networks: (filters, kernel) of each conv layer of the encoder; the
 # decoder mirrors them with transposed convolutions. CNN_6 is the Inception network.
 CONV_VARIANTS: dict[str, tuple[tuple[int, int], ...]] = {
@@ -41,13 +43,13 @@ class ModelConfig:
     def __post_init__(self) -> None:
         object.__setattr__(self, "variant", ALIASES.get(self.variant.lower(), self.variant.lower()))
         if self.variant not in VARIANTS:
-            raise ValueError(f"unknown variant {self.variant!r}; choose one of {', '.join(VARIANTS)}")
+            raise InvalidInput(f"unknown variant {self.variant!r}; choose one of {', '.join(VARIANTS)}")
         if self.latent_dim < 1:
-            raise ValueError(f"latent_dim must be ≥ 1, got {self.latent_dim}")
+            raise InvalidInput(f"latent_dim must be ≥ 1, got {self.latent_dim}")
         if self.spline_ctrl and not 4 <= self.spline_ctrl <= self.n_points:
-            raise ValueError(f"spline_ctrl must be 0 (off) or 4 … {self.n_points}, got {self.spline_ctrl}")
+            raise InvalidInput(f"spline_ctrl must be 0 (off) or 4 … {self.n_points}, got {self.spline_ctrl}")
         if self.spline_params and not self.spline_ctrl:
-            raise ValueError("spline_params needs the B-spline head (spline_ctrl > 0)")
+            raise InvalidInput("spline_params needs the B-spline head (spline_ctrl > 0)")
 
     def same_weights(self, other: ModelConfig) -> bool:
         """Whether the two configs have the same trainable weights (the spline head has none of its own)."""
@@ -93,14 +95,14 @@ class TrainConfig:
 
     def __post_init__(self) -> None:
         if self.schedule not in SCHEDULES:
-            raise ValueError(f"schedule must be one of {', '.join(SCHEDULES)}, got {self.schedule!r}")
+            raise InvalidInput(f"schedule must be one of {', '.join(SCHEDULES)}, got {self.schedule!r}")
         if self.time_budget and self.schedule == "plateau":
-            raise ValueError("a time budget needs a onecycle, cosine or constant schedule, not plateau")
+            raise InvalidInput("a time budget needs a onecycle, cosine or constant schedule, not plateau")
         if self.snapshots < 0:
-            raise ValueError(f"snapshots must be ≥ 0, got {self.snapshots}")
+            raise InvalidInput(f"snapshots must be ≥ 0, got {self.snapshots}")
         if self.match not in MATCHES:
-            raise ValueError(f"match must be one of {', '.join(MATCHES)}, got {self.match!r}")
+            raise InvalidInput(f"match must be one of {', '.join(MATCHES)}, got {self.match!r}")
         if self.only_params and self.only_encoder:
-            raise ValueError("only_params and only_encoder exclude each other: pick one part to train")
+            raise InvalidInput("only_params and only_encoder exclude each other: pick one part to train")
         if self.epochs < 1 or self.batch_size < 1 or self.lr <= 0:
-            raise ValueError("epochs and batch_size must be ≥ 1 and lr > 0")
+            raise InvalidInput("epochs and batch_size must be ≥ 1 and lr > 0")

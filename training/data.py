@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path
 from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
 
@@ -40,17 +41,17 @@ class DataConfig:
 
     def __post_init__(self) -> None:
         if self.mix not in MIXES:
-            raise ValueError(f"mix must be one of {', '.join(MIXES)}, got {self.mix!r}")
+            raise InvalidInput(f"mix must be one of {', '.join(MIXES)}, got {self.mix!r}")
         if self.mix == "broad" and not self.mix_version:
             from curve_vae.training.families import MIX_VERSION
 
             object.__setattr__(self, "mix_version", MIX_VERSION)
         elif self.mix != "broad" and self.mix_version:
-            raise ValueError('mix_version belongs to mix "broad" only')
+            raise InvalidInput('mix_version belongs to mix "broad" only')
         if self.twins and self.mix != "broad":
-            raise ValueError('twins belong to mix "broad" only: its families know their own parameter')
+            raise InvalidInput('twins belong to mix "broad" only: its families know their own parameter')
         if (self.mix == "files") != bool(self.source):
-            raise ValueError('a data source (--curves PATH) goes with mix "files", and only with it')
+            raise InvalidInput('a data source (--curves PATH) goes with mix "files", and only with it')
 
 
 def generate_curves(
@@ -155,7 +156,7 @@ class CurveDataset:
         with np.load(path, allow_pickle=False) as z:
             meta = json.loads(str(z["meta"]))
             if meta.get("format_version") != FORMAT_VERSION:
-                raise ValueError(
+                raise InvalidInput(
                     f"{path}: data set format {meta.get('format_version')}, "
                     f"expected {FORMAT_VERSION}; regenerate it with `curve-vae dataset`"
                 )
@@ -188,13 +189,13 @@ def load_or_generate(
         try:
             ds = CurveDataset.load(cache)
         except (ValueError, KeyError, OSError) as e:
-            raise ValueError(
+            raise InvalidInput(
                 f"{cache} is not a curve-vae data set ({e}); it is left as it is: give another --data path"
             ) from e
         if ds.config != config:
             mine, theirs = asdict(config), asdict(ds.config)
             diff = ", ".join(f"{k} {theirs[k]} (file) vs {mine[k]} (asked)" for k in mine if mine[k] != theirs[k])
-            raise ValueError(
+            raise InvalidInput(
                 f"{cache} holds a data set of another configuration: {diff}; it is left as it is: give another "
                 "--data path, or omit --data for the default cache of each configuration"
             )

@@ -23,6 +23,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path
 from curve_vae.geometry import canonical_frame, clamped_uniform_knots
 from curve_vae.inference.manifest import MANIFEST_VERSION, Manifest, file_entry
@@ -194,7 +195,7 @@ def export(
     reading: the pose and spacing the encoder was trained for (what a request's "auto" means; `reading_of`).
     """
     if placement not in PLACEMENTS:
-        raise ValueError(f"placement must be one of {', '.join(PLACEMENTS)}, got {placement!r}")
+        raise InvalidInput(f"placement must be one of {', '.join(PLACEMENTS)}, got {placement!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     model = model.float().cpu().eval()

@@ -19,6 +19,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
 from curve_vae.geometry.frame import canonical_frame, chord_heading, posed_frame, turns_clockwise
 
@@ -306,7 +307,7 @@ def own_curves(
 
     curves = read_curve_files(source)
     if len(curves) < 3:
-        raise ValueError(f"{source}: {len(curves)} curves; a data set needs at least 3 (train, validation, test)")
+        raise InvalidInput(f"{source}: {len(curves)} curves; a data set needs at least 3 (train, validation, test)")
     rng = np.random.default_rng(seed)
     # each curve densely along its own points (its own spacing), and at n_points that way
     dense = np.stack([resample(np.asarray(c, np.float64), DENSE, spacing="parameter") for c in curves])
@@ -315,7 +316,7 @@ def own_curves(
     k = max(1, int(round(held * len(dense))))
     test, val, train = own[order[:k]], own[order[k : 2 * k]], order[2 * k :]
     if not len(train):
-        raise ValueError(f"{source}: {len(curves)} curves leave none for training after validation and test")
+        raise InvalidInput(f"{source}: {len(curves)} curves leave none for training after validation and test")
     picked = dense[train[rng.integers(0, len(train), n_train)]]
     drawn = respace(picked, n_points, list(rng.choice(SPACINGS, n_train)), rng)
     return tuple(to_pose(s, rng, model_size).astype(np.float32) for s in (drawn, val, test))  # type: ignore[return-value]
@@ -362,7 +363,7 @@ def broad_mix(
     `workers`. twins: (2, count, n_points, 2), the curves and their twins (`draw_family`), in the same order; the
     curves are not those drawn without twins (the twins are drawn too)."""
     if version not in MIXES:
-        raise ValueError(f"the broad mix of version {version} is no longer made (made: {sorted(MIXES)})")
+        raise InvalidInput(f"the broad mix of version {version} is no longer made (made: {sorted(MIXES)})")
     jobs = [
         (seed, i, min(CHUNK, count - start), n_points, model_size, version, twins)
         for i, start in enumerate(range(0, count, CHUNK))

@@ -10,6 +10,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry import clamped_uniform_knots, spline_head
 from curve_vae.training.config import CONV_VARIANTS, VARIANTS, ModelConfig
 
@@ -92,17 +93,17 @@ def _needed(module: nn.Module, n: int, x: torch.Tensor) -> int:
     if isinstance(module, (nn.ConvTranspose1d, nn.Conv1d, nn.MaxPool1d)):
         k, s, p, d = (_first(getattr(module, a)) for a in ("kernel_size", "stride", "padding", "dilation"))
         if s != 1 or d != 1:
-            raise ValueError(f"no prefix rule for a strided or dilated {type(module).__name__}")
+            raise InvalidInput(f"no prefix rule for a strided or dilated {type(module).__name__}")
         # transposed: output j reads inputs j+p-k+1 … j+p; direct: inputs j-p … j-p+k-1
         return min(n + p if isinstance(module, nn.ConvTranspose1d) else n - p + k - 1, length)
     if isinstance(module, nn.Upsample):
         if module.mode != "nearest" or module.scale_factor is None:
-            raise ValueError("no prefix rule for a non-nearest or sized Upsample")
+            raise InvalidInput("no prefix rule for a non-nearest or sized Upsample")
         scale = int(_first(module.scale_factor))
         return min(-(-n // scale), length)
     if isinstance(module, (nn.ReLU, nn.BatchNorm1d)):
         return n
-    raise ValueError(f"no prefix rule for {type(module).__name__}")
+    raise InvalidInput(f"no prefix rule for {type(module).__name__}")
 
 
 def _first(v: int | float | tuple) -> int | float:
@@ -197,7 +198,7 @@ class Decoder(nn.Module):
             self.features = nn.Sequential(*layers)
         _, out_len = _out_len(self.features, feat_channels, feat_len)
         if out_len < cfg.n_points:
-            raise ValueError(f"decoder of {cfg.variant} yields {out_len} < {cfg.n_points} points")
+            raise InvalidInput(f"decoder of {cfg.variant} yields {out_len} < {cfg.n_points} points")
         self.crops = _prefix_lengths(self.features, cfg.n_points, torch.zeros(1, *self.feat_shape))
         if cfg.spline_ctrl:
             # Fixed, not trained and not saved: rebuilt from the config, so older weights load unchanged.
@@ -291,7 +292,7 @@ class VAE(nn.Module):
         statistics included: the curves' shapes stay the weights', only where the points sit along them is
         trained. Returns the parameters left to train."""
         if not self.cfg.spline_params:
-            raise ValueError("only the parameters can be trained with learned parameters (spline_params)")
+            raise InvalidInput("only the parameters can be trained with learned parameters (spline_params)")
         self.frozen_body = True
         for p in self.parameters():
             p.requires_grad_(False)
@@ -331,7 +332,7 @@ class VAE(nn.Module):
         if not dense:
             return self.decoder(z), mean, log_var
         if not self.cfg.spline_ctrl:
-            raise ValueError("a dense decoding needs the B-spline head (spline_ctrl)")
+            raise InvalidInput("a dense decoding needs the B-spline head (spline_ctrl)")
         _, ctrl = self.decoder.decode(z)
         return torch.matmul(self.decoder.dense_basis, ctrl), mean, log_var
 

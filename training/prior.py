@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from curve_vae.errors import InvalidInput
 from curve_vae.inference.prior import LatentPrior
 
 COMPONENTS = 8  # measured: 1 → 25% self-intersecting samples, 8 → 13.8%, 32 → 11.6%
@@ -126,7 +127,7 @@ def fit_named_prior(
         fit = {"bic": {str(k): v for k, v in bic.items()}}
         chosen = "given" if components else f"BIC over {', '.join(map(str, bic))} components"
     else:
-        raise ValueError(f"kind must be parzen or gmm, got {kind!r}")
+        raise InvalidInput(f"kind must be parzen or gmm, got {kind!r}")
     meta = {
         "kind": kind,
         "reading": {"pose": reading.pose, "spacing": reading.spacing, "refine": reading.refine},

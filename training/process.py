@@ -10,6 +10,7 @@ import torch
 import torch.distributed as dist
 from torch import nn
 
+from curve_vae.errors import InvalidInput
 from curve_vae.training.config import TrainConfig
 
 
@@ -17,7 +18,7 @@ def pick_device(name: str) -> torch.device:
     if name == "auto":
         return torch.device("cuda" if torch.cuda.is_available() else "cpu")
     if name == "cuda" and not torch.cuda.is_available():
-        raise RuntimeError("--device cuda asked for, but torch sees no CUDA device")
+        raise InvalidInput("--device cuda asked for, but torch sees no CUDA device")
     return torch.device(name)
 
 

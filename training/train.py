@@ -26,6 +26,7 @@ import torch.distributed as dist
 from torch import nn
 from tqdm import tqdm
 
+from curve_vae.errors import InvalidInput
 from curve_vae.training.checkpoint import (
     CHECKPOINT_VERSION,
     atomic_save,
@@ -134,7 +135,7 @@ def _load_splits(
     train_np = ds.train[: cfg.train_limit] if cfg.train_limit else ds.train
     if cfg.match in TWIN_MATCHES:  # each curve with its twin: (n, 2, N, 2)
         if ds.train_twins is None:
-            raise ValueError(f'match {cfg.match!r} needs a data set with twins (mix "broad", DataConfig.twins)')
+            raise InvalidInput(f'match {cfg.match!r} needs a data set with twins (mix "broad", DataConfig.twins)')
         train_np = np.stack([train_np, ds.train_twins[: len(train_np)]], axis=1)
     return torch.from_numpy(np.ascontiguousarray(train_np)), torch.from_numpy(np.ascontiguousarray(ds.val))
 
@@ -175,7 +176,7 @@ def _restore(
         ckpt = load_checkpoint(last)
         was = ckpt["train_config"]["epochs"]
         if sched is not None and cfg.schedule in ("onecycle", "cosine") and was != cfg.epochs:
-            raise ValueError(
+            raise InvalidInput(
                 f"{last} was trained for a {was}-epoch {cfg.schedule} schedule; resume it with --epochs {was}, "
                 "or start a new run directory (use --init-from to start from its weights)"
             )
@@ -195,7 +196,7 @@ def _restore(
         if model.cfg.spline_params and not init_cfg.spline_params and init_cfg.spline_ctrl:
             init_cfg, weights = replace(init_cfg, spline_params=True), widen(weights, model)
         if not init_cfg.same_weights(model.cfg):
-            raise ValueError(f"{init_from} holds a {asdict(init_cfg)} model, not {asdict(model.cfg)}")
+            raise InvalidInput(f"{init_from} holds a {asdict(init_cfg)} model, not {asdict(model.cfg)}")
         model.load_state_dict(weights)
         proc.say(f"initialised from {init_from}")
     return RunState()
@@ -234,7 +235,7 @@ def _steps_per_epoch(n_curves: int, proc: Process, cfg: TrainConfig) -> int:
     """Full batches per epoch on each process (the ragged last batch is dropped)."""
     steps = n_curves // proc.world // (cfg.batch_size // proc.world)
     if steps < 1:
-        raise ValueError(f"{n_curves} training curves are fewer than one batch of {cfg.batch_size}")
+        raise InvalidInput(f"{n_curves} training curves are fewer than one batch of {cfg.batch_size}")
     return steps
 
 
@@ -301,10 +302,12 @@ def _stop_reason(cfg: TrainConfig, state: RunState, clock: Clock) -> str | None:
 def _check_match(model_cfg: ModelConfig, cfg: TrainConfig) -> None:
     """A loss on the decoded spline needs the B-spline head; "mixed" needs it at even parameters."""
     if cfg.match != "index" and not model_cfg.spline_ctrl:
-        raise ValueError(f"match {cfg.match!r} measures the decoded spline: it needs the B-spline head (--spline-ctrl)")
+        raise InvalidInput(
+            f"match {cfg.match!r} measures the decoded spline: it needs the B-spline head (--spline-ctrl)"
+        )
     if cfg.match == "mixed" and model_cfg.spline_params:
         # its index half measures the decoder's even parameters, which learned parameters would not serve
-        raise ValueError('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
+        raise InvalidInput('match "mixed" needs the B-spline head at even parameters (spline_ctrl, no spline_params)')
 
 
 def _run_epochs(

@@ -23,6 +23,7 @@ import numpy as np
 from curve_vae import __version__
 from curve_vae.client.client import Client, fresh_seed
 from curve_vae.client.results import Augmented, ModelRef
+from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path, atomic_write_text
 from curve_vae.npy import npy_chunks
 
@@ -63,15 +64,15 @@ def write_chunks(path: str | Path, count: int, chunks: Iterable[Augmented]) -> t
     path = Path(path)
     suffix = path.suffix
     if suffix not in FORMATS:
-        raise ValueError(f"{path}: write .npy, .npz or .parquet")
+        raise InvalidInput(f"{path}: write .npy, .npz or .parquet")
     it = iter(chunks)
     first = next(it, None)
-    n_points = first.curves.shape[1] if first is not None else 0
+    n_points = _curves(first).shape[1] if first is not None else 0
     shape = (count, n_points, 2)
     everything = _chained(first, it)
     if suffix == ".npy":
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
-            for block in npy_chunks(shape, (c.curves for c in everything)):
+            for block in npy_chunks(shape, (_curves(c) for c in everything)):
                 f.write(block)
     elif suffix == ".npz":
         data = np.concatenate([c.curves for c in everything]) if first is not None else np.zeros(shape, np.float32)
@@ -80,6 +81,11 @@ def write_chunks(path: str | Path, count: int, chunks: Iterable[Augmented]) -> t
     else:
         _write_parquet(path, everything, n_points)
     return shape
+
+
+def _curves(chunk: Augmented) -> np.ndarray:
+    """A chunk's curves, one array (n, n_points, 2): an augmentation's curves all have the same length."""
+    return np.asarray(chunk.curves)
 
 
 def _chained(first: Augmented | None, rest: Iterable[Augmented]) -> Iterable[Augmented]:
@@ -146,11 +152,11 @@ def regenerate(manifest: str | Path, out: str | Path, *, url: str | None = None,
     m = json.loads(Path(manifest).read_text())
     req = m["request"]
     if req["endpoint"] != "/augment":
-        raise ValueError(f"{manifest}: made by {req['endpoint']}; only /augment batches are made again here")
+        raise InvalidInput(f"{manifest}: made by {req['endpoint']}; only /augment batches are made again here")
     body = dict(req["body"])
     with Client(url or m["model"]["url"], **client) as c:
         if c.model_ref().sha256 != m["model"]["sha256"]:
-            raise ValueError(
+            raise InvalidInput(
                 f"{c.url} serves {c.model_ref().name} {c.model_ref().version} with other files than the manifest's "
                 f"{m['model']['name']} {m['model']['version']}: its curves would differ"
             )

@@ -19,6 +19,7 @@ from curve_vae.commands.options import (
     server_client,
 )
 from curve_vae.curvefiles.help import INPUT_HELP, OUTPUT_HELP
+from curve_vae.errors import InvalidInput
 from curve_vae.files import refuse_overwrite
 from curve_vae.inference.choices import Output, choices
 from curve_vae.inference.reading import Reading
@@ -60,7 +61,7 @@ def cmd_encode(a: argparse.Namespace) -> int:
 
     refuse_overwrite(a.output, a.force)
     if a.output != "-" and Path(a.output).suffix.lower() not in ("", ".json"):
-        raise ValueError(f"{a.output}: encode writes latents as JSON (a .json file, or - for stdout)")
+        raise InvalidInput(f"{a.output}: encode writes latents as JSON (a .json file, or - for stdout)")
     reading = reading_fields(a)
     curves = read_curves(a.input)
     if a.server:

@@ -8,6 +8,7 @@ import sys
 
 from curve_vae.commands.options import add_server_option, server_client
 from curve_vae.curvefiles.help import INPUT_HELP, OUTPUT_HELP
+from curve_vae.errors import InvalidInput
 from curve_vae.files import refuse_overwrite
 from curve_vae.inference.choices import Axis, FitParam, MeshFormat, choices
 
@@ -41,7 +42,7 @@ def cmd_revolve(a: argparse.Namespace) -> int:
     refuse_overwrite(a.output, a.force)
     curves = read_curves(a.input)
     if len(curves) != 1:
-        raise ValueError(f"{a.input}: revolve takes one profile curve, got {len(curves)}")
+        raise InvalidInput(f"{a.input}: revolve takes one profile curve, got {len(curves)}")
     fmt = a.format or ("stl" if a.output.endswith(".stl") else "obj")
     if a.server:
         with server_client(a) as c:

@@ -20,6 +20,7 @@ from curve_vae.commands.options import (
     server_client,
 )
 from curve_vae.curvefiles.help import INPUT_HELP
+from curve_vae.errors import InvalidInput
 from curve_vae.files import refuse_overwrite
 from curve_vae.inference.choices import AugmentMode, Output, choices
 from curve_vae.progress import bar, counted, shown
@@ -77,7 +78,7 @@ def cmd_augment(a: argparse.Namespace) -> int:
     seeds = read_curves(a.input)
     seed = fresh_seed() if a.seed is None else a.seed
     if a.output.endswith(".npy") and a.metrics:
-        raise ValueError("--metrics needs a JSON output: a .npy file holds the curves alone")
+        raise InvalidInput("--metrics needs a JSON output: a .npy file holds the curves alone")
     with bar(a.count, "augment", enabled=shown(a.no_progress)) as progress:
         if a.server:
             with server_client(a) as c:

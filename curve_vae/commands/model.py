@@ -14,6 +14,7 @@ from curve_vae.commands.options import (
     add_suite_option,
     data_path,
 )
+from curve_vae.errors import InvalidInput
 
 
 def cmd_export(a: argparse.Namespace) -> int:
@@ -25,7 +26,7 @@ def cmd_export(a: argparse.Namespace) -> int:
         if (Path(a.out) / f).exists()
     ]
     if held and not a.force:
-        raise ValueError(
+        raise InvalidInput(
             f"{a.out} already holds a model ({', '.join(held)}) and is left as it is: pass --force to replace it, "
             "or export to a new --out directory"
         )

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from curve_vae.curvefiles.help import OUTPUT_HELP
+from curve_vae.errors import InvalidInput
 from curve_vae.inference.choices import Providers, choices
 from curve_vae.inference.cpus import available_cpus
 from curve_vae.inference.reading import Reading, reading_options
@@ -73,7 +74,7 @@ def data_config(a: argparse.Namespace):
 
     mix = "files" if a.curves else a.mix
     if a.mix_version and mix != "broad":
-        raise ValueError("--mix-version goes with --mix broad")
+        raise InvalidInput("--mix-version goes with --mix broad")
     return DataConfig(
         n_train=a.n_train,
         n_val=a.n_val,

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from curve_vae.commands.options import add_model_options, model_runtime
+from curve_vae.errors import InvalidInput
 from curve_vae.files import refuse_overwrite
 
 
@@ -18,11 +19,11 @@ def cmd_prior(a: argparse.Namespace) -> int:
 
     out = Path(a.output)
     if out.suffix != ".npz":
-        raise ValueError(f"{out}: a prior is a .npz file named after it (NAME.npz: /sample's prior NAME)")
+        raise InvalidInput(f"{out}: a prior is a .npz file named after it (NAME.npz: /sample's prior NAME)")
     refuse_overwrite(out, a.force)
     curves = read_curve_files(a.curves)
     if len(curves) < 2:
-        raise ValueError(f"{a.curves}: {len(curves)} curves; a prior needs at least 2")
+        raise InvalidInput(f"{a.curves}: {len(curves)} curves; a prior needs at least 2")
     runtime = model_runtime(a)
     prior = fit_named_prior(
         runtime,
@@ -56,6 +57,7 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
             refuse_overwrite(path, a.force)
     builtin = a.prior in ("learned", "standard")
     prior = None if builtin else NamedPrior.load(a.prior)
+    name = a.prior if prior is None else prior.name  # a built-in prior's, or the file's
     runtime = model_runtime(a, priors_dir=None if builtin else Path(a.prior).parent)
     held_out = read_curve_files(a.curves)
     if a.train:
@@ -64,10 +66,10 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
         ref = prior.reference
         train = list(runtime.decode(ref.latents, frames=[ref.frame(i) for i in range(len(ref.latents))]).curves)
     else:
-        raise ValueError(f"--prior {a.prior}: a built-in prior needs --train, the curves it was fitted to")
+        raise InvalidInput(f"--prior {a.prior}: a built-in prior needs --train, the curves it was fitted to")
     report = evaluate_prior(
         runtime,
-        a.prior if builtin else prior.name,
+        name,
         held_out,
         train,
         seeds=list(range(a.seeds)),
@@ -80,7 +82,7 @@ def cmd_evaluate_prior(a: argparse.Namespace) -> int:
     if a.figure:
         from curve_vae.training.figures import plot_beside
 
-        made = runtime.sample(12, seed=0, prior=a.prior if builtin else prior.name)
+        made = runtime.sample(12, seed=0, prior=name)
         plot_beside(list(made.curves), held_out, Path(a.figure), title=f"prior {report['prior']}, seed 0")
     if a.out:
         Path(a.out).write_text(json.dumps(report, indent=1) + "\n")
