@@ -21,12 +21,14 @@ from curve_vae.geometry.bspline import (
     spline_head,
 )
 from curve_vae.geometry.frame import (
+    MODEL_SIZE,
     Frame,
     arc_centroid,
     arc_fractions,
     at_fractions,
     blend_frames,
     canonical_frame,
+    cumulative_length,
     fit_frame,
     pose_frames,
     posed_frame,
@@ -48,6 +50,8 @@ from curve_vae.geometry.mixing import simplex_grid, simplex_grid_size
 from curve_vae.geometry.natural import natural_params, natural_readings, natural_readings_of
 
 __all__ = [
+    "MODEL_SIZE",
+    "cumulative_length",
     "arc_length_params",
     "arc_fractions",
     "at_fractions",

@@ -14,6 +14,7 @@ import numpy as np
 from scipy.interpolate import BSpline, make_lsq_spline
 
 from curve_vae.errors import InvalidInput
+from curve_vae.geometry.frame import cumulative_length
 
 
 def clamped_uniform_knots(n_ctrl: int, degree: int = 3) -> np.ndarray:
@@ -158,7 +159,7 @@ def params_at_arc_fractions(
     at = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
     u = np.linspace(0.0, 1.0, dense)
     pts = sample_bspline(control_points, dense, degree)
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    s = cumulative_length(pts)
     if not s[-1] > 1e-9 * (1.0 + np.abs(pts).max()):
         return at  # a spline collapsed to a point (up to rounding): any spacing is even
     keep = np.concatenate([[True], np.diff(s) > 0])
@@ -278,7 +279,7 @@ def fit_bspline(
     if param == "uniform":
         u = np.linspace(0.0, 1.0, len(pts))
     elif param == "chord":
-        cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        cum = cumulative_length(pts)
         if cum[-1] <= 0:
             raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
         u = cum / cum[-1]  # ends exactly at 1 (dividing by a separately summed total may not)

@@ -18,6 +18,9 @@ from curve_vae.errors import InvalidInput
 
 #: Centre of the model's plane (paper §3.1: a radius-64 circle in a 128×128 plane).
 MODEL_CENTER = (64.0, 64.0)
+#: The larger bounding-box side of a curve in the model plane: the paper's curves' median. Training poses its curves
+#: at this size and export records it in the manifest (`model_size`), which is what serving reads.
+MODEL_SIZE = 92.6
 
 
 @dataclass(frozen=True)
@@ -214,9 +217,14 @@ def posed_frame(points: np.ndarray, rotation: float, *, mirror: bool = False, re
     return Frame((float(center[0]), float(center[1])), float((hi - lo).max()), rotation, mirror, reverse)
 
 
+def cumulative_length(points: np.ndarray) -> np.ndarray:
+    """Arc length (n,) from a polyline's (n, 2) first point to each of its points: the one place it is summed."""
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+
+
 def arc_fractions(points: np.ndarray) -> np.ndarray:
     """Where each point of a polyline (n, 2) sits along its arc length, from 0 to 1."""
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    s = cumulative_length(points)
     if s[-1] <= 0:
         raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
     return s / s[-1]
@@ -261,7 +269,7 @@ def resample(points: np.ndarray, n_points: int, *, spacing: str = "arc_length") 
     seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     if len(pts) == n_points and np.ptp(seg) <= 1e-9 * max(seg.mean(), 1e-300):
         return pts.copy()  # already evenly spaced: untouched, so a round trip is exact
-    s = np.concatenate([[0.0], np.cumsum(seg)])
+    s = cumulative_length(pts)
     if s[-1] <= 0:
         raise InvalidInput("all points coincide: a curve needs at least 2 distinct points")
     keep = np.concatenate([[True], seg > 0])  # np.interp needs strictly increasing abscissae

@@ -112,9 +112,12 @@ SOURCES_PER_MODE: dict[str, int] = {"pair": 2, "triplet": 3}
 #: The body /augment answers: JSON pages, or one streamed .npy file.
 AugmentFormat = Literal["json", "npy"]
 
-#: Where a reconstruction's points are placed on its spline: "closest" (each input point at its closest point,
-#: kept in order), "index" (point i at the head's parameter i); "model": as the model's manifest says.
-Placement = Literal["model", "closest", "index"]
+#: Where a reconstruction's points are placed on its spline, as a model's manifest records it (spline.placement):
+#: "closest", each input point at its closest point on the decoded spline, kept in order (never further from the input
+#: than "index" on the same spline); "index", point i at the head's parameter i (models before 0.10.1).
+SplinePlacement = Literal["closest", "index"]
+#: What a server or a command may ask for: one of those whatever the manifest says, or "model": as it says.
+Placement = Literal["model", SplinePlacement]
 
 #: onnxruntime providers: "cuda" must load or the service does not start; "auto" takes CUDA where it is.
 Providers = Literal["cpu", "cuda", "auto"]

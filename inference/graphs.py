@@ -18,7 +18,7 @@ import onnxruntime as ort
 from curve_vae.geometry import clamped_uniform_knots
 from curve_vae.inference import batching
 from curve_vae.inference.cancel import checkpoint
-from curve_vae.inference.manifest import Manifest, ModelLoadError
+from curve_vae.inference.manifest import ENCODER_OUTPUTS, Manifest, ModelLoadError, decoder_outputs
 from curve_vae.inference.sessions import SessionConfig, SessionPool, open_pair, resolve_providers
 
 
@@ -83,14 +83,14 @@ class ModelGraphs:
             problems.append(
                 f"encoder input {enc_in.name} has shape {enc_in.shape}, expected [batch, {self.n_points}, 2]"
             )
-        if not {"mean", "log_var"} <= enc_out:
+        if not set(ENCODER_OUTPUTS) <= enc_out:
             problems.append(f"encoder outputs {sorted(enc_out)}, expected mean and log_var")
         if list(dec_in.shape[1:]) != [self.latent_dim]:
             problems.append(
                 f"decoder input {dec_in.name} has shape {dec_in.shape}, expected [batch, {self.latent_dim}]"
             )
         dec_out = [o.name for o in self.decoder.get_outputs()]
-        expected = ["curves", "control_points", "params"][: 1 + self.has_splines + self.has_params]
+        expected = decoder_outputs(self.has_splines, self.has_params)
         if dec_out[: len(expected)] != expected:
             problems.append(f"decoder outputs {dec_out}, expected {', '.join(expected)} (the manifest's spline)")
         if problems:
@@ -145,7 +145,7 @@ class ModelGraphs:
         encoder = self.encoder
         means, log_vars = [], []
         for i in range(0, len(x), self.batch_size):
-            mean, log_var = self._run_graph(encoder, "encoder", x[i : i + self.batch_size], ["mean", "log_var"])
+            mean, log_var = self._run_graph(encoder, "encoder", x[i : i + self.batch_size], list(ENCODER_OUTPUTS))
             means.append(mean)
             log_vars.append(log_var)
         if not means:

@@ -20,11 +20,21 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from curve_vae.errors import InvalidInput, ModelError
 from curve_vae.files import atomic_write_text
 from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.inference.choices import ModelPose, ModelSpacing
+from curve_vae.inference.choices import ModelPose, ModelSpacing, SplinePlacement, choices
 from curve_vae.inference.prior import PRIOR_FILE
 
 MANIFEST_VERSION = 1
 MANIFEST_FILE = "manifest.json"
+
+#: The graphs' interface, as training/export.py writes it and inference.graphs checks it.
+ENCODER_INPUT, ENCODER_OUTPUTS = "curves", ("mean", "log_var")  # (B, n_points, 2) -> 2 × (B, latent_dim)
+DECODER_INPUT = "latent"  # (B, latent_dim)
+DECODER_OUTPUTS = ("curves", "control_points", "params")  # the last two with a B-spline head, learned parameters
+
+
+def decoder_outputs(splines: bool, params: bool) -> list[str]:
+    """The decoder's output names: its curves, then control points (a B-spline head), then each point's parameter."""
+    return list(DECODER_OUTPUTS[: 1 + splines + (splines and params)])
 
 
 class ModelLoadError(ModelError):
@@ -64,8 +74,8 @@ class SplineHead(_Part):
     @field_validator("placement")
     @classmethod
     def _placement(cls, v: str) -> str:
-        if v not in ("closest", "index"):
-            raise InvalidInput(f'placement must be "closest" or "index", got {v!r}')
+        if v not in choices(SplinePlacement):
+            raise InvalidInput(f"placement must be one of {', '.join(choices(SplinePlacement))}, got {v!r}")
         return v
 
 

@@ -29,7 +29,7 @@ from curve_vae.geometry import Frame, blend_frames
 from curve_vae.geometry.adapt import is_closed
 from curve_vae.inference.augmenting import AugmentPlan, neighbour_pools
 from curve_vae.inference.cache import DEFAULT_CACHE_BYTES, EncodingCache
-from curve_vae.inference.choices import SOURCES_PER_MODE
+from curve_vae.inference.choices import SOURCES_PER_MODE, Placement, choices
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
@@ -118,8 +118,8 @@ class CurveRuntime:
         their files' stems; one fitted to another model is a ModelLoadError."""
         root = Path(model_dir)
         manifest = Manifest.read(root)
-        if placement not in ("model", "closest", "index"):
-            raise InvalidInput(f"placement must be model, closest or index, got {placement!r}")
+        if placement not in choices(Placement):
+            raise InvalidInput(f"placement must be one of {', '.join(choices(Placement))}, got {placement!r}")
         if placement == "closest" and manifest.spline is None:
             raise ModelLoadError(f"{root}: placement closest needs a model with a B-spline head; this one has none")
         prior = None

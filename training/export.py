@@ -26,7 +26,16 @@ from torch import nn
 from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path
 from curve_vae.geometry import canonical_frame, clamped_uniform_knots
-from curve_vae.inference.manifest import MANIFEST_VERSION, Manifest, file_entry
+from curve_vae.inference.choices import SplinePlacement, choices
+from curve_vae.inference.manifest import (
+    DECODER_INPUT,
+    ENCODER_INPUT,
+    ENCODER_OUTPUTS,
+    MANIFEST_VERSION,
+    Manifest,
+    decoder_outputs,
+    file_entry,
+)
 from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
 from curve_vae.training.checkpoint import save_weights
 from curve_vae.training.model import VAE, ModelConfig
@@ -56,10 +65,9 @@ class _DecoderGraph(nn.Module):
         return curves if ctrl is None else (curves, ctrl) if params is None else (curves, ctrl, params)
 
 
-#: How a consumer places a reconstruction's points (the manifest's spline.placement): "closest", each input point at its
-#: closest point on the decoded spline (the service's default for a model with a B-spline head: never further from
-#: the input than "index" on the same spline), or "index", point i at the head's parameter i.
-PLACEMENTS = ("closest", "index")
+#: How a consumer places a reconstruction's points (the manifest's spline.placement; inference.choices says what each
+#: value does).
+PLACEMENTS = choices(SplinePlacement)
 
 
 def spline_manifest(cfg: ModelConfig, placement: str = "closest") -> dict[str, Any] | None:
@@ -130,11 +138,11 @@ def _export_graphs(model: VAE, out: Path) -> list[str]:
         _EncoderGraph(model),
         torch.zeros(2, cfg.n_points, 2) + 64.0,
         out / "encoder.onnx",
-        "curves",
-        ["mean", "log_var"],
+        ENCODER_INPUT,
+        list(ENCODER_OUTPUTS),
     )
-    dec_outputs = ["curves", "control_points", "params"][: 1 + bool(cfg.spline_ctrl) + cfg.spline_params]
-    _export(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", "latent", dec_outputs)
+    dec_outputs = decoder_outputs(bool(cfg.spline_ctrl), bool(cfg.spline_params))
+    _export(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", DECODER_INPUT, dec_outputs)
     return ["encoder.onnx", "decoder.onnx"]
 
 
@@ -262,7 +270,7 @@ def export_checkpoint(
     ckpt = load_checkpoint(checkpoint)
     data_cfg = DataConfig(**{**ckpt["data_config"], "center": tuple(ckpt["data_config"]["center"])})
     if data_cfg.mix == "broad":  # posed at one size, tested on the paper's curves: no training split to draw
-        from curve_vae.training.families import MODEL_SIZE
+        from curve_vae.geometry import MODEL_SIZE
 
         train, test, model_size = None, load_test_split(data_cfg, None), MODEL_SIZE
     else:
@@ -335,7 +343,7 @@ def _fit_shipped_prior(
         else generate_curves(min(FIT_CURVES, data_cfg.n_train), data_cfg.seed, n_points=data_cfg.n_points)[0]
     )
     if canonical:
-        from curve_vae.training.families import MODEL_SIZE
+        from curve_vae.geometry import MODEL_SIZE
 
         fit_on = np.stack([canonical_frame(c).to_model(c, MODEL_SIZE) for c in fit_on.astype(np.float64)])
         fit_on = fit_on.astype(np.float32)

@@ -21,9 +21,15 @@ import numpy as np
 
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry import random_control_points, sample_bspline, self_intersects
-from curve_vae.geometry.frame import canonical_frame, chord_heading, posed_frame, turns_clockwise
+from curve_vae.geometry.frame import (  # noqa: F401  (MODEL_SIZE: the size these curves are posed at)
+    MODEL_SIZE,
+    canonical_frame,
+    chord_heading,
+    cumulative_length,
+    posed_frame,
+    turns_clockwise,
+)
 
-MODEL_SIZE = 92.6  # the larger bounding-box side of a posed curve in the model plane: the paper's curves' median
 DENSE = 641  # points per curve before respacing: 4× the model's, so every spacing interpolates finely
 SPACINGS = ("parameter", "arc_length", "warped")
 
@@ -220,7 +226,7 @@ def respace(dense: np.ndarray, n_points: int, spacings: list[str], rng: np.rando
     warps = warp(rng, len(dense), n_points)
     for i, (c, sp) in enumerate(zip(dense, spacings)):
         if sp == "arc_length":
-            s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
+            s = cumulative_length(c)
             x = np.interp(np.linspace(0.0, s[-1], n_points), s, idx)
         elif sp == "warped":
             x = warps[i] * (len(c) - 1)

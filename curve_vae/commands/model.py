@@ -15,6 +15,7 @@ from curve_vae.commands.options import (
     data_path,
 )
 from curve_vae.errors import InvalidInput
+from curve_vae.inference.choices import SplinePlacement, choices
 
 
 def cmd_export(a: argparse.Namespace) -> int:
@@ -192,7 +193,7 @@ def _add_export(sub: argparse._SubParsersAction) -> None:
     )
     s.add_argument(
         "--placement",
-        choices=("closest", "index"),
+        choices=choices(SplinePlacement),
         default="closest",
         help="with a B-spline head, how the service places a reconstruction's points, recorded in the manifest: "
         "closest (each input point at its closest point on the decoded spline: never further from the input than "
