@@ -1,7 +1,8 @@
-"""JSON bodies of the generating and design endpoints, shared by the REST routes and the offline CLI.
+"""The JSON bodies of the endpoints, built from the runtime's results, shared by the REST routes and the offline CLI.
 
-`curve-vae sample|augment|fit` write exactly what POST /sample, /augment and /fit answer
-for the same request, because both build their bodies here from the runtime's arrays.
+`curve-vae encode|reconstruct|sample|augment|fit` write exactly what POST /encode, /reconstruct, /sample, /augment
+and /fit answer for the same request, because both build their bodies here. Arrays stay numpy (the service's
+orjson writes them directly; the CLI's JSON writer turns them into lists).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import numpy as np
 
 from curve_vae.geometry import Frame, curve_length, fit_bspline, fit_bspline_auto, self_intersects, smoothness
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.results import Augmented, Sampled, Spline
+from curve_vae.inference.results import Augmented, Curves, Encoding, Interpolation, Reconstruction, Sampled, Spline
 
 
 def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
@@ -41,6 +42,30 @@ def with_output(body: dict[str, Any], splines: Sequence[Spline] | None, output: 
     if output == "bspline":
         out.pop("curves", None)
     return out
+
+
+def encode_body(enc: Encoding) -> dict[str, Any]:
+    # float64 as the JSON always carried: orjson would write float32 at float32's shorter precision
+    return {
+        "mean": enc.mean.astype(np.float64),
+        "log_var": enc.log_var.astype(np.float64),
+        "frames": frames_json(enc.frames),
+    }
+
+
+def decode_body(made: Curves, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
+    body = with_metrics({"curves": made.curves.tolist()}, made.curves, metrics)
+    return with_output(body, made.splines, output)
+
+
+def reconstruct_body(rec: Reconstruction, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
+    body = {"curves": [np.ascontiguousarray(c) for c in rec.curves], "mse": rec.mse}
+    return with_output(with_metrics(body, rec.curves, metrics), rec.splines, output)
+
+
+def interpolate_body(mix: Interpolation, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
+    body = {"weights": mix.weights, "curves": np.ascontiguousarray(mix.curves), "frames": frames_json(mix.frames)}
+    return with_output(with_metrics(body, mix.curves, metrics), mix.splines, output)
 
 
 def sample_body(made: Sampled, *, metrics: bool = False) -> dict[str, Any]:

@@ -4,29 +4,22 @@ the bounded, timed run of the work in a worker thread."""
 from __future__ import annotations
 
 import asyncio
-import math
 import time
 from collections.abc import Callable
 from typing import Annotated, Any, TypeVar
 
 import anyio
-import numpy as np
 from fastapi import Depends, Request
 from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
-from curve_vae.geometry import simplex_grid, simplex_grid_size
 from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.service import schemas as s
 from curve_vae.service.metrics import Metrics
 from curve_vae.service.settings import Settings
 
 T = TypeVar("T")
-
-DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
-WEIGHT_SUM_TOLERANCE = 1e-6
 
 
 def settings_of(request: Request) -> Settings:
@@ -51,48 +44,6 @@ async def _runtime(request: Request) -> CurveRuntime:
 # what is an attribute read (measured: a fifth of a single-curve request's server CPU).
 SettingsDep = Annotated[Settings, Depends(_settings)]
 RuntimeDep = Annotated[CurveRuntime, Depends(_runtime)]
-
-
-#: What one curve costs a fitting step beyond its points, in points: its decoder runs (inference/fitting.py) take
-#: about as long as matching 300 points (10 steps: ~86 ms for a 4-point curve, ~130 ms for a 161-point one).
-REFINE_POINTS_PER_CURVE = 300
-
-
-def check_refine(steps: int, curves: list[np.ndarray], settings: Settings) -> None:
-    """The fitting work a request asks for — steps × (input points + REFINE_POINTS_PER_CURVE per curve) — within
-    CURVE_VAE_MAX_REFINE_WORK."""
-    points = sum(len(c) for c in curves)
-    work = steps * (points + REFINE_POINTS_PER_CURVE * len(curves))
-    if work > settings.max_refine_work:
-        raise InputError(
-            ("refine",),
-            f"{steps} steps on {len(curves)} curves of {points} points in all are {work} units of work (steps × "
-            f"(points + {REFINE_POINTS_PER_CURVE} per curve)); at most {settings.max_refine_work} "
-            "(CURVE_VAE_MAX_REFINE_WORK): send fewer curves or steps",
-        )
-
-
-def check_weights(req: s.InterpolateRequest, settings: Settings) -> np.ndarray:
-    n = len(req.curves)
-    if req.weights is None:
-        steps = req.steps if req.steps is not None else DEFAULT_STEPS
-        rows = simplex_grid_size(n, steps)
-        if rows > settings.max_curves:
-            raise InputError(
-                ("steps",),
-                f"{steps} steps over {n} curves make {rows} curves; at most {settings.max_curves} per response",
-            )
-        return simplex_grid(n, steps)
-    for r, row in enumerate(req.weights):
-        if len(row) != n:
-            raise InputError(("weights", r), f"expected {n} numbers, one per input curve, got {len(row)}")
-        try:
-            total = math.fsum(row)
-        except OverflowError:  # terms near the float limit
-            total = math.inf
-        if not abs(total - 1.0) <= WEIGHT_SUM_TOLERANCE:
-            raise InputError(("weights", r), f"weights must sum to 1, got {total:.9g}")
-    return np.array(req.weights, dtype=np.float64)
 
 
 def check_output(output: str, runtime: CurveRuntime) -> None:

@@ -1,18 +1,28 @@
 """The request limits that come from the settings (curves per request, points per curve, …), written once: `BOUNDS`
 both checks a request (`check`, a 422 naming the field) and states each limit in the published schema
-(`state_bounds`), so a client generated from openapi.yaml knows them. Rules that combine fields (a triplet's steps,
-/augment's count by format, refine's work) stay with the routes that own them."""
+(`state_bounds`), so a client generated from openapi.yaml knows them. The rules that combine fields are here too:
+refine's work (`check_refine`), an interpolation's weights and grid (`check_weights`), /augment's count and body by
+format (`check_augment_format`). A schema's own bounds (≥ 4 points, refine's 0…MAX_REFINE_STEPS from the reading's
+definition, inference.choices) are the request models'."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from pydantic import BaseModel
 
+from curve_vae.geometry import simplex_grid, simplex_grid_size
 from curve_vae.inference.errors import InputError
+
+if TYPE_CHECKING:
+    from curve_vae.service.schemas import AugmentRequest, InterpolateRequest
+
+DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
+WEIGHT_SUM_TOLERANCE = 1e-6
 
 #: openapi.yaml's latent length (the shipped model's); the live schema states the loaded model's.
 DEFAULT_LATENT_DIM = 32
@@ -98,6 +108,66 @@ class WithCurves(Protocol):
 def curves_of(req: WithCurves) -> list[np.ndarray]:
     """A checked request's curves as float64 arrays."""
     return [np.asarray(c, dtype=np.float64) for c in req.curves]
+
+
+#: What one curve costs a fitting step beyond its points, in points: its decoder runs (inference/fitting.py) take
+#: about as long as matching 300 points (10 steps: ~86 ms for a 4-point curve, ~130 ms for a 161-point one).
+REFINE_POINTS_PER_CURVE = 300
+
+
+def check_refine(steps: int, curves: list[np.ndarray], settings: Any) -> None:
+    """The fitting work a request asks for — steps × (input points + REFINE_POINTS_PER_CURVE per curve) — within
+    CURVE_VAE_MAX_REFINE_WORK."""
+    points = sum(len(c) for c in curves)
+    work = steps * (points + REFINE_POINTS_PER_CURVE * len(curves))
+    if work > settings.max_refine_work:
+        raise InputError(
+            ("refine",),
+            f"{steps} steps on {len(curves)} curves of {points} points in all are {work} units of work (steps × "
+            f"(points + {REFINE_POINTS_PER_CURVE} per curve)); at most {settings.max_refine_work} "
+            "(CURVE_VAE_MAX_REFINE_WORK): send fewer curves or steps",
+        )
+
+
+def check_weights(req: InterpolateRequest, settings: Any) -> np.ndarray:
+    """The weight rows of an interpolation: the even grid of `steps` (default DEFAULT_STEPS) within max_curves, or
+    the request's rows, one number per curve, each summing to 1."""
+    n = len(req.curves)
+    if req.weights is None:
+        steps = req.steps if req.steps is not None else DEFAULT_STEPS
+        rows = simplex_grid_size(n, steps)
+        if rows > settings.max_curves:
+            raise InputError(
+                ("steps",),
+                f"{steps} steps over {n} curves make {rows} curves; at most {settings.max_curves} per response",
+            )
+        return simplex_grid(n, steps)
+    for r, row in enumerate(req.weights):
+        if len(row) != n:
+            raise InputError(("weights", r), f"expected {n} numbers, one per input curve, got {len(row)}")
+        try:
+            total = math.fsum(row)
+        except OverflowError:  # terms near the float limit
+            total = math.inf
+        if not abs(total - 1.0) <= WEIGHT_SUM_TOLERANCE:
+            raise InputError(("weights", r), f"weights must sum to 1, got {total:.9g}")
+    return np.array(req.weights, dtype=np.float64)
+
+
+def check_augment_format(req: AugmentRequest, settings: Any) -> None:
+    """What the body's format allows: the count (a page of JSON, or a stream of .npy) and what a .npy body can carry."""
+    limit, setting = (
+        (settings.max_curves, "CURVE_VAE_MAX_CURVES")
+        if req.format == "json"
+        else (settings.max_stream_curves, "CURVE_VAE_MAX_STREAM_CURVES")
+    )
+    if req.count > limit:
+        more = "; page through more with offset, or stream them with format npy" if req.format == "json" else ""
+        raise InputError(("count",), f"at most {limit}, got {req.count} (format {req.format}, {setting}){more}")
+    if req.metrics and req.format == "npy":
+        raise InputError(("metrics",), "only with format json: a .npy body carries the curves alone")
+    if req.output != "points" and req.format == "npy":
+        raise InputError(("output",), 'only "points" with format npy: a .npy body carries the curves\' points alone')
 
 
 def state_bounds(schema: dict[str, Any], settings: Any, latent_dim: int | None) -> dict[str, Any]:

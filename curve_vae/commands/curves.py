@@ -27,7 +27,7 @@ from curve_vae.inference.reading import Reading
 
 def cmd_reconstruct(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
-    from curve_vae.inference.bodies import with_metrics, with_output
+    from curve_vae.inference.bodies import reconstruct_body
 
     refuse_overwrite(a.output, a.force)
     reading = reading_fields(a)
@@ -45,10 +45,7 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
                 body["metrics"] = rec.metrics
     else:
         rec = model_runtime(a).reconstruct(curves, Reading(**reading), n_points=a.n_points)
-        body = with_metrics(
-            {"curves": [c.tolist() for c in rec.curves], "mse": rec.mse.tolist()}, rec.curves, a.metrics
-        )
-        body = with_output(body, rec.splines, a.output_as)
+        body = reconstruct_body(rec, metrics=a.metrics, output=a.output_as)
     write_output(a.output, body, array_key="curves" if "curves" in body else None)
     mse = np.asarray(body["mse"])
     print(f"{a.output}: {len(mse)} curves reconstructed, MSE (paper eq. 4) mean {mse.mean():.4g}", file=sys.stderr)
@@ -57,7 +54,7 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
 
 def cmd_encode(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
-    from curve_vae.inference.bodies import frames_json
+    from curve_vae.inference.bodies import encode_body
 
     refuse_overwrite(a.output, a.force)
     if a.output != "-" and Path(a.output).suffix.lower() not in ("", ".json"):
@@ -67,15 +64,9 @@ def cmd_encode(a: argparse.Namespace) -> int:
     if a.server:
         with server_client(a) as c:
             enc = c.encode(curves, **reading)
-            frames = enc.frames
+            body = {"mean": enc.mean, "log_var": enc.log_var, "frames": enc.frames}
     else:
-        enc = model_runtime(a).encode(curves, Reading(**reading))
-        frames = frames_json(enc.frames)
-    body = {
-        "mean": np.asarray(enc.mean, np.float64).tolist(),
-        "log_var": np.asarray(enc.log_var, np.float64).tolist(),
-        "frames": frames,
-    }
+        body = encode_body(model_runtime(a).encode(curves, Reading(**reading)))
     write_output(a.output, body)
     print(f"{a.output}: {len(body['mean'])} latents of {len(body['mean'][0])} numbers", file=sys.stderr)
     return 0

@@ -48,11 +48,18 @@ def write_output(path: str, payload: dict[str, Any], array_key: str | None = Non
     elif suffix in (".svg", ".dxf"):
         _write_drawing(path, suffix, payload, array_key)
     else:
-        text = json.dumps(payload, indent=None, separators=(",", ":")) + "\n"
+        text = json.dumps(payload, indent=None, separators=(",", ":"), default=_listed) + "\n"
         if path == "-":
             sys.stdout.write(text)
         else:
             atomic_write_text(path, text)
+
+
+def _listed(value: Any) -> Any:
+    """numpy in an endpoint's body (inference.bodies keeps arrays for the service's orjson) as lists and numbers."""
+    if isinstance(value, np.ndarray | np.generic):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
 
 
 def _write_drawing(path: str, suffix: str, payload: dict[str, Any], array_key: str | None) -> None:

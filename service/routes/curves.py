@@ -8,7 +8,7 @@ import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
-from curve_vae.inference.bodies import frames_json, with_metrics, with_output
+from curve_vae.inference.bodies import decode_body, encode_body, interpolate_body, reconstruct_body
 from curve_vae.inference.errors import InputError
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
@@ -17,14 +17,12 @@ from curve_vae.service.deps import (
     RuntimeDep,
     SettingsDep,
     check_output,
-    check_refine,
-    check_weights,
     run_inference,
     runtime_of,
     settings_of,
 )
 from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.limits import check
+from curve_vae.service.limits import check, check_refine, check_weights
 from curve_vae.service.npy_bodies import curve_route
 
 curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
@@ -44,13 +42,10 @@ async def encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray
     """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance).
     The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
     runtime = runtime_of(request)
-    check_refine(req.refine, curves, settings_of(request))
+    check_refine(req.reading().refine, curves, settings_of(request))
 
     def work() -> Response:
-        enc = runtime.encode(curves, req.reading())
-        # float64 as the JSON always carried: orjson would write float32 at float32's shorter precision
-        body = {"mean": enc.mean.astype(np.float64), "log_var": enc.log_var.astype(np.float64)}
-        return JSON({**body, "frames": frames_json(enc.frames)})
+        return JSON(encode_body(runtime.encode(curves, req.reading())))
 
     return await run_inference(request, "/encode", len(curves), work)
 
@@ -79,8 +74,7 @@ async def decode(request: Request, runtime: RuntimeDep, settings: SettingsDep, r
         made = runtime.decode(
             np.array(req.latents, np.float64), n_points=req.n_points, spacing=req.spacing, frames=frames
         )
-        body = with_metrics({"curves": made.curves.tolist()}, made.curves, req.metrics)
-        return JSON(with_output(body, made.splines, req.output))
+        return JSON(decode_body(made, metrics=req.metrics, output=req.output))
 
     return await run_inference(request, "/decode", len(req.latents), work)
 
@@ -99,14 +93,12 @@ async def reconstruct(request: Request, req: s.ReconstructRequest, curves: list[
     """Encode each curve's latent mean and decode it: the reconstruction in the caller's frame, and its MSE there.
     The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
     runtime = runtime_of(request)
-    check_refine(req.refine, curves, settings_of(request))
+    check_refine(req.reading().refine, curves, settings_of(request))
     check_output(req.output, runtime)
 
     def work() -> Response:
         rec = runtime.reconstruct(curves, req.reading(), n_points=req.n_points)
-        out = [np.ascontiguousarray(c) for c in rec.curves]
-        body = with_metrics({"curves": out, "mse": rec.mse}, rec.curves, req.metrics)
-        return JSON(with_output(body, rec.splines, req.output))
+        return JSON(reconstruct_body(rec, metrics=req.metrics, output=req.output))
 
     return await run_inference(request, "/reconstruct", len(curves), work)
 
@@ -126,13 +118,12 @@ async def interpolate(request: Request, req: s.InterpolateRequest, curves: list[
     into the same blend of the inputs' frames. The curves may also be posted as a .npy body
     (`Content-Type: application/x-npy`), the other fields in the query."""
     runtime, settings = runtime_of(request), settings_of(request)
-    check_refine(req.refine, curves, settings)
+    check_refine(req.reading().refine, curves, settings)
     weights = check_weights(req, settings)
     check_output(req.output, runtime)
 
     def work() -> Response:
         mix = runtime.interpolate(curves, weights, req.reading(), n_points=req.n_points)
-        body = {"weights": weights, "curves": np.ascontiguousarray(mix.curves), "frames": frames_json(mix.frames)}
-        return JSON(with_output(with_metrics(body, mix.curves, req.metrics), mix.splines, req.output))
+        return JSON(interpolate_body(mix, metrics=req.metrics, output=req.output))
 
     return await run_inference(request, "/interpolate", len(weights), work)

@@ -13,7 +13,6 @@ from fastapi.responses import Response, StreamingResponse
 
 from curve_vae.inference.augmenting import AugmentPlan
 from curve_vae.inference.bodies import augment_body, sample_body, with_output
-from curve_vae.inference.errors import InputError
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.inference.sampling import fresh_seed
 from curve_vae.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
@@ -21,11 +20,10 @@ from curve_vae.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
-from curve_vae.service.deps import RuntimeDep, SettingsDep, check_output, check_refine, in_executor, run_inference
+from curve_vae.service.deps import RuntimeDep, SettingsDep, check_output, in_executor, run_inference
 from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.limits import check, curves_of
+from curve_vae.service.limits import check, check_augment_format, check_refine, curves_of
 from curve_vae.service.metrics import Metrics
-from curve_vae.service.settings import Settings
 
 generate_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 
@@ -91,8 +89,8 @@ async def augment(request: Request, runtime: RuntimeDep, settings: SettingsDep, 
     depends only on (seed, i): page with `offset`, or stream any count as .npy with `format` "npy"."""
     check(req, settings)
     curves = curves_of(req)
-    check_refine(req.refine, curves, settings)
-    _check_augment_format(req, settings)
+    check_refine(req.reading().refine, curves, settings)
+    check_augment_format(req, settings)
     check_output(req.output, runtime)
     seed = fresh_seed() if req.seed is None else req.seed
     start, stop = req.offset, req.offset + req.count
@@ -109,22 +107,6 @@ async def augment(request: Request, runtime: RuntimeDep, settings: SettingsDep, 
         return JSON(with_output(augment_body(made, metrics=req.metrics), made.splines, req.output))
 
     return await run_inference(request, "/augment", req.count, work)
-
-
-def _check_augment_format(req: s.AugmentRequest, settings: Settings) -> None:
-    """What the body's format allows: the count (a page of JSON, or a stream of .npy) and what a .npy body can carry."""
-    limit, setting = (
-        (settings.max_curves, "CURVE_VAE_MAX_CURVES")
-        if req.format == "json"
-        else (settings.max_stream_curves, "CURVE_VAE_MAX_STREAM_CURVES")
-    )
-    if req.count > limit:
-        more = "; page through more with offset, or stream them with format npy" if req.format == "json" else ""
-        raise InputError(("count",), f"at most {limit}, got {req.count} (format {req.format}, {setting}){more}")
-    if req.metrics and req.format == "npy":
-        raise InputError(("metrics",), "only with format json: a .npy body carries the curves alone")
-    if req.output != "points" and req.format == "npy":
-        raise InputError(("output",), 'only "points" with format npy: a .npy body carries the curves\' points alone')
 
 
 async def _stream_augment(
