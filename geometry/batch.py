@@ -107,13 +107,12 @@ class FrameRows:
 def canonical_frames(curves: Sequence[np.ndarray]) -> list[Frame]:
     """`frame.canonical_frame` of every curve, computed for the curves of each length together. Raises ValueError
     naming the first curve whose points all coincide."""
-    out: list[Frame | None] = [None] * len(curves)
+    out: dict[int, Frame] = {}
     lengths = np.array([len(c) for c in curves])
     for n in np.unique(lengths):
-        idx = np.flatnonzero(lengths == n)
-        for i, f in zip(idx, _canonical_same_length(np.stack([np.asarray(curves[i], np.float64) for i in idx]))):
-            out[i] = f
-    return out  # type: ignore[return-value]
+        idx: list[int] = np.flatnonzero(lengths == n).tolist()
+        out.update(zip(idx, _canonical_same_length(np.stack([np.asarray(curves[i], np.float64) for i in idx]))))
+    return [out[i] for i in range(len(curves))]
 
 
 def _canonical_same_length(pts: np.ndarray) -> list[Frame]:

@@ -59,8 +59,9 @@ def curve_length(curves: np.ndarray) -> np.ndarray:
     return np.linalg.norm(np.diff(np.asarray(curves, np.float64), axis=-2), axis=-1).sum(axis=-1)
 
 
-def self_intersects(curves: np.ndarray) -> np.ndarray:
-    """Whether each open polyline crosses or touches itself, (batch, n, 2) → (batch,) bool."""
+def self_intersects(curves: np.ndarray) -> np.ndarray | bool:
+    """Whether each open polyline crosses or touches itself, (batch, n, 2) → (batch,) bool; one polyline (n, 2) → a
+    bool."""
     c = np.asarray(curves, np.float64)
     if c.ndim == 2:
         return bool(~shapely.is_simple(shapely.linestrings(c)))

@@ -233,7 +233,7 @@ class AsyncClient(Endpoints):
         assert self._model is not None
         return self._model
 
-    async def _call(self, call: k.Call) -> Any:  # type: ignore[override]
+    async def _call(self, call: k.Call) -> Any:
         model = await self.model_ref()
         return call.parse((await self.send(**_request(call))).content, model)
 

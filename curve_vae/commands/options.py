@@ -168,7 +168,8 @@ def model_runtime(a: argparse.Namespace, priors_dir: Path | None = None):
     from curve_vae.inference.runtime import CurveRuntime
 
     model_dir = model_directory(a.model_dir)
-    priors = priors_dir or (getattr(a, "priors_dir", "") or None)
+    flag: str | None = getattr(a, "priors_dir", "") or None  # --priors-dir, where the command has it
+    priors = priors_dir or flag
     return CurveRuntime.load(
         model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False, priors_dir=priors
     )
