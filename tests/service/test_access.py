@@ -1,4 +1,4 @@
-"""API keys: every route but liveness and readiness needs one when keys are set; /metrics can be switched off."""
+"""API keys (service.access): every route but liveness and readiness needs one when keys are set."""
 
 from __future__ import annotations
 
@@ -74,13 +74,6 @@ def test_keys_compare_whole_and_exactly():
     assert not accepted(None, ["abc"]) and not accepted("", [""])
     assert key_of({b"authorization": b"Bearer t"}) == "t" and key_of({b"x-api-key": b" t "}) == "t"
     assert key_of({}) is None
-
-
-def test_metrics_can_be_switched_off(make_client):
-    client = make_client(metrics=False)
-    r = client.get("/metrics")
-    assert r.status_code == 404 and "CURVE_VAE_METRICS=false" in r.json()["detail"]
-    assert client.get("/health").status_code == 200
 
 
 def test_keys_come_from_the_environment(monkeypatch):

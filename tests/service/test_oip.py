@@ -1,33 +1,15 @@
-"""The Open Inference Protocol (KServe v2) under /v2: metadata from the graphs, infer equal to the runtime's own
-runs, the protocol's request and response shapes, and its `{"error": ...}` answers."""
+"""The Open Inference Protocol (KServe v2) requests and answers (service.oip): infer equal to the runtime's own runs,
+the protocol's request and response shapes, and its `{"error": ...}` answers to what does not fit the tensors."""
 
 from __future__ import annotations
 
 import json
 
 import numpy as np
-import onnxruntime as ort
 import pytest
-from fastapi.testclient import TestClient
 
 from curve_vae.service import oip
-from curve_vae.service.app import create_app
-from curve_vae.service.settings import Settings
-from tests.helpers import SHIPPED, bspline_curves
-
-DATATYPE = {"tensor(float)": "FP32"}
-
-
-def graph_tensors(path) -> dict[str, list[dict]]:
-    """What onnxruntime says of a graph's tensors, in the protocol's terms (-1 for a symbolic axis)."""
-    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
-    return {
-        kind: [
-            {"name": t.name, "datatype": DATATYPE[t.type], "shape": [d if isinstance(d, int) else -1 for d in t.shape]}
-            for t in tensors
-        ]
-        for kind, tensors in (("inputs", session.get_inputs()), ("outputs", session.get_outputs()))
-    }
+from tests.helpers import bspline_curves
 
 
 def tensor(name: str, a: np.ndarray, datatype: str = "FP32") -> dict:
@@ -49,58 +31,6 @@ def error(r, status: int = 400) -> str:
 
 
 # ------------------------------------------------------------------------------------------- health and metadata
-
-
-def test_health_and_readiness(client):
-    assert client.get("/v2/health/live").json() == {"live": True}
-    assert client.get("/v2/health/ready").json() == {"ready": True}
-    for model in ("encoder", "decoder"):
-        assert client.get(f"/v2/models/{model}/ready").json() == {"name": model, "ready": True}
-    server = client.get("/v2").json()
-    assert server["name"] == "curve-vae" and server["extensions"] == []
-
-
-def test_not_ready_before_the_model_is_loaded(model_dir):
-    client = TestClient(create_app(Settings(model_dir=model_dir)))  # no `with`: the lifespan never loads the model
-    assert client.get("/v2/health/live").status_code == 200
-    assert "not loaded" in error(client.get("/v2/health/ready"), 503)
-    assert "not loaded" in error(client.get("/v2/models/encoder/ready"), 503)
-    assert "not loaded" in error(client.post("/v2/models/decoder/infer", json={"inputs": []}), 503)
-
-
-@pytest.mark.parametrize("model", ["encoder", "decoder"])
-def test_metadata_is_the_graphs_own(client, model_dir, runtime, model):
-    meta = client.get(f"/v2/models/{model}").json()
-    assert meta["name"] == model and meta["platform"] == "onnxruntime_onnx"
-    assert meta["versions"] == [runtime.manifest.version]
-    graph = graph_tensors(model_dir / f"{model}.onnx")
-    assert {"inputs": meta["inputs"], "outputs": meta["outputs"]} == graph
-    assert all(t["shape"][0] == -1 for t in graph["inputs"] + graph["outputs"])  # the batch axis
-
-
-def test_the_schema_without_a_model_states_the_shipped_models_tensors():
-    """openapi.yaml is written without loading a model: its tensors (oip.DEFAULT_SIGNATURES) are the shipped ones."""
-    if not (SHIPPED / "manifest.json").is_file():
-        pytest.skip("no shipped model")
-    for model, sig in oip.DEFAULT_SIGNATURES.items():
-        graph = graph_tensors(SHIPPED / f"{model}.onnx")
-        assert [t.json() for t in sig.inputs] == graph["inputs"], model
-        assert [t.json() for t in sig.outputs] == graph["outputs"], model
-
-
-def test_the_live_schema_states_the_loaded_models_tensors(make_client, runtime):
-    spec = make_client(max_curves=9).get("/openapi.json").json()
-    body = spec["paths"]["/v2/models/decoder/infer"]["post"]["requestBody"]["content"]["application/json"]["schema"]
-    latent = body["properties"]["inputs"]["items"]["properties"]
-    assert latent["name"]["enum"] == ["latent"] and latent["datatype"]["enum"] == ["FP32"]
-    assert latent["shape"]["prefixItems"] == [
-        {"type": "integer", "minimum": 1, "maximum": 9},
-        {"type": "integer", "const": runtime.latent_dim},
-    ]
-    assert body["properties"]["outputs"]["items"]["properties"]["name"]["enum"] == ["curves", "control_points"]
-    assert {"/v2", "/v2/health/live", "/v2/health/ready", "/v2/models/encoder", "/v2/models/encoder/ready"} <= set(
-        spec["paths"]
-    )
 
 
 # ------------------------------------------------------------------------------------------- infer
@@ -167,15 +97,6 @@ def test_a_batch_is_run_in_parts_of_batch_size(client, runtime):
     req = oip.parse_request({"inputs": [tensor("curves", curves)]}, "encoder", sig, max_batch=40)
     parts = oip.infer(runtime.graphs.encoder, req, batch_size=7)  # 7 + 7 + 7 + 7 + 2 rows
     np.testing.assert_allclose(parts["mean"], want, atol=1e-5)
-
-
-def test_infer_goes_through_the_inference_queue(make_client):
-    client = make_client()
-    assert client.post("/v2/models/encoder/infer", json=encoder_request(3)).status_code == 200
-    text = client.get("/metrics").text
-    assert 'curve_vae_batch_size_sum{route="/v2/models/encoder/infer"} 3.0' in text
-    assert 'curve_vae_inference_duration_seconds_count{route="/v2/models/encoder/infer"} 1.0' in text
-    assert 'route="/v2/models/encoder/infer",status="200"' in text
 
 
 # ------------------------------------------------------------------------------------------- errors
@@ -263,39 +184,6 @@ def test_batches_over_max_curves_are_400(make_client):
     client = make_client(max_curves=2)
     r = client.post("/v2/models/encoder/infer", json=encoder_request(3))
     assert "inputs[0].shape: batch of 3; at most 2 per request (CURVE_VAE_MAX_CURVES)" in error(r)
-
-
-def test_binary_tensor_data_is_refused_with_what_to_send_instead(client):
-    r = client.post("/v2/models/encoder/infer", content=b"{}", headers={"Inference-Header-Content-Length": "2"})
-    assert "binary_data=False" in error(r)
-
-
-@pytest.mark.parametrize(
-    ("method", "path"),
-    [("get", "/v2/models/resnet"), ("get", "/v2/models/resnet/ready"), ("post", "/v2/models/resnet/infer")],
-)
-def test_an_unknown_model_is_404(client, method, path):
-    r = getattr(client, method)(path, **({"json": encoder_request(1)} if method == "post" else {}))
-    assert error(r, 404) == "unknown model 'resnet': this server serves encoder and decoder"
-
-
-def test_api_keys_body_limit_and_unknown_paths_answer_in_the_protocols_format(make_client):
-    client = make_client(api_keys="s3cret", max_body_bytes=4096)
-    assert "needs an API key" in error(client.post("/v2/models/encoder/infer", json=encoder_request(1)), 401)
-    assert "needs an API key" in error(client.get("/v2/models/encoder"), 401)
-    assert client.get("/v2/health/live").status_code == 200  # probes need no key
-    assert client.get("/v2/health/ready").status_code == 200
-    key = {"X-API-Key": "s3cret"}
-    assert client.get("/v2/models/encoder", headers=key).status_code == 200
-    big = client.post("/v2/models/encoder/infer", json=encoder_request(2), headers=key)  # ~12 kB
-    assert "exceeds the limit of 4096 bytes" in error(big, 413)
-    decoded = client.post(
-        "/v2/models/decoder/infer", json={"inputs": [tensor("latent", np.zeros((1, 32)))]}, headers=key
-    )
-    assert decoded.status_code == 200
-    assert error(client.get("/v2/models/encoder/versions/1", headers=key), 404) == "Not Found"
-    assert client.get("/ready").json() == {"status": "ready"}  # the v1 routes keep their own format
-    assert set(client.post("/decode", json={}, headers=key).json()) == {"detail", "errors"}
 
 
 def test_integral_numbers_are_integers_in_a_shape(client):

@@ -1,4 +1,5 @@
-"""openapi.yaml is the app's own schema, documents every status the service answers, and the service needs no torch."""
+"""openapi.yaml (service.openapi) is the app's own schema and documents every status the service answers; the live
+schema states the model's and the settings' bounds; and the service needs no torch."""
 
 from __future__ import annotations
 
@@ -42,17 +43,6 @@ def test_every_status_is_documented_with_an_example():
     for path in ("/ready", "/model"):
         assert {"200", "503"} <= set(paths[path]["get"]["responses"]), path
     assert {"/health", "/metrics"} <= set(paths)
-
-
-def test_request_examples_are_valid_requests(client):
-    """Every example body in the schema is accepted by the running app."""
-    for path, item in openapi_spec()["paths"].items():
-        op = item.get("post")
-        if op is None:
-            continue
-        for name, example in op["requestBody"]["content"]["application/json"]["examples"].items():
-            r = client.post(path, json=example["value"])
-            assert r.status_code == 200, (path, name, r.text)
 
 
 def test_the_service_runs_without_torch(model_dir):
@@ -102,9 +92,3 @@ def test_the_live_schema_states_the_model_and_the_settings_bounds(make_client, r
     assert spec["schemas"]["SampleRequest"]["properties"]["count"]["maximum"] == 7
     assert spec["schemas"]["AugmentRequest"]["properties"]["count"]["maximum"] == 900
     assert spec["schemas"]["InterpolateRequest"]["not"] == {"required": ["steps", "weights"]}
-
-
-def test_steps_and_weights_exclude_each_other_even_as_null(client):
-    c = [[0, 0], [1, 2], [2, 3], [3, 1]]
-    r = client.post("/interpolate", json={"curves": [c, c[::-1]], "steps": 3, "weights": None})
-    assert r.status_code == 422 and "either steps or weights" in r.json()["detail"]

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from ezdxf import recover
 
+from tests.e2e.test_page import arc, browser, draw, open_page, server, state  # noqa: F401 - fixtures
 from tests.helpers import FIXTURES
-from tests.service.test_page import arc, browser, draw, open_page, server, state  # noqa: F401 - fixtures
 
 FILES = FIXTURES / "files"
 PAGE = json.loads((FILES / "page-export.json").read_text())["curves"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.service.test_page import H, browser, draw, open_page, server, state  # noqa: F401 (fixtures)
+from tests.e2e.test_page import H, browser, draw, open_page, server, state  # noqa: F401 (fixtures)
 
 pytestmark = pytest.mark.integration
 

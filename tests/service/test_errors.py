@@ -1,4 +1,5 @@
-"""Every validation rule gets the bad input it exists for: a 4xx whose message names field, curve and point.
+"""The API's one error body (service.errors): every validation rule gets the bad input it exists for, and a 4xx whose
+message names field, curve and point; paths under /v2 answer in the Open Inference Protocol's format instead.
 
 No input may produce a 5xx: the last tests throw malformed and extreme bodies at every endpoint.
 """
@@ -10,24 +11,18 @@ import json
 import numpy as np
 import pytest
 
-from tests.helpers import FIXTURES
+from tests.helpers import FIXTURES, bspline_curves
 
 FILES = FIXTURES / "files"
 
 C = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]  # a valid curve
 Z = [0.0] * 32  # a valid latent
-LIMITS = {"max_curves": 4, "max_points": 300, "max_body_bytes": 20_000}
 
 
 def _with(curve_index: int, point_index: int, coord: int, value: object) -> list:
     curves = [list(map(list, C)) for _ in range(3)]
     curves[curve_index][point_index][coord] = value
     return curves
-
-
-@pytest.fixture
-def limited(make_client):
-    return make_client(**LIMITS)
 
 
 # (path, JSON body or raw text, expected status, expected start of "detail")
@@ -346,81 +341,6 @@ def test_bad_input_is_rejected_with_a_message_naming_where(client, path, body, s
     assert out["errors"] and out["errors"][0]["loc"] == detail.split(":")[0]
 
 
-LIMIT_CASES = [
-    pytest.param("/encode", {"curves": [C] * 5}, "curves: at most 4 curves per request, got 5", id="too-many-curves"),
-    pytest.param(
-        "/fit", {"curves": [C] * 5, "n_ctrl": 4}, "curves: at most 4 curves per request, got 5", id="fit-curves"
-    ),
-    pytest.param(
-        "/fit",
-        {"curves": [C], "n_ctrl": 4, "n_points": 301},
-        "n_points: at most 300, got 301",
-        id="fit-n-points-over-limit",
-    ),
-    pytest.param(
-        "/revolve",
-        {"curve": np.linspace(0, 1, 602).reshape(301, 2).tolist()},
-        "curve: at most 300 points, got 301",
-        id="revolve-profile-too-long",
-    ),
-    pytest.param(
-        "/reconstruct",
-        {"curves": [C, np.linspace(0, 1, 602).reshape(301, 2).tolist()]},
-        "curves[1]: at most 300 points per curve, got 301",
-        id="too-many-points",
-    ),
-    pytest.param(
-        "/reconstruct", {"curves": [C], "n_points": 301}, "n_points: at most 300, got 301", id="n-points-over-limit"
-    ),
-    pytest.param(
-        "/decode", {"latents": [Z] * 5}, "latents: at most 4 latents per request, got 5", id="too-many-latents"
-    ),
-    pytest.param(
-        "/interpolate",
-        {"curves": [C, C], "steps": 5},
-        "steps: 5 steps over 2 curves make 5 curves; at most 4",
-        id="steps-over-limit",
-    ),
-    pytest.param(
-        "/interpolate",
-        {"curves": [C, C, C], "steps": 3},
-        "steps: 3 steps over 3 curves make 6 curves",
-        id="triplet-grid-over-limit",
-    ),
-    pytest.param(
-        "/interpolate",
-        {"curves": [C, C], "weights": [[1, 0]] * 5},
-        "weights: at most 4 rows, got 5",
-        id="too-many-weight-rows",
-    ),
-]
-
-
-@pytest.mark.parametrize("path,body,detail", LIMIT_CASES)
-def test_configured_limits(limited, path, body, detail):
-    r = limited.post(path, json=body)
-    assert r.status_code == 422, r.text
-    assert r.json()["detail"].startswith(detail), r.json()["detail"]
-
-
-def test_body_over_the_limit_is_413(limited):
-    big = {"curves": [np.linspace(0, 1, 600).reshape(300, 2).tolist()] * 4}
-    r = limited.post("/reconstruct", json=big)
-    assert r.status_code == 413
-    assert r.json()["detail"].startswith("body: a body of") and "20000 bytes" in r.json()["detail"]
-
-
-def test_streamed_body_over_the_limit_is_413(limited):
-    def chunks():  # no Content-Length: the limit must hold while reading
-        yield b'{"curves": ['
-        for _ in range(100):
-            yield json.dumps(C).encode() * 5 + b","
-        yield b"]}"
-
-    r = limited.post("/encode", content=chunks(), headers={"Content-Type": "application/json"})
-    assert r.status_code == 413 and "streamed body" in r.json()["detail"]
-
-
 def test_form_encoded_body_gets_a_hint(client):
     r = client.post(
         "/encode", content=json.dumps({"curves": [C]}), headers={"Content-Type": "application/x-www-form-urlencoded"}
@@ -500,14 +420,6 @@ def test_garbage_never_gives_5xx(client, path):
         assert r.json()["detail"]
 
 
-def test_integral_numbers_are_integers_as_in_json_schema(client):
-    """JSON Schema's "integer" admits 3.0; so does the service, and 3.5 stays an error."""
-    ok = client.post("/sample", json={"count": 3.0, "seed": 7.0, "n_points": 50.0})
-    same = client.post("/sample", json={"count": 3, "seed": 7, "n_points": 50})
-    assert ok.status_code == 200 and ok.json() == same.json()
-    assert client.post("/sample", json={"count": 3.5}).json()["detail"] == "count: not an integer"
-
-
 @pytest.mark.parametrize("path", ["/encode", "/reconstruct", "/interpolate", "/augment"])
 def test_one_curve_not_wrapped_in_a_list_gets_one_error_that_says_wrap_it(client, path):
     r = client.post(path, json={"curves": [[0, 0], [1, 2], [2, 3], [3, 1]]})
@@ -530,3 +442,60 @@ def test_the_pages_json_export_posted_as_it_is_gets_told_what_to_send(client, pa
     detail = r.json()["detail"]
     assert detail.startswith("curves[0]: a curve is a list of [x, y] points, not an object: send each curve's")
     assert "curve-vae reconstruct FILE reads it" in detail
+
+
+def tensor(name: str, a: np.ndarray, datatype: str = "FP32") -> dict:
+    return {"name": name, "shape": list(a.shape), "datatype": datatype, "data": a.ravel().tolist()}
+
+
+def encoder_request(count: int = 2, seed: int = 0) -> dict:
+    return {"inputs": [tensor("curves", bspline_curves(count, seed=seed).astype(np.float32))]}
+
+
+def error(r, status: int = 400) -> str:
+    assert r.status_code == status, r.text
+    assert set(r.json()) == {"error"}, r.text
+    return r.json()["error"]
+
+
+def test_api_keys_body_limit_and_unknown_paths_answer_in_the_protocols_format(make_client):
+    client = make_client(api_keys="s3cret", max_body_bytes=4096)
+    assert "needs an API key" in error(client.post("/v2/models/encoder/infer", json=encoder_request(1)), 401)
+    assert "needs an API key" in error(client.get("/v2/models/encoder"), 401)
+    assert client.get("/v2/health/live").status_code == 200  # probes need no key
+    assert client.get("/v2/health/ready").status_code == 200
+    key = {"X-API-Key": "s3cret"}
+    assert client.get("/v2/models/encoder", headers=key).status_code == 200
+    big = client.post("/v2/models/encoder/infer", json=encoder_request(2), headers=key)  # ~12 kB
+    assert "exceeds the limit of 4096 bytes" in error(big, 413)
+    decoded = client.post(
+        "/v2/models/decoder/infer", json={"inputs": [tensor("latent", np.zeros((1, 32)))]}, headers=key
+    )
+    assert decoded.status_code == 200
+    assert error(client.get("/v2/models/encoder/versions/1", headers=key), 404) == "Not Found"
+    assert client.get("/ready").json() == {"status": "ready"}  # the v1 routes keep their own format
+    assert set(client.post("/decode", json={}, headers=key).json()) == {"detail", "errors"}
+
+
+def test_at_most_twenty_problems_are_listed_the_first_one_first(client):
+    curve = [[i, "x"] for i in range(30)]  # 30 bad numbers
+    r = client.post("/reconstruct", json={"curves": [curve]})
+    assert r.status_code == 422
+    errors = r.json()["errors"]
+    assert [e["loc"] for e in errors] == [f"curves[0][{i}][1]" for i in range(20)]
+    assert r.json()["detail"] == "curves[0][0][1]: not a number"
+
+
+@pytest.mark.parametrize(
+    ("path", "protocol"),
+    [
+        pytest.param("/v2/nothing", True, id="under-v2"),
+        pytest.param("/v2", True, id="v2-itself-wrong-method"),
+        pytest.param("/v2x", False, id="v2x-is-not-v2"),
+        pytest.param("/v1/nothing", False, id="elsewhere"),
+    ],
+)
+def test_only_paths_under_v2_answer_in_the_protocols_format(client, path, protocol):
+    r = client.delete(path)
+    assert r.status_code in (404, 405)
+    assert set(r.json()) == ({"error"} if protocol else {"detail", "errors"}), r.json()

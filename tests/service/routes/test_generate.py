@@ -1,14 +1,27 @@
-"""Sampling and augmentation (issue 5): seeded, paged and streamed batches; weights in the simplex; metrics."""
+"""POST /sample and /augment (service.routes.generate, issue 5): seeded, paged and streamed batches; weights in the
+simplex; metrics; a stream that fails midway is visibly short."""
 
 from __future__ import annotations
 
 import io
+import threading
+import time
 
+import httpx
 import numpy as np
 import pytest
+import uvicorn
 
-from curve_vae.geometry import Frame, curve_length, self_intersects, smoothness
+from curve_vae.geometry import (
+    Frame,
+    curve_length,
+    self_intersects,
+    smoothness,
+)
 from curve_vae.inference.bodies import curve_metrics
+from curve_vae.inference.runtime import CurveRuntime
+from curve_vae.service.app import create_app
+from curve_vae.service.settings import Settings
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 
@@ -217,3 +230,80 @@ def test_metrics_measure_what_they_say():
 def test_metrics_need_json(client):
     r = client.post("/augment", json={"curves": [CURVE, CURVE], "count": 2, "format": "npy", "metrics": True})
     assert r.status_code == 422 and r.json()["detail"].startswith("metrics: only with format json")
+
+
+def test_a_stream_that_fails_midway_is_visibly_short(model_dir, monkeypatch):
+    """The .npy answer carries its Content-Length: a failure after the first chunk ends the connection early, and
+    the client sees an incomplete body, never a silently short file."""
+    runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1)
+    real, calls = runtime.augment, []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 3:
+            raise RuntimeError("the decoder broke down")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(runtime, "augment", failing)
+    config = uvicorn.Config(create_app(Settings(model_dir=model_dir), runtime=runtime), port=0, log_level="critical")
+    server = uvicorn.Server(config)
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    try:
+        deadline = time.monotonic() + 30
+        while not server.started:
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        port = server.servers[0].sockets[0].getsockname()[1]
+        body = {"curves": [CURVE, CURVE[::-1]], "count": 1000, "format": "npy", "seed": 1}
+        with pytest.raises(httpx.RemoteProtocolError, match="incomplete|closed"):
+            with httpx.stream("POST", f"http://127.0.0.1:{port}/augment", json=body, timeout=30) as r:
+                assert r.status_code == 200 and int(r.headers["content-length"]) == 128 + 1000 * 7 * 2 * 4
+                r.read()
+    finally:
+        server.should_exit = True
+        thread.join(timeout=30)
+    assert len(calls) == 3
+
+
+def test_sample_is_reproducible_with_a_seed(client, runtime):
+    a = client.post("/sample", json={"count": 3, "seed": 5, "n_points": 50}).json()
+    b = client.post("/sample", json={"count": 3, "seed": 5, "n_points": 50}).json()
+    c = client.post("/sample", json={"count": 3, "seed": 6, "n_points": 50}).json()
+    assert a == b and a["latents"] != c["latents"]
+    assert np.shape(a["latents"]) == (3, 32) and np.shape(a["curves"]) == (3, 50, 2)
+    np.testing.assert_allclose(a["curves"], runtime.decode(np.array(a["latents"]), n_points=50).curves, rtol=1e-9)
+    cold = client.post("/sample", json={"count": 2, "temperature": 0, "prior": "standard", "valid": False}).json()
+    assert np.all(np.array(cold["latents"]) == 0)
+    cold = client.post("/sample", json={"count": 4, "temperature": 0, "valid": False}).json()  # the learned prior
+    for z in cold["latents"]:  # each a component's mean
+        assert np.abs(runtime.prior.means - np.array(z)).max(axis=1).min() < 1e-12
+
+
+@pytest.mark.parametrize("mode,k", [("pair", 2), ("triplet", 3)])
+def test_augment(client, curves, runtime, mode, k):
+    c = [x * (i + 1) + 10 * i for i, x in enumerate(curves(4, 161))]
+    body = {"curves": [x.tolist() for x in c], "count": 6, "mode": mode, "seed": 3}
+    out = client.post("/augment", json=body).json()
+    assert out == client.post("/augment", json=body).json()  # same seed, same answer
+    sources, weights = np.array(out["sources"]), np.array(out["weights"])
+    assert sources.shape == weights.shape == (6, k)
+    assert all(len(set(row)) == k for row in sources.tolist()) and sources.min() >= 0 and sources.max() < 4
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0)
+    assert (weights >= 0).all()
+    full = np.zeros((6, 4))
+    np.put_along_axis(full, sources, weights, axis=1)
+    expected = runtime.interpolate(c, full).curves
+    np.testing.assert_allclose(out["curves"], expected, rtol=1e-9, atol=1e-9)
+
+
+C1 = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
+
+
+C2 = [[0, 0], [1.5, 0.5], [3, 2], [4, 4], [5, 6.5], [6.5, 8], [8, 8.5]]
+
+
+def test_npy_augment_is_points_only(client):
+    body = {"curves": [C1, C2], "count": 3, "format": "npy", "output": "both"}
+    r = client.post("/augment", json=body)
+    assert r.status_code == 422 and r.json()["detail"].startswith('output: only "points" with format npy')

@@ -1,0 +1,174 @@
+"""`curve-vae serve` (service.cli): a real uvicorn process on a loopback port, called with httpx; its flags, defaults
+and configuration errors, workers, and shutdown on SIGTERM (requests in flight finish, exit 0)."""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import json
+import shutil
+import signal
+import subprocess
+import threading
+from pathlib import Path
+
+import httpx
+import numpy as np
+import onnxruntime as ort
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+C = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
+
+
+def test_endpoints_over_a_socket(live_server, curves):
+    with httpx.Client(base_url=live_server.url, timeout=30) as http:
+        assert http.get("/health").json() == {"status": "ok"}
+        assert http.get("/model").json()["providers"] == ["CPUExecutionProvider"]
+        before = _counts(http.get("/metrics").text)  # the server is shared: other tests' requests are counted too
+        c = curves(2, 90) * 0.2 - 3
+        rec = http.post("/reconstruct", json={"curves": c.tolist()})
+        assert rec.status_code == 200 and np.shape(rec.json()["curves"]) == (2, 90, 2)
+        inter = http.post("/interpolate", json={"curves": c.tolist(), "steps": 4, "n_points": 30})
+        assert np.shape(inter.json()["curves"]) == (4, 30, 2)
+        bad = http.post(
+            "/encode",
+            content=b'{"curves": [[[0,0],[1,NaN],[2,3],[3,1]]]}',
+            headers={"Content-Type": "application/json"},
+        )
+        assert bad.status_code == 422 and bad.json()["detail"] == "curves[0][1][1]: not a finite number"
+        big = http.post("/encode", json={"curves": [np.linspace(0, 1, 8000).reshape(-1, 2).tolist()] * 10})
+        assert big.status_code == 413  # the server was started with --max-body-bytes 200000
+        after = _counts(http.get("/metrics").text)
+        for route, status in (("/encode", "413"), ("/reconstruct", "200"), ("/interpolate", "200"), ("/encode", "422")):
+            key = f'method="POST",route="{route}",status="{status}"'
+            assert after.get(key, 0) - before.get(key, 0) == 1, key
+
+
+def _counts(metrics: str) -> dict[str, float]:
+    """curve_vae_http_requests_total by its labels, from a Prometheus text page."""
+    out = {}
+    for line in metrics.splitlines():
+        if line.startswith("curve_vae_http_requests_total{"):
+            labels, value = line[len("curve_vae_http_requests_total{") :].rsplit("} ", 1)
+            out[labels] = float(value)
+    return out
+
+
+def test_concurrent_requests(live_server, curves):
+    """Inference runs off the event loop: /health answers while requests are in flight."""
+    import concurrent.futures as cf
+
+    body = {"curves": curves(16, 161).tolist()}  # under the server's 200 kB body limit
+    with httpx.Client(base_url=live_server.url, timeout=60) as http, cf.ThreadPoolExecutor(4) as pool:
+        futures = [pool.submit(http.post, "/reconstruct", json=body) for _ in range(3)]
+        assert http.get("/health", timeout=5).status_code == 200
+        assert all(f.result().status_code == 200 for f in futures)
+
+
+def test_two_workers(server_factory, model_dir):
+    """Workers are separate processes that rebuild the settings from the environment."""
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2", "--max-curves", "3")
+    server.wait_ready(timeout=60)
+    r = httpx.post(f"{server.url}/encode", json={"curves": [C] * 4}, timeout=30)
+    assert r.status_code == 422 and "at most 3 curves" in r.json()["detail"]
+    assert server.stop() == 0
+
+
+def test_sigterm_shuts_down_cleanly(server_factory, model_dir):
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--log-level", "info")
+    server.wait_ready()
+    server.proc.terminate()
+    # uvicorn shuts down gracefully, then re-raises the signal so the exit status tells it was terminated
+    assert server.proc.wait(timeout=20) in (0, -signal.SIGTERM)
+    log = server.proc.stdout.read()  # type: ignore[union-attr]
+    assert "Application shutdown complete" in log and "Traceback" not in log
+
+
+def test_a_model_that_fails_at_startup_stops_the_server(server_factory, model_dir, tmp_path):
+    broken = tmp_path / "model"
+    shutil.copytree(model_dir, broken)
+    manifest = json.loads((broken / "manifest.json").read_text())
+    manifest["latent_dim"] = 16  # checksums still match; the graphs do not
+    (broken / "manifest.json").write_text(json.dumps(manifest))
+    server = server_factory("--model-dir", str(broken), "--providers", "cpu")
+    assert server.proc.wait(timeout=60) == 3
+    assert "graphs do not match the manifest" in server.proc.stdout.read()  # type: ignore[union-attr]
+
+
+# ----------------------------------------------------------------------------- CLI configuration errors
+
+
+def _serve(*args: str) -> subprocess.CompletedProcess[str]:
+    import sys
+
+    cmd = [sys.executable, "-m", "curve_vae.service.cli", *args]
+    return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=60)
+
+
+@pytest.mark.skipif("CUDAExecutionProvider" in ort.get_available_providers(), reason="CUDA is available here")
+def test_cuda_where_unavailable_is_a_clear_startup_error(model_dir):
+    out = _serve("--model-dir", str(model_dir), "--providers", "cuda")
+    assert out.returncode == 2
+    assert "providers=cuda" in out.stderr and "onnxruntime-gpu" in out.stderr
+
+
+def test_configuration_errors(tmp_path, model_dir, capsys):
+    import argparse
+
+    from curve_vae.service.cli import configure_parser, run
+
+    parser = argparse.ArgumentParser()
+    configure_parser(parser)
+    assert run(parser.parse_args(["--model-dir", str(tmp_path)])) == 2
+    assert "manifest.json is missing" in capsys.readouterr().err
+    assert run(parser.parse_args(["--model-dir", str(model_dir), "--max-points", "2"])) == 2
+    assert "max_points" in capsys.readouterr().err
+
+
+def test_help_names_defaults_and_variables():
+    out = _serve("--help")
+    assert out.returncode == 0
+    for text in ("--providers", "CURVE_VAE_PROVIDERS", "default: auto", "--model-dir", "CURVE_VAE_MAX_BODY_BYTES"):
+        assert text in out.stdout
+
+
+def test_flags_override_the_environment(monkeypatch):
+    import argparse
+
+    from curve_vae.service.cli import configure_parser, settings_from_args
+
+    monkeypatch.setenv("CURVE_VAE_PORT", "9001")
+    monkeypatch.setenv("CURVE_VAE_WORKERS", "3")
+    parser = argparse.ArgumentParser()
+    configure_parser(parser)
+    settings = settings_from_args(
+        parser.parse_args(["--port", "9002", "--cors-origins", "https://a.example,https://b"])
+    )
+    assert (settings.port, settings.workers, settings.cors_origins) == (9002, 3, ["https://a.example", "https://b"])
+
+
+CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
+
+
+def test_sigterm_lets_requests_in_flight_finish_then_exits_0(server_factory, model_dir):
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu")
+    server.wait_ready()
+    body = {"curves": [CURVE, CURVE[::-1]], "count": 10_000, "format": "npy", "seed": 1, "n_points": 161}
+    expected = 128 + 10_000 * 161 * 2 * 4
+    with httpx.Client(timeout=120) as http, cf.ThreadPoolExecutor(1) as pool:
+        started = threading.Event()
+
+        def download() -> int:
+            with http.stream("POST", server.url + "/augment", json=body) as r:
+                size = 0
+                for chunk in r.iter_bytes():
+                    started.set()
+                    size += len(chunk)
+                return size
+
+        future = pool.submit(download)
+        assert started.wait(30)
+        server.proc.send_signal(signal.SIGTERM)  # mid-stream
+        assert future.result() == expected  # the whole file arrived
+    assert server.proc.wait(timeout=60) == 0
+    assert "Traceback" not in server.proc.stdout.read()  # type: ignore[union-attr]
