@@ -29,7 +29,7 @@ ERROR_EXAMPLES = {
     401: (
         "The server needs an API key (CURVE_VAE_API_KEYS) and the request sent none or a wrong one.",
         "this service needs an API key: send Authorization: Bearer <key> or X-API-Key: <key>",
-        None,
+        "headers.authorization",
     ),
     504: (
         "The request took longer than CURVE_VAE_REQUEST_TIMEOUT seconds, queueing included.",
@@ -43,7 +43,8 @@ def error_docs(*codes: int) -> dict[int | str, dict[str, Any]]:
     out: dict[int | str, dict[str, Any]] = {}
     for code in codes:
         description, detail, loc = ERROR_EXAMPLES[code]
-        errors = [{"loc": loc, "msg": detail.split(": ", 1)[1]}] if loc else []
+        msg = detail.removeprefix(f"{loc}: ")  # a field's message follows its name; a header's is the detail itself
+        errors = [{"loc": loc, "msg": msg}] if loc else []
         out[code] = {
             "model": r.ErrorResponse,
             "description": description,

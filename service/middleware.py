@@ -59,7 +59,7 @@ class BodyLimitMiddleware:
             more = message.get("more_body", False)
             if size > self.limit:
                 chunks.clear()
-                await self._refuse(f"a streamed body of more than {size} bytes", scope, receive, send, drain=more)
+                await self._refuse(f"a streamed body of at least {size} bytes", scope, receive, send, drain=more)
                 return
         await self.app(
             scope, _replay([{"type": "http.request", "body": b"".join(chunks), "more_body": False}], receive), send

@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import shlex
 
-import pytest
-
 from curve_vae.service.openapi import openapi_spec
 
 
@@ -59,11 +57,6 @@ def test_the_401_example_says_what_the_service_says(make_client):
     assert r.status_code == 401 and r.json()["detail"] == example["detail"]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the documented 401 body has errors: [] but the service answers one item, "
-    "{loc: headers.authorization, msg: <the detail>} (service/api_docs.py ERROR_EXAMPLES[401] has loc None)",
-)
 def test_the_401_example_is_the_whole_answer(make_client):
     example = _error_example(openapi_spec(), "/reconstruct", "401")
     r = make_client(api_keys=["k-0123456789"]).post("/reconstruct", json={"curves": []})
