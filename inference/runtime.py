@@ -21,19 +21,20 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
-from curve_vae.errors import InvalidInput
 from curve_vae.geometry import Frame, blend_frames
 from curve_vae.geometry.adapt import is_closed
 from curve_vae.inference.augmenting import AugmentPlan, neighbour_pools
 from curve_vae.inference.cache import DEFAULT_CACHE_BYTES, EncodingCache
-from curve_vae.inference.choices import SOURCES_PER_MODE, Placement, choices
+from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.manifest import Manifest, ModelLoadError
+from curve_vae.inference.manifest import Manifest, ModelLoadError  # noqa: F401  (ModelLoadError: part of its API)
+from curve_vae.inference.opening import open_model
 from curve_vae.inference.placing import (
     check_finite,
     check_range,
@@ -46,7 +47,7 @@ from curve_vae.inference.placing import (
 )
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
-from curve_vae.inference.priors import NamedPrior, load_priors
+from curve_vae.inference.priors import NamedPrior
 from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
@@ -64,6 +65,7 @@ from curve_vae.inference.sampling import MAX_DRAWS, Sampler, fresh_seed
 from curve_vae.inference.sessions import SessionConfig
 
 DEFAULT = Reading()
+T = TypeVar("T")
 
 
 class CurveRuntime:
@@ -116,39 +118,17 @@ class CurveRuntime:
         spline.placement says; "closest" or "index" whatever it says (CURVE_VAE_PLACEMENT). `cache_bytes`: the
         encoding cache's bound (0: no cache). `priors_dir`: priors fitted to users' curves (`curve-vae prior`), by
         their files' stems; one fitted to another model is a ModelLoadError."""
-        root = Path(model_dir)
-        manifest = Manifest.read(root)
-        if placement not in choices(Placement):
-            raise InvalidInput(f"placement must be one of {', '.join(choices(Placement))}, got {placement!r}")
-        if placement == "closest" and manifest.spline is None:
-            raise ModelLoadError(f"{root}: placement closest needs a model with a B-spline head; this one has none")
-        prior = None
-        if manifest.prior is not None:
-            path = root / manifest.prior.file
-            try:
-                prior = LatentPrior.load(path)
-            except (OSError, ValueError, KeyError) as e:
-                raise ModelLoadError(f"{path}: not a usable latent prior ({e})") from e
-            if prior.latent_dim != manifest.latent_dim:
-                raise ModelLoadError(
-                    f"graphs do not match the manifest: the prior has {prior.latent_dim} latent dimensions, "
-                    f"the model {manifest.latent_dim}"
-                )
-        ranker = None
-        if manifest.ranker is not None:
-            path = root / manifest.ranker.file
-            try:
-                ranker = Ranker.load(path)
-            except (OSError, ValueError, KeyError) as e:
-                raise ModelLoadError(f"{path}: not a usable reading ranker ({e})") from e
-        config = sessions or SessionConfig(intra_op_threads=intra_op_threads)
-        graphs = ModelGraphs.open(
-            root, manifest, providers=providers, sessions=config, batch_size=batch_size, warm_up=warm_up
+        parts = open_model(
+            model_dir,
+            providers=providers,
+            batch_size=batch_size,
+            warm_up=warm_up,
+            sessions=sessions or SessionConfig(intra_op_threads=intra_op_threads),
+            placement=placement,
+            cache_bytes=cache_bytes,
+            priors_dir=priors_dir,
         )
-        closest = None if placement == "model" else placement == "closest"
-        cache = EncodingCache(cache_bytes) if cache_bytes > 0 else None
-        named = load_priors(priors_dir, manifest, manifest.latent_dim)
-        return cls(graphs, prior=prior, closest=closest, cache=cache, model_dir=root, priors=named, ranker=ranker)
+        return cls(**parts)
 
     # ----------------------------------------------------------------------- what the model is
 

@@ -1,0 +1,74 @@
+"""Opening a model directory: its manifest checked, its graphs' sessions opened, the files beside them read (the
+learned prior, the reading ranker, priors fitted to users' curves), each failure a ModelLoadError that names the file
+and what to fix. `CurveRuntime.load` is the way in; this is what it is made of."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+from curve_vae.errors import InvalidInput
+from curve_vae.inference.cache import EncodingCache
+from curve_vae.inference.choices import Placement, choices
+from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.manifest import Manifest, ModelLoadError
+from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.priors import load_priors
+from curve_vae.inference.ranker import Ranker
+from curve_vae.inference.sessions import SessionConfig
+
+T = TypeVar("T")
+
+
+def open_model(
+    model_dir: str | Path,
+    *,
+    providers: str,
+    batch_size: int,
+    warm_up: bool,
+    sessions: SessionConfig,
+    placement: str,
+    cache_bytes: int,
+    priors_dir: str | Path | None,
+) -> dict[str, Any]:
+    """The parts `CurveRuntime(...)` takes, by name (see `CurveRuntime.load` for the options)."""
+    root = Path(model_dir)
+    manifest = Manifest.read(root)
+    if placement not in choices(Placement):
+        raise InvalidInput(f"placement must be one of {', '.join(choices(Placement))}, got {placement!r}")
+    if placement == "closest" and manifest.spline is None:
+        raise ModelLoadError(f"{root}: placement closest needs a model with a B-spline head; this one has none")
+    prior = _load_part(root, manifest.prior, "latent prior", LatentPrior.load)
+    if prior is not None and prior.latent_dim != manifest.latent_dim:
+        raise ModelLoadError(
+            f"graphs do not match the manifest: the prior has {prior.latent_dim} latent dimensions, "
+            f"the model {manifest.latent_dim}"
+        )
+    ranker = _load_part(root, manifest.ranker, "reading ranker", Ranker.load)
+    graphs = ModelGraphs.open(
+        root, manifest, providers=providers, sessions=sessions, batch_size=batch_size, warm_up=warm_up
+    )
+    closest = None if placement == "model" else placement == "closest"
+    cache = EncodingCache(cache_bytes) if cache_bytes > 0 else None
+    named = load_priors(priors_dir, manifest, manifest.latent_dim)
+    return {
+        "graphs": graphs,
+        "prior": prior,
+        "closest": closest,
+        "cache": cache,
+        "model_dir": root,
+        "priors": named,
+        "ranker": ranker,
+    }
+
+
+def _load_part(root: Path, entry: Any, what: str, load: Callable[[Path], T]) -> T | None:
+    """A model file the manifest names (None where it names none), or a ModelLoadError saying why it is unusable."""
+    if entry is None:
+        return None
+    path = root / entry.file
+    try:
+        return load(path)
+    except (OSError, ValueError, KeyError) as e:
+        raise ModelLoadError(f"{path}: not a usable {what} ({e})") from e
