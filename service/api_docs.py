@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Any
-
-from fastapi import Body
+from typing import Any
 
 from curve_vae.service import responses as r
-from curve_vae.service import schemas as s
 
 ERROR_EXAMPLES = {
     413: (
@@ -105,50 +102,33 @@ INTERPOLATE = {
         {"curves": [C1, C2], "weights": [[0.5, 0.5]], "output": "bspline"},
     ),
 }
-Decode = Annotated[
-    s.DecodeRequest,
-    Body(
-        openapi_examples={
-            "origin": example("The centre of the latent space, 50 points", {"latents": [[0.0] * 32], "n_points": 50}),
-            "in a frame": example(
-                "Mapped into a frame from /encode",
-                {"latents": [[0.0] * 32], "frames": [{"center": [4.0, 1.75], "size": 8.0}]},
-            ),
-        }
+DECODE = {
+    "origin": example("The centre of the latent space, 50 points", {"latents": [[0.0] * 32], "n_points": 50}),
+    "in a frame": example(
+        "Mapped into a frame from /encode",
+        {"latents": [[0.0] * 32], "frames": [{"center": [4.0, 1.75], "size": 8.0}]},
     ),
-]
-Sample = Annotated[
-    s.SampleRequest,
-    Body(
-        openapi_examples={
-            "seeded": example("Three curves, reproducible", {"count": 3, "seed": 7, "n_points": 50}),
-            "tame": example("Closer to typical shapes", {"count": 2, "seed": 1, "temperature": 0.5}),
-            "standard prior": example(
-                "The VAE's N(0, I), every draw kept", {"count": 2, "seed": 1, "prior": "standard", "valid": False}
-            ),
-            "framed": example(
-                "In a frame of one's own, with smoothness metrics",
-                {"count": 2, "seed": 3, "frame": {"center": [0, 0], "size": 2}, "metrics": True},
-            ),
-        }
+}
+SAMPLE = {
+    "seeded": example("Three curves, reproducible", {"count": 3, "seed": 7, "n_points": 50}),
+    "tame": example("Closer to typical shapes", {"count": 2, "seed": 1, "temperature": 0.5}),
+    "standard prior": example(
+        "The VAE's N(0, I), every draw kept", {"count": 2, "seed": 1, "prior": "standard", "valid": False}
     ),
-]
-Augment = Annotated[
-    s.AugmentRequest,
-    Body(
-        openapi_examples={
-            "pairs": example("Four random pair interpolants", {"curves": [C1, C2, C3], "count": 4, "seed": 1}),
-            "triplets": example(
-                "Two random triplet interpolants", {"curves": [C1, C2, C3], "count": 2, "mode": "triplet"}
-            ),
-            "neighbours, second page": example(
-                "Pairs of near neighbours only; curves 4 and 5 of the seeded sequence",
-                {"curves": [C1, C2, C3], "count": 2, "neighbours": 1, "seed": 1, "offset": 4},
-            ),
-            "npy": example(
-                "1000 curves as a binary .npy file (curl -o batch.npy)",
-                {"curves": [C1, C2, C3], "count": 1000, "seed": 1, "n_points": 64, "format": "npy"},
-            ),
-        }
+    "framed": example(
+        "In a frame of one's own, with smoothness metrics",
+        {"count": 2, "seed": 3, "frame": {"center": [0, 0], "size": 2}, "metrics": True},
     ),
-]
+}
+AUGMENT = {
+    "pairs": example("Four random pair interpolants", {"curves": [C1, C2, C3], "count": 4, "seed": 1}),
+    "triplets": example("Two random triplet interpolants", {"curves": [C1, C2, C3], "count": 2, "mode": "triplet"}),
+    "neighbours, second page": example(
+        "Pairs of near neighbours only; curves 4 and 5 of the seeded sequence",
+        {"curves": [C1, C2, C3], "count": 2, "neighbours": 1, "seed": 1, "offset": 4},
+    ),
+    "npy": example(
+        "1000 curves as a binary .npy file (curl -o batch.npy)",
+        {"curves": [C1, C2, C3], "count": 1000, "seed": 1, "n_points": 64, "format": "npy"},
+    ),
+}

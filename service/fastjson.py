@@ -52,7 +52,7 @@ class FastJSONRoute(APIRoute):
         handler = super().get_route_handler()
 
         async def route_handler(request: Request) -> Response:
-            npy = getattr(self, "npy", None)  # set by npy_bodies.curve_route
+            npy = getattr(self, "npy", None)  # set by routing.model_route(..., npy=True)
             if npy is not None and npy_bodies.is_npy(request):
                 return await npy_bodies.dispatch(request, npy)
             return await handler(_Request(request.scope, request.receive))

@@ -1,25 +1,24 @@
-"""The request limits that come from the settings (curves per request, points per curve, …), written once: `BOUNDS`
-both checks a request (`check`, a 422 naming the field) and states each limit in the published schema
+"""The request limits, written once. Those that come from the settings (curves per request, points per curve, …) are
+`BOUNDS`: it both checks a request (`check`, a 422 naming the field) and states each limit in the published schema
 (`state_bounds`), so a client generated from openapi.yaml knows them. The rules that combine fields are here too:
 refine's work (`check_refine`), an interpolation's weights and grid (`check_weights`), /augment's count and body by
-format (`check_augment_format`). A schema's own bounds (≥ 4 points, refine's 0…MAX_REFINE_STEPS from the reading's
-definition, inference.choices) are the request models'."""
+format (`check_augment_format`), a revolved mesh's triangles (`check_mesh`); `check_request` applies all that apply
+(service.routing builds every route with it). A schema's own bounds (≥ 4 points, refine's 0…MAX_REFINE_STEPS from
+the reading's definition, inference.choices) are the request models'."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import Any, Protocol
 
 import numpy as np
 from pydantic import BaseModel
 
 from curve_vae.geometry import simplex_grid, simplex_grid_size
 from curve_vae.inference.errors import InputError
-
-if TYPE_CHECKING:
-    from curve_vae.service.schemas import AugmentRequest, InterpolateRequest
+from curve_vae.service.schemas import AugmentRequest, InterpolateRequest, RevolveRequest
 
 DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
 WEIGHT_SUM_TOLERANCE = 1e-6
@@ -86,6 +85,30 @@ def check(req: BaseModel, settings: Any, *, skip: tuple[str, ...] = ()) -> None:
                     raise InputError((bound.field, i), _message(bound, limit, len(item)))
         if bound.kind == "value" and value > limit:
             raise InputError((bound.field,), _message(bound, limit, value))
+
+
+def check_request(req: BaseModel, settings: Any, curves: list[np.ndarray], *, skip: tuple[str, ...] = ()) -> None:
+    """Every limit a request is held to, in one place (service.routing.model_route calls it for every route): its
+    model's BOUNDS, refine's work for a request that reads curves, /augment's count and body by format."""
+    check(req, settings, skip=skip)
+    reading = getattr(req, "reading", None)
+    if reading is not None:
+        check_refine(reading().refine, curves, settings)
+    if isinstance(req, AugmentRequest):
+        check_augment_format(req, settings)
+    if isinstance(req, RevolveRequest):
+        check_mesh(req, settings)
+
+
+def check_mesh(req: RevolveRequest, settings: Any) -> None:
+    """The triangles a revolved profile can make, 2 × (points - 1) × segments, within CURVE_VAE_MAX_MESH_TRIANGLES."""
+    triangles = 2 * (len(req.curve) - 1) * req.segments  # at most: pole bands have half as many
+    if triangles > settings.max_mesh_triangles:
+        raise InputError(
+            ("segments",),
+            f"{req.segments} segments of a {len(req.curve)}-point profile make up to {triangles} triangles; at most "
+            f"{settings.max_mesh_triangles} (CURVE_VAE_MAX_MESH_TRIANGLES)",
+        )
 
 
 def check_shape(model: str, count: int, points: int, settings: Any) -> None:

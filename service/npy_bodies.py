@@ -5,20 +5,19 @@ is the JSON request `{"curves": <the array>, "pose": "as_is"}`: the other fields
 each a JSON value (`n_points=100`, `metrics=true`, `weights=[[0.5,0.5]]`) or else a string (`frame=model`).
 The curves skip JSON parsing and per-number validation: numpy checks them at once, and each refusal is a 422
 naming what is wrong (the header, the dtype, the shape, or the curve and point that is not finite).
-The answer is the same JSON as for a JSON request: `curve_route` registers one handler for both bodies.
+The answer is the same JSON as for a JSON request: service.routing.model_route registers one handler for both bodies.
 """
 
 from __future__ import annotations
 
-import inspect
 import io
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
-from typing import Annotated, Any
+from typing import Any
 
 import numpy as np
 import orjson
-from fastapi import APIRouter, Body, Request
+from fastapi import Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
 from pydantic import BaseModel, ValidationError
@@ -56,40 +55,6 @@ class NpyRoute:
     handler: Handler  # (request, validated request model, curves) -> the response
 
 
-def curve_route(
-    router: APIRouter,
-    path: str,
-    model: type[BaseModel],
-    *,
-    examples: dict[str, Any] | None = None,
-    openapi_extra: dict[str, Any] | None = None,
-    **route: Any,
-) -> Callable[[Handler], Handler]:
-    """Register `handler(request, req, curves)` at POST `path`, once for both bodies: JSON of `model` (validated,
-    its limits checked), or the curves as a .npy body with the other fields in the query (dispatch). The route's
-    OpenAPI operation documents both."""
-
-    def register(handler: Handler) -> Handler:
-        async def endpoint(request: Request, req: Any) -> Response:
-            limits.check(req, request.app.state.settings)
-            return await handler(request, req, limits.curves_of(req))
-
-        endpoint.__name__, endpoint.__doc__ = handler.__name__, handler.__doc__
-        body = Annotated[model, Body(openapi_examples=examples)] if examples else model
-        # a function declares no __signature__, but inspect.signature (so FastAPI) reads the one set here
-        endpoint.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
-            [
-                inspect.Parameter("request", inspect.Parameter.POSITIONAL_OR_KEYWORD, annotation=Request),
-                inspect.Parameter("req", inspect.Parameter.POSITIONAL_OR_KEYWORD, annotation=body),
-            ]
-        )
-        router.post(path, openapi_extra=OPENAPI_BODY | (openapi_extra or {}), **route)(endpoint)
-        router.routes[-1].npy = NpyRoute(model, handler)  # type: ignore[attr-defined]  # our mark on the route
-        return handler
-
-    return register
-
-
 def is_npy(request: Request) -> bool:
     return request.headers.get("content-type", "").split(";")[0].strip().lower() == MEDIA_TYPE
 
@@ -104,7 +69,7 @@ async def dispatch(request: Request, route: NpyRoute) -> Response:
     except ValidationError as e:
         errors = [{**err, "loc": ("query", *err["loc"])} for err in e.errors() if err["loc"][:1] != ("curves",)]
         raise RequestValidationError(errors or e.errors()) from None
-    limits.check(req, settings, skip=("curves",))
+    limits.check_request(req, settings, curves, skip=("curves",))
     return await route.handler(request, req, curves)
 
 

@@ -1,6 +1,7 @@
-"""The model's curve routes: encode, decode, reconstruct, interpolate. Each takes its curves as JSON or as a .npy
-body (one handler, `npy_bodies.curve_route`), checks what its request combines, calls the runtime in a worker thread
-(deps.run_inference) and shapes the JSON; the OpenAPI examples are service.api_docs'."""
+"""The model's curve routes: encode, decode, reconstruct, interpolate. Each is built by service.routing.model_route
+(the request validated and within its limits; curves as JSON or, but for decode, a .npy body), calls the runtime in a
+worker thread (deps.run_inference) and answers the body inference.bodies builds; the OpenAPI examples are
+service.api_docs'."""
 
 from __future__ import annotations
 
@@ -13,25 +14,19 @@ from curve_vae.inference.errors import InputError
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
-from curve_vae.service.deps import (
-    RuntimeDep,
-    SettingsDep,
-    check_output,
-    run_inference,
-    runtime_of,
-    settings_of,
-)
+from curve_vae.service.deps import check_output, run_inference, runtime_of, settings_of
 from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.limits import check, check_refine, check_weights
-from curve_vae.service.npy_bodies import curve_route
+from curve_vae.service.limits import check_weights
+from curve_vae.service.routing import model_route
 
 curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 
 
-@curve_route(
+@model_route(
     curves_router,
     "/encode",
     s.EncodeRequest,
+    npy=True,
     examples=docs.ENCODE,
     openapi_extra=docs.curl_sample("/encode", docs.ONE_CURVE),
     response_model=r.EncodeResponse,
@@ -42,7 +37,6 @@ async def encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray
     """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance).
     The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
     runtime = runtime_of(request)
-    check_refine(req.reading().refine, curves, settings_of(request))
 
     def work() -> Response:
         return JSON(encode_body(runtime.encode(curves, req.reading())))
@@ -50,16 +44,19 @@ async def encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray
     return await run_inference(request, "/encode", len(curves), work)
 
 
-@curves_router.post(
+@model_route(
+    curves_router,
     "/decode",
+    s.DecodeRequest,
+    examples=docs.DECODE,
     response_model=r.CurvesResponse,
     responses=docs.POST_ERRORS,
     summary="Curves for latent vectors",
     openapi_extra=docs.curl_sample("/decode", '{"latents": [[' + ",".join(["0"] * 32) + ']], "n_points": 50}'),
 )
-async def decode(request: Request, runtime: RuntimeDep, settings: SettingsDep, req: docs.Decode) -> Response:
+async def decode(request: Request, req: s.DecodeRequest, _curves: list[np.ndarray]) -> Response:
     """Decode latent vectors (length latent_dim, see GET /model) into curves: the model's 128×128 plane, or `frames`."""
-    check(req, settings)
+    runtime = runtime_of(request)
     for i, z in enumerate(req.latents):
         if len(z) != runtime.latent_dim:
             raise InputError(
@@ -79,10 +76,11 @@ async def decode(request: Request, runtime: RuntimeDep, settings: SettingsDep, r
     return await run_inference(request, "/decode", len(req.latents), work)
 
 
-@curve_route(
+@model_route(
     curves_router,
     "/reconstruct",
     s.ReconstructRequest,
+    npy=True,
     examples=docs.RECONSTRUCT,
     openapi_extra=docs.curl_sample("/reconstruct", docs.ONE_CURVE),
     response_model=r.ReconstructResponse,
@@ -93,7 +91,6 @@ async def reconstruct(request: Request, req: s.ReconstructRequest, curves: list[
     """Encode each curve's latent mean and decode it: the reconstruction in the caller's frame, and its MSE there.
     The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
     runtime = runtime_of(request)
-    check_refine(req.reading().refine, curves, settings_of(request))
     check_output(req.output, runtime)
 
     def work() -> Response:
@@ -103,10 +100,11 @@ async def reconstruct(request: Request, req: s.ReconstructRequest, curves: list[
     return await run_inference(request, "/reconstruct", len(curves), work)
 
 
-@curve_route(
+@model_route(
     curves_router,
     "/interpolate",
     s.InterpolateRequest,
+    npy=True,
     examples=docs.INTERPOLATE,
     openapi_extra=docs.curl_sample("/interpolate", docs.TWO_CURVES[:-1] + ', "steps": 5}'),
     response_model=r.InterpolateResponse,
@@ -117,9 +115,8 @@ async def interpolate(request: Request, req: s.InterpolateRequest, curves: list[
     """Decode affine combinations of the curves' latent means; with frame "auto" each result is mapped
     into the same blend of the inputs' frames. The curves may also be posted as a .npy body
     (`Content-Type: application/x-npy`), the other fields in the query."""
-    runtime, settings = runtime_of(request), settings_of(request)
-    check_refine(req.reading().refine, curves, settings)
-    weights = check_weights(req, settings)
+    runtime = runtime_of(request)
+    weights = check_weights(req, settings_of(request))
     check_output(req.output, runtime)
 
     def work() -> Response:

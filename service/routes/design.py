@@ -1,11 +1,10 @@
-"""Geometry tools that need no model: least-squares B-spline fits and surfaces of revolution."""
+"""Geometry tools that need no model: least-squares B-spline fits and surfaces of revolution (routes built by
+service.routing.model_route: each request validated and within its limits before the handler runs)."""
 
 from __future__ import annotations
 
-from typing import Annotated
-
 import numpy as np
-from fastapi import APIRouter, Body, Request
+from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
 from curve_vae.geometry import revolve
@@ -14,15 +13,36 @@ from curve_vae.inference.errors import InputError
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example
-from curve_vae.service.deps import SettingsDep, run_inference
+from curve_vae.service.deps import run_inference
 from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.limits import check, curves_of
+from curve_vae.service.routing import model_route
 
 design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 
+FIT_EXAMPLES = {
+    "automatic": example("The fewest control points within 0.1% of the diagonal", {"curves": [C1]}),
+    "five control points": example("A 7-point curve, 5 control points", {"curves": [C1], "n_ctrl": 5}),
+    "with the fitted curve": example(
+        "Control polygon and the spline at 20 points", {"curves": [C1, C2], "n_ctrl": 6, "n_points": 20}
+    ),
+}
+REVOLVE_EXAMPLES = {
+    "vase": example(
+        "A closed vase: the profile's ends lie on the axis x = 0",
+        {"curve": [[0, 0], [3, 0], [4, 1], [3, 3], [2.5, 5], [3, 7], [0, 7]], "segments": 32},
+    ),
+    "ring, STL": example(
+        "An open band about the horizontal line y = -1, binary STL",
+        {"curve": C1, "axis": "x", "axis_position": -1, "format": "stl"},
+    ),
+}
 
-@design_router.post(
+
+@model_route(
+    design_router,
     "/fit",
+    s.FitRequest,
+    examples=FIT_EXAMPLES,
     response_model=r.FitResponse,
     responses=error_docs(413, 422),
     summary="Least-squares cubic B-spline of each curve",
@@ -30,26 +50,9 @@ design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
         "/fit", '{"curves": [[[0,0],[1,2],[2.5,3.2],[4,3.5],[5.5,3],[7,1.5],[8,0]]], "n_ctrl": 5}'
     ),
 )
-async def fit(
-    request: Request,
-    settings: SettingsDep,
-    req: Annotated[
-        s.FitRequest,
-        Body(
-            openapi_examples={
-                "automatic": example("The fewest control points within 0.1% of the diagonal", {"curves": [C1]}),
-                "five control points": example("A 7-point curve, 5 control points", {"curves": [C1], "n_ctrl": 5}),
-                "with the fitted curve": example(
-                    "Control polygon and the spline at 20 points", {"curves": [C1, C2], "n_ctrl": 6, "n_points": 20}
-                ),
-            }
-        ),
-    ],
-) -> Response:
+async def fit(request: Request, req: s.FitRequest, curves: list[np.ndarray]) -> Response:
     """Clamped uniform cubic B-spline with `n_ctrl` control points (omitted: the fewest within `tolerance`) fitted to
     each curve by least squares: control points, knots, and how far the curve is from the spline."""
-    check(req, settings)
-    curves = curves_of(req)
 
     def work() -> Response:
         return JSON(fit_body(curves, req.n_ctrl, param=req.param, n_points=req.n_points, tolerance=req.tolerance))
@@ -60,8 +63,11 @@ async def fit(
 MESH_TYPES = {"obj": "model/obj", "stl": "model/stl"}
 
 
-@design_router.post(
+@model_route(
+    design_router,
     "/revolve",
+    s.RevolveRequest,
+    examples=REVOLVE_EXAMPLES,
     response_class=Response,
     responses={
         200: {
@@ -86,36 +92,10 @@ MESH_TYPES = {"obj": "model/obj", "stl": "model/stl"}
     summary="Surface of revolution of a profile curve (a vase, paper Fig. 12)",
     openapi_extra=curl_sample("/revolve", '{"curve": [[0,0],[3,0],[4,1],[3,3],[2.5,5],[3,7],[0,7]], "segments": 32}'),
 )
-async def revolve_profile(
-    request: Request,
-    settings: SettingsDep,
-    req: Annotated[
-        s.RevolveRequest,
-        Body(
-            openapi_examples={
-                "vase": example(
-                    "A closed vase: the profile's ends lie on the axis x = 0",
-                    {"curve": [[0, 0], [3, 0], [4, 1], [3, 3], [2.5, 5], [3, 7], [0, 7]], "segments": 32},
-                ),
-                "ring, STL": example(
-                    "An open band about the horizontal line y = -1, binary STL",
-                    {"curve": C1, "axis": "x", "axis_position": -1, "format": "stl"},
-                ),
-            }
-        ),
-    ],
-) -> Response:
+async def revolve_profile(request: Request, req: s.RevolveRequest, _curves: list[np.ndarray]) -> Response:
     """Revolve a profile about a vertical (or horizontal) line of its plane into a triangle mesh, outward-facing;
     answered as a file (OBJ text by default, or binary STL) with its vertex and triangle counts in headers."""
-    check(req, settings)
     profile = np.asarray(req.curve, dtype=np.float64)
-    triangles = 2 * (len(profile) - 1) * req.segments  # at most: pole bands have half as many
-    if triangles > settings.max_mesh_triangles:
-        raise InputError(
-            ("segments",),
-            f"{req.segments} segments of a {len(profile)}-point profile make up to {triangles} triangles; at most "
-            f"{settings.max_mesh_triangles} (CURVE_VAE_MAX_MESH_TRIANGLES)",
-        )
 
     def work() -> Response:
         try:

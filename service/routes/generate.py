@@ -1,6 +1,7 @@
 """The generating routes: /sample (new curves from a latent distribution) and /augment (new curves between given
-ones, as seeded JSON pages or one streamed .npy file). Each checks what its request combines, runs the runtime in a
-worker thread and shapes the body (inference.bodies, shared with the command line)."""
+ones, as seeded JSON pages or one streamed .npy file). Each is built by service.routing.model_route (the request
+validated and within its limits), runs the runtime in a worker thread and answers the body inference.bodies builds,
+shared with the command line."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import time
 from collections.abc import AsyncIterator, Callable
 from typing import Any
 
+import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import Response, StreamingResponse
 
@@ -20,27 +22,30 @@ from curve_vae.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
-from curve_vae.service.deps import RuntimeDep, SettingsDep, check_output, in_executor, run_inference
+from curve_vae.service.deps import check_output, in_executor, run_inference, runtime_of
 from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.limits import check, check_augment_format, check_refine, curves_of
 from curve_vae.service.metrics import Metrics
+from curve_vae.service.routing import model_route
 
 generate_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 
 
-@generate_router.post(
+@model_route(
+    generate_router,
     "/sample",
+    s.SampleRequest,
+    examples=docs.SAMPLE,
     response_model=r.SampleResponse,
     responses=docs.POST_ERRORS,
     summary="New curves from a latent distribution: the learned one, a named prior, or the standard prior",
     openapi_extra=docs.curl_sample("/sample", '{"count": 3, "seed": 7, "n_points": 50}'),
 )
-async def sample(request: Request, runtime: RuntimeDep, settings: SettingsDep, req: docs.Sample) -> Response:
+async def sample(request: Request, req: s.SampleRequest, _curves: list[np.ndarray]) -> Response:
     """Decode latents drawn from the learned latent distribution (a Gaussian mixture fitted to the training curves'
     latent means, shipped with the model) or from the standard prior N(0, I), into curves in the model's 128×128
     plane (or `frame`). By default a curve that crosses itself or leaves the data's disc is drawn again. The same
     seed gives the same curves; without one, the response reports the seed drawn."""
-    check(req, settings)
+    runtime = runtime_of(request)
     check_output(req.output, runtime)
     seed = fresh_seed() if req.seed is None else req.seed
     frame = req.frame.frame() if req.frame else None
@@ -76,21 +81,21 @@ AUGMENT_NPY = {
 }
 
 
-@generate_router.post(
+@model_route(
+    generate_router,
     "/augment",
+    s.AugmentRequest,
+    examples=docs.AUGMENT,
     response_model=r.AugmentResponse,
     responses={200: AUGMENT_NPY, **docs.POST_ERRORS},
     summary="New curves between given curves",
     openapi_extra=docs.curl_sample("/augment", docs.THREE_CURVES[:-1] + ', "count": 4, "mode": "triplet", "seed": 1}'),
 )
-async def augment(request: Request, runtime: RuntimeDep, settings: SettingsDep, req: docs.Augment) -> Response:
+async def augment(request: Request, req: s.AugmentRequest, curves: list[np.ndarray]) -> Response:
     """Random interpolants of random pairs or triplets of the curves (optionally near neighbours in latent space),
     each in the blend of its sources' frames: new training data between the given curves. Item i of the sequence
     depends only on (seed, i): page with `offset`, or stream any count as .npy with `format` "npy"."""
-    check(req, settings)
-    curves = curves_of(req)
-    check_refine(req.reading().refine, curves, settings)
-    check_augment_format(req, settings)
+    runtime = runtime_of(request)
     check_output(req.output, runtime)
     seed = fresh_seed() if req.seed is None else req.seed
     start, stop = req.offset, req.offset + req.count
