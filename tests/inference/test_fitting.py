@@ -8,9 +8,11 @@ import io
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
+from scipy.interpolate import BSpline
 
 from curve_vae.geometry import evaluate_bspline, resample, self_intersects
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.reading import Reading
 from curve_vae.service.app import create_app
 from curve_vae.service.schemas import MAX_REFINE_STEPS
@@ -168,9 +170,9 @@ def test_refined_points_never_step_back_along_the_curve_at_a_sharp_corner(shippe
 
     drawn = draw_family(HELD_OUT["superellipse"], 40, np.random.default_rng(0), model_size=None)
     curves = [drawn[8].astype(np.float64), drawn[34].astype(np.float64)]
-    splines: list = []
-    out = shipped_runtime.reconstruct(curves, Reading(refine=10)).curves
-    for o, s in zip(out, splines):
+    rec = shipped_runtime.reconstruct(curves, Reading(refine=10))
+    assert rec.splines is not None and len(rec.splines) == len(curves)  # else the loop below checks nothing
+    for o, s in zip(rec.curves, rec.splines):
         assert (np.diff(s.params) >= 0).all()
         assert not self_intersects(o)
 
@@ -220,3 +222,41 @@ def test_closed_curves_interpolate_into_closed_curves_whose_ends_are_their_recon
             np.testing.assert_array_equal(curve[0], curve[-1])
         np.testing.assert_allclose(sweep[0], ends[0], atol=1e-9)
         np.testing.assert_allclose(sweep[2], ends[1], atol=1e-9)
+
+
+# ------------------------------------------------------------------ Fitter.refine_latents on the graphs themselves
+
+
+def _distance(graphs, ctrl: np.ndarray, target: np.ndarray, u: np.ndarray) -> float:
+    """Sum of squared distances from the target's points to the spline at u, by scipy (not the fitter's own)."""
+    return float(((BSpline(graphs.knots, ctrl.astype(np.float64), graphs.spline_degree)(u) - target) ** 2).sum())
+
+
+def test_refined_latents_come_closer_to_a_curve_the_decoder_can_draw(runtime):
+    """The target is the decoding of one latent, the start another nearby: the fit can only come closer, and what it
+    returns is consistent — the decoding is the refined latents', the feet ordered from 0 to 1."""
+    g = runtime.graphs
+    rng = np.random.default_rng(0)
+    goal = rng.standard_normal((2, g.latent_dim))
+    start = goal + 0.3 * rng.standard_normal(goal.shape)
+    targets = [t.astype(np.float64)[::2] for t in g.decode(goal)[0]]  # 81 of each curve's points
+    around = [np.linspace(0.0, 1.0, len(t)) for t in targets]
+    _, start_ctrl, _ = g.decode(start)
+    z, (out, ctrl, params), feet = Fitter(g).refine_latents(start, targets, around, 6)
+    assert z.dtype == np.float64 and z.shape == start.shape and params is None
+    np.testing.assert_allclose(out, g.decode(z)[0], atol=1e-5)
+    np.testing.assert_allclose(ctrl, g.decode(z)[1], atol=1e-5)
+    for i, (t, u) in enumerate(zip(targets, feet)):
+        assert u[0] == 0.0 and u[-1] == 1.0 and (np.diff(u) >= 0).all()
+        before = _distance(g, start_ctrl[i], t, around[i])
+        assert _distance(g, ctrl[i], t, u) < 0.5 * before, i  # several steps: much closer, not merely no worse
+
+
+def test_no_steps_keep_the_latents_and_decode_them(runtime):
+    g = runtime.graphs
+    start = np.random.default_rng(1).standard_normal((1, g.latent_dim))
+    target = [g.decode(start + 0.5)[0][0].astype(np.float64)]
+    z, (out, _, _), feet = Fitter(g).refine_latents(start, target, [np.linspace(0, 1, 161)], 0)
+    np.testing.assert_array_equal(z, start)
+    np.testing.assert_allclose(out, g.decode(start)[0], atol=1e-6)
+    assert len(feet) == 1 and len(feet[0]) == 161

@@ -1,29 +1,28 @@
-"""Geometry: B-spline sampling and fitting, resampling, frames, metrics."""
+"""geometry.bspline: clamped uniform B-splines — knots, the paper's random control points, sampling and evaluation
+(checked against scipy.interpolate.BSpline and the Bernstein form), least-squares fits, the fixed output head,
+arc-length parameters and closest points."""
+
+from math import comb
 
 import numpy as np
 import pytest
+from scipy.interpolate import BSpline
 
 from curve_vae.geometry import (
     arc_length_params,
-    blend_frames,
     clamped_uniform_knots,
     closest_params,
-    closest_squared_distances,
-    curve_length,
     evaluate_bspline,
     fit_bspline,
     fit_bspline_auto,
-    fit_frame,
     mse_per_curve,
     params_at_arc_fractions,
     random_control_points,
-    resample,
     sample_bspline,
-    self_intersects,
     smoothness,
     spline_head,
-    turning_angles,
 )
+from curve_vae.geometry.bspline import basis_and_slope, spline_values
 
 
 def test_knots_are_clamped_and_uniform():
@@ -62,65 +61,6 @@ def test_fit_recovers_control_points_of_exact_samples():
 def test_fit_rejects_too_few_points():
     with pytest.raises(ValueError, match="at least n_ctrl"):
         fit_bspline(np.zeros((5, 2)), n_ctrl=10)
-
-
-def test_resample_keeps_ends_and_spaces_evenly():
-    ctrl = random_control_points(np.random.default_rng(4), 1)[0]
-    pts = sample_bspline(ctrl, 161)
-    r = resample(pts, 50)
-    assert r.shape == (50, 2)
-    np.testing.assert_allclose(r[[0, -1]], pts[[0, -1]])
-    seg = np.linalg.norm(np.diff(r, axis=0), axis=1)
-    assert seg.std() / seg.mean() < 0.02  # chords of equal arcs: nearly equal
-    assert abs(curve_length(r) - curve_length(pts)) / curve_length(pts) < 0.01
-
-
-def test_resample_tolerates_repeated_points():
-    pts = np.array([[0, 0], [0, 0], [1, 0], [1, 0], [2, 0]], float)
-    np.testing.assert_allclose(resample(pts, 5)[:, 0], [0, 0.5, 1, 1.5, 2])
-
-
-def test_frame_round_trip_and_equivariance():
-    rng = np.random.default_rng(5)
-    pts = sample_bspline(random_control_points(rng, 1)[0])
-    moved = pts * 3.5 + np.array([-1000.0, 42.0])
-    f, g = fit_frame(pts), fit_frame(moved)
-    np.testing.assert_allclose(f.to_model(pts, 100.0), g.to_model(moved, 100.0), atol=1e-9)
-    np.testing.assert_allclose(g.from_model(g.to_model(moved, 100.0), 100.0), moved, atol=1e-9)
-    with pytest.raises(ValueError, match="coincide"):
-        fit_frame(np.ones((4, 2)))
-
-
-def test_blend_frames_is_affine():
-    a, b = fit_frame(np.array([[0, 0], [2, 1.0]])), fit_frame(np.array([[10, 10], [14, 12.0]]))
-    mid = blend_frames([a, b], np.array([[0.5, 0.5]]))[0]
-    assert mid.center == (6.5, 5.75) and mid.size == 3.0
-
-
-def test_self_intersection():
-    arc = np.stack([np.cos(np.linspace(0, 3, 50)), np.sin(np.linspace(0, 3, 50))], axis=1)
-    loop = np.stack([np.cos(np.linspace(0, 7, 50)), np.sin(np.linspace(0, 7, 50)) * 0.5], axis=1)
-    assert not self_intersects(arc)
-    assert self_intersects(loop)
-    np.testing.assert_array_equal(self_intersects(np.stack([arc, loop])), [False, True])
-
-
-def test_turning_angles_of_circle_arc_are_constant():
-    t = np.linspace(0, np.pi, 101)
-    arc = np.stack([np.cos(t), np.sin(t)], axis=1)
-    a = turning_angles(arc)
-    np.testing.assert_allclose(a, np.pi / 100, rtol=1e-9)
-    s = smoothness(arc[None])
-    assert s["roughness"][0] < 1e-9
-    noisy = arc + np.random.default_rng(0).normal(0, 1e-3, arc.shape)
-    assert smoothness(noisy[None])["roughness"][0] > 0.01
-
-
-def test_mse_per_curve_is_paper_eq4():
-    a = np.zeros((2, 3, 2))
-    b = a.copy()
-    b[1, 0, 0] = 3.0  # one coordinate of six off by 3 → 9/6
-    np.testing.assert_allclose(mse_per_curve(a, b), [0.0, 1.5])
 
 
 def test_chord_fit_of_many_curves_and_bunched_points():
@@ -178,19 +118,6 @@ def test_params_at_arc_fractions_reach_those_fractions_of_the_length():
     np.testing.assert_array_equal(params_at_arc_fractions(np.ones((6, 2)), fractions), fractions)
 
 
-def test_closest_squared_distances_measure_to_the_polyline_with_the_ends_pinned():
-    line = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
-    points = np.array([[1.0, 1.0], [5.0, -2.0], [12.0, 5.0], [10.5, 10.0], [9.0, 9.0]])
-    # inner points to their nearest segment; the first and last to the line's first and last vertex
-    want = [1.0**2 + 1.0**2, 2.0**2, 2.0**2, 0.5**2, 1.0**2 + 1.0**2]
-    np.testing.assert_allclose(closest_squared_distances(points, line), want)
-    # the same points in any spacing along a curve are at distance 0 (up to the polyline's chords)
-    ctrl = random_control_points(np.random.default_rng(7), 1)[0]
-    fine = evaluate_bspline(ctrl, np.linspace(0, 1, 4001))
-    anywhere = evaluate_bspline(ctrl, np.sort(np.r_[0.0, np.random.default_rng(8).uniform(0, 1, 50), 1.0]))
-    assert closest_squared_distances(anywhere, fine).max() < 1e-6
-
-
 def test_fit_bspline_auto_takes_the_fewest_control_points():
     ctrl = random_control_points(np.random.default_rng(4), 1)[0]
     exact = sample_bspline(ctrl, 161)
@@ -230,3 +157,111 @@ def test_closest_params_stay_within_their_window():
     anywhere = closest_params(ctrl, target, np.array([0.5]), window=1.0)
     assert near_start[0] <= 0.07
     assert anywhere[0] > 0.9
+
+
+# ------------------------------------------------------------------ evaluation against independent references
+
+#: (n_ctrl, degree) of the splines evaluated against scipy: the paper's 10, the head's 31, and other degrees
+SHAPES = {"cubic, 10": (10, 3), "cubic, 31": (31, 3), "quadratic, 7": (7, 2), "quintic, 12": (12, 5)}
+
+
+def _reference(ctrl: np.ndarray, degree: int) -> BSpline:
+    """scipy's spline on the clamped uniform knots, built here from their definition, not from the module."""
+    n = len(ctrl)
+    knots = np.r_[np.zeros(degree), np.linspace(0.0, 1.0, n - degree + 1), np.ones(degree)]
+    return BSpline(knots, ctrl, degree)
+
+
+@pytest.mark.parametrize("n_ctrl, degree", SHAPES.values(), ids=SHAPES.keys())
+def test_sampling_and_evaluation_agree_with_scipy(n_ctrl, degree):
+    ctrl = np.random.default_rng(n_ctrl + degree).normal(0, 30, (n_ctrl, 2))
+    want = _reference(ctrl, degree)
+    np.testing.assert_allclose(sample_bspline(ctrl, 57, degree), want(np.linspace(0, 1, 57)), atol=1e-10)
+    u = np.random.default_rng(1).uniform(0, 1, 40)
+    np.testing.assert_allclose(evaluate_bspline(ctrl, u, degree), want(u), atol=1e-10)
+    # parameters outside [0, 1] are clipped to the ends, where a clamped spline meets its end control points
+    np.testing.assert_allclose(evaluate_bspline(ctrl, [-0.5, 1.5], degree), ctrl[[0, -1]], atol=1e-12)
+
+
+def test_four_control_points_make_the_cubic_bezier_curve():
+    # with degree + 1 control points the knots are [0,0,0,0,1,1,1,1]: the Bernstein form, written out here
+    ctrl = np.array([[0.0, 0.0], [1.0, 3.0], [4.0, 3.0], [5.0, -1.0]])
+    t = np.linspace(0, 1, 11)[:, None]
+    bezier = sum(comb(3, k) * t**k * (1 - t) ** (3 - k) * ctrl[k] for k in range(4))
+    np.testing.assert_allclose(evaluate_bspline(ctrl, t[:, 0]), bezier, atol=1e-12)
+    np.testing.assert_allclose(sample_bspline(ctrl, 11), bezier, atol=1e-12)
+
+
+def test_a_batch_is_sampled_curve_by_curve():
+    ctrl = random_control_points(np.random.default_rng(9), 3)
+    batch = sample_bspline(ctrl, 40)
+    assert batch.shape == (3, 40, 2)
+    for c, b in zip(ctrl, batch):
+        np.testing.assert_allclose(b, _reference(c, 3)(np.linspace(0, 1, 40)), atol=1e-10)
+
+
+@pytest.mark.parametrize("n_ctrl, degree", SHAPES.values(), ids=SHAPES.keys())
+def test_spline_values_give_each_points_own_spline_and_its_derivatives(n_ctrl, degree):
+    rng = np.random.default_rng(n_ctrl * degree)
+    ctrl = rng.normal(0, 10, (3, n_ctrl, 2))
+    u = np.r_[0.0, rng.uniform(0, 1, 30), 1.0]  # the ends too: the last span holds u = 1
+    owner = rng.integers(0, 3, len(u))
+    values = spline_values(ctrl, u, owner, degree=degree, order=2)
+    assert len(values) == 3
+    for d, got in enumerate(values):
+        want = np.array(
+            [
+                _reference(ctrl[o], degree).derivative(d)(x) if d else _reference(ctrl[o], degree)(x)
+                for o, x in zip(owner, u)
+            ]
+        )
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-8 * np.abs(want).max())
+    # without an owner every point is on the first spline
+    np.testing.assert_allclose(spline_values(ctrl, u, degree=degree)[0], _reference(ctrl[0], degree)(u), atol=1e-9)
+
+
+def test_basis_and_slope_are_scipys_basis_and_its_derivative():
+    u = np.array([-0.2, 0.0, 0.13, 0.5, 0.77, 1.0, 1.4])
+    basis, slope = basis_and_slope(u, 8)
+    clipped = np.clip(u, 0, 1)
+    eye = _reference(np.eye(8), 3)
+    np.testing.assert_allclose(basis, eye(clipped), atol=1e-12)
+    np.testing.assert_allclose(slope, eye.derivative()(clipped), atol=1e-9)
+    np.testing.assert_allclose(basis.sum(axis=1), 1.0, atol=1e-12)  # a partition of unity
+    np.testing.assert_allclose(slope.sum(axis=1), 0.0, atol=1e-9)
+
+
+# ------------------------------------------------------------------ bad input
+
+
+@pytest.mark.parametrize("n_ctrl", [1, 3], ids=["one", "degree"])
+def test_knots_need_more_control_points_than_the_degree(n_ctrl):
+    with pytest.raises(ValueError, match=f"need more than 3 control points for degree 3, got {n_ctrl}"):
+        clamped_uniform_knots(n_ctrl)
+
+
+BAD_FITS = {
+    "three coordinates": (np.zeros((20, 3)), {}, r"points must have shape \(n, 2\), got \(20, 3\)"),
+    "flat list": (np.zeros(20), {}, r"points must have shape \(n, 2\)"),
+    "unknown param": (np.random.default_rng(0).normal(size=(20, 2)), {"param": "arc"}, "param must be 'uniform' or"),
+    "coincident, chord": (np.ones((20, 2)), {"param": "chord"}, "all points coincide"),
+}
+
+
+@pytest.mark.parametrize("points, options, message", BAD_FITS.values(), ids=BAD_FITS.keys())
+def test_fit_names_what_is_wrong_with_its_input(points, options, message):
+    with pytest.raises(ValueError, match=message):
+        fit_bspline(points, **options)
+
+
+@pytest.mark.parametrize("shape", [(3, 2), (10, 3)], ids=["three points", "three coordinates"])
+def test_auto_fit_needs_four_points_in_the_plane(shape):
+    with pytest.raises(ValueError, match="points must have shape"):
+        fit_bspline_auto(np.random.default_rng(0).normal(size=shape))
+
+
+def test_auto_fit_of_a_straight_line_takes_four_control_points():
+    # a line is a cubic with any number of control points: the fewest tried, exact (chord parameters are its own)
+    line = np.stack([np.linspace(0, 10, 30), np.linspace(0, 5, 30)], axis=1)
+    fit = fit_bspline_auto(line)
+    assert len(fit.control_points) == 4 and fit.rms_error < 1e-9
