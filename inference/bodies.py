@@ -29,8 +29,9 @@ def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
     ]
 
 
-def with_metrics(body: dict[str, Any], curves: Sequence[np.ndarray], wanted: bool) -> dict[str, Any]:
-    """`body` plus the per-curve quality measures when the request asked for them."""
+def with_metrics(body: dict[str, Any], curves: Sequence[np.ndarray] | np.ndarray, wanted: bool) -> dict[str, Any]:
+    """`body` plus the per-curve quality measures when the request asked for them: `curves` a list of (n, 2) arrays
+    or one (n_curves, n, 2) array."""
     return {**body, "metrics": curve_metrics(curves)} if wanted else body
 
 
@@ -157,8 +158,9 @@ def mesh_file(mesh: Any, *, points: int, segments: int, axis: str, fmt: str) -> 
     return mesh.to_obj(comment=comment).encode()
 
 
-def curve_metrics(curves: Sequence[np.ndarray]) -> list[dict[str, Any]]:
-    """Per curve, as the API reports it: smoothness (paper §3.4, degrees), self-intersection, length."""
+def curve_metrics(curves: Sequence[np.ndarray] | np.ndarray) -> list[dict[str, Any]]:
+    """Per curve (a list of (n, 2) arrays or one (n_curves, n, 2) array), as the API reports it: smoothness (paper
+    §3.4, degrees), self-intersection, length."""
     out = []
     for c in curves:
         with np.errstate(all="ignore"):

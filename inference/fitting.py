@@ -121,8 +121,9 @@ class Fitter:
         for step in range(steps if count else 0):
             if step % JACOBIAN_EVERY == 0:
                 shifted = (z[:, None, :] + FD_STEP * np.eye(dim)[None]).reshape(-1, dim)
-                moved = self.graphs.decode(shifted)[1].astype(np.float64)
-                jac = (moved.reshape(count, dim, -1, 2) - fit[1][:, None]) / FD_STEP
+                moved = self.graphs.decode(shifted)[1]
+                assert moved is not None, "refinement needs a B-spline head"
+                jac = (moved.astype(np.float64).reshape(count, dim, -1, 2) - fit[1][:, None]) / FD_STEP
             trial = self._step(z, fit[1], jac, targets, feet, damping)
             with np.errstate(all="ignore"):
                 tried = _float64(self.graphs.decode(trial))

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -40,7 +40,8 @@ class ReadCurve:
     def owned(self) -> ReadCurve:
         """This row with arrays of its own: a row sliced out of a batch's arrays keeps the whole batch alive, so what
         is kept (the encoding cache) keeps copies, and `nbytes` is then the memory it holds."""
-        views = {
+        # Any: mypy checks a **mapping against every field (frame too); these names are ARRAYS', all ndarray | None
+        views: dict[str, Any] = {
             name: np.array(a, copy=True)
             for name in self.ARRAYS
             if (a := getattr(self, name)) is not None and a.base is not None

@@ -42,8 +42,12 @@ def reading_field(option: ReadingOption) -> tuple[Any, Any]:
     """A request field for one of the reading's options (inference.reading): its values or bounds and its
     description, as `pydantic.create_model` takes them (service.schemas.ReadingIn)."""
     doc = option.doc
-    bounds = {"ge": doc.ge, "le": doc.le, "strict": True} if not option.values else {}
-    return Annotated[option.kind, Field(description=doc.description(option.default), **bounds)], option.default
+    description = doc.description(option.default)
+    if option.values:
+        field = Field(description=description)
+    else:  # an integer option: its bounds, strictly
+        field = Field(description=description, ge=doc.ge, le=doc.le, strict=True)
+    return Annotated[option.kind, field], option.default
 
 
 NPoints = Annotated[

@@ -75,7 +75,7 @@ def generate_curves(
     while have < count:
         ctrl = random_control_points(rng, chunk, n_ctrl=n_ctrl, radius=radius, center=center)
         pts = sample_bspline(ctrl, n_points)
-        ok = ~self_intersects(pts)
+        ok = ~np.asarray(self_intersects(pts))  # (chunk,) bool: a batch's answer is an array
         curves.append(pts[ok].astype(np.float32))
         ctrls.append(ctrl[ok].astype(np.float32))
         have += int(ok.sum())
@@ -140,7 +140,10 @@ class CurveDataset:
         """Write atomically: a crash never leaves a half-written cache behind."""
         meta = json.dumps({"format_version": FORMAT_VERSION, "config": asdict(self.config)})
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
-            twins = {} if self.train_twins is None else {"train_twins": self.train_twins, "val_twins": self.val_twins}
+            twins: dict[str, np.ndarray] = {}
+            if self.train_twins is not None:
+                assert self.val_twins is not None, "twins come in pairs: train and val"
+                twins = {"train_twins": self.train_twins, "val_twins": self.val_twins}
             np.savez(
                 f,
                 meta=np.array(meta),
@@ -148,7 +151,7 @@ class CurveDataset:
                 val=self.val,
                 test=self.test,
                 test_ctrl=self.test_ctrl,
-                **twins,
+                **twins,  # type: ignore[arg-type]  # numpy's stub: mypy checks **arrays against allow_pickle: bool too
             )
 
     @classmethod

@@ -83,7 +83,7 @@ def evaluate_set(curves: np.ndarray, recon: np.ndarray) -> dict[str, Any]:
         ),
         "smoothness_input": {k: float(v.mean()) for k, v in s_in.items()},
         "smoothness_output": {k: float(v.mean()) for k, v in s_out.items()},
-        "self_intersecting_outputs": float(self_intersects(recon).mean()),
+        "self_intersecting_outputs": float(np.mean(self_intersects(recon))),
     }
 
 
@@ -104,7 +104,7 @@ def interpolation_report(
         flat = c.reshape(-1, *curves.shape[1:])
         s = smoothness(flat)
         out[name] = {
-            "self_intersecting": float(self_intersects(flat).mean()),
+            "self_intersecting": float(np.mean(self_intersects(flat))),
             **{k: float(v.mean()) for k, v in s.items()},
         }
     return out
@@ -127,7 +127,7 @@ def sample_quality(samples: np.ndarray, data: np.ndarray, reference: np.ndarray)
     """
     size = lambda c: np.linalg.norm(np.ptp(c, axis=1), axis=1)  # bounding-box diagonals
     return {
-        "self_intersecting": float(self_intersects(samples).mean()),
+        "self_intersecting": float(np.mean(self_intersects(samples))),
         "roughness": float(smoothness(samples)["roughness"].mean()),
         "roughness_data": float(smoothness(data)["roughness"].mean()),
         "size_vs_data": float(size(samples).mean() / size(data).mean()),

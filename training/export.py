@@ -119,6 +119,7 @@ def _export(module: nn.Module, example: torch.Tensor, path: Path, in_name: str, 
             external_data=False,
             verbose=False,
         )
+        assert program is not None, "dynamo=True returns the ONNXProgram"
         program.save(str(tmp), external_data=False)
 
 

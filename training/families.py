@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
+from typing import TypedDict
 
 import numpy as np
 
@@ -328,6 +329,15 @@ def own_curves(
     return tuple(to_pose(s, rng, model_size).astype(np.float32) for s in (drawn, val, test))  # type: ignore[return-value]
 
 
+class _Posed(TypedDict):
+    """The keywords of `draw_family` that a chunk of the broad mix gives each family alike."""
+
+    n_points: int
+    model_size: float
+    twins: bool
+    canonical: bool
+
+
 def _mix_chunk(args: tuple[int, int, int, int, float, int, bool]) -> np.ndarray:
     """Chunk `index` of the broad mix of `version`: `count` curves in its shares, drawn with its own seed
     (seed, index); with twins (2, count, n_points, 2), each curve and its twin (`draw_family`)."""
@@ -337,7 +347,7 @@ def _mix_chunk(args: tuple[int, int, int, int, float, int, bool]) -> np.ndarray:
     sizes = {name: int(count * share) for name, share in spec.shares.items()}
     sizes["paper"] += count - sum(sizes.values())  # the rounding's few curves: exactly `count` in all
     canonical = spec.pose == "canonical"
-    posed = {"n_points": n_points, "model_size": model_size, "twins": twins, "canonical": canonical}
+    posed: _Posed = {"n_points": n_points, "model_size": model_size, "twins": twins, "canonical": canonical}
     parts = []
     for name, k in sizes.items():
         if name == "paper":

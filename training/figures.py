@@ -222,7 +222,7 @@ def plot_latent_vs_pointwise(
                 ax.plot(*c.T, color=cmap(i / (steps - 1)), lw=1.2, label=f"w={w[i]:.2f}")
             inner = curves[1:-1]
             rough = smoothness(inner)["roughness"].mean()
-            crossing = int(self_intersects(inner).sum())
+            crossing = int(np.sum(self_intersects(inner)))
             ax.set_title(f"{name}: roughness {rough:.2f}°, {crossing}/{len(inner)} self-intersecting", fontsize=9)
             ax.set_aspect("equal")
             ax.set_xticks([])

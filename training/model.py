@@ -91,7 +91,7 @@ def _needed(module: nn.Module, n: int, x: torch.Tensor) -> int:
     if isinstance(module, Inception):
         return max(_needed(b, n, x) for b in (module.b1, module.b3, module.b5, module.bp))
     if isinstance(module, (nn.ConvTranspose1d, nn.Conv1d, nn.MaxPool1d)):
-        k, s, p, d = (_first(getattr(module, a)) for a in ("kernel_size", "stride", "padding", "dilation"))
+        k, s, p, d = (int(_first(getattr(module, a))) for a in ("kernel_size", "stride", "padding", "dilation"))
         if s != 1 or d != 1:
             raise InvalidInput(f"no prefix rule for a strided or dilated {type(module).__name__}")
         # transposed: output j reads inputs j+p-k+1 … j+p; direct: inputs j-p … j-p+k-1
@@ -165,6 +165,14 @@ class Decoder(nn.Module):
     whole maps, and restricting them to the prefix trained worse per second in a measured
     A/B (scripts/decoder_prefix_ab.py).
     """
+
+    # the spline head's buffers (register_buffer, with cfg.spline_ctrl): typed here, where nn.Module's __getattr__
+    # would say Tensor | Module
+    basis: torch.Tensor
+    pinv: torch.Tensor
+    knots: torch.Tensor
+    closed: torch.Tensor
+    dense_basis: torch.Tensor
 
     def __init__(self, cfg: ModelConfig, feat_channels: int, feat_len: int) -> None:
         super().__init__()
@@ -297,12 +305,14 @@ class VAE(nn.Module):
         for p in self.parameters():
             p.requires_grad_(False)
         last = self.decoder.features[-1]
-        keep = torch.zeros_like(last.bias)
+        weight, bias = last.weight, last.bias
+        assert isinstance(weight, nn.Parameter) and isinstance(bias, nn.Parameter), "the head: a biased convolution"
+        keep = torch.zeros_like(bias)
         keep[2] = 1.0
-        for p, mask in ((last.weight, keep.view(1, -1, 1)), (last.bias, keep)):
+        for p, mask in ((weight, keep.view(1, -1, 1)), (bias, keep)):
             p.requires_grad_(True)
             p.register_hook(lambda g, mask=mask: g * mask)  # the x and y rows stay as they are
-        return [last.weight, last.bias]
+        return [weight, bias]
 
     def learn_only_encoder(self) -> list[nn.Parameter]:
         """Freeze the decoder and every BatchNorm statistic; train the encoder's weights alone. The decoded curves
@@ -334,6 +344,7 @@ class VAE(nn.Module):
         if not self.cfg.spline_ctrl:
             raise InvalidInput("a dense decoding needs the B-spline head (spline_ctrl)")
         _, ctrl = self.decoder.decode(z)
+        assert ctrl is not None  # the spline head (above)
         return torch.matmul(self.decoder.dense_basis, ctrl), mean, log_var
 
 

@@ -33,7 +33,7 @@ def morph_pairs(test_curves: np.ndarray, count: int = 40, seed: int = 7) -> list
         turn = np.array([[np.cos(angle), np.sin(angle)], [-np.sin(angle), np.cos(angle)]])
         scale, shift = rng.uniform(2, 6), rng.uniform(100, 400, 2)
         pairs.append(tuple(((c - 64.0) @ turn * scale) * [1.0, -1.0] + shift for c in (a, b)))
-    return pairs  # type: ignore[return-value]
+    return pairs
 
 
 def sweep_measures(sweeps: list[np.ndarray]) -> dict[str, float]:

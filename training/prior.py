@@ -7,12 +7,17 @@ own (1.00×), in a 4-second fit; 32 gain little more (scripts/prior_components.p
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from curve_vae.errors import InvalidInput
 from curve_vae.inference.prior import LatentPrior
+
+if TYPE_CHECKING:
+    from curve_vae.inference.priors import NamedPrior
+    from curve_vae.inference.reading import Reading
+    from curve_vae.inference.runtime import CurveRuntime
 
 COMPONENTS = 8  # measured: 1 → 25% self-intersecting samples, 8 → 13.8%, 32 → 11.6%
 FIT_CURVES = 20_000  # latent means of this many training curves: enough for 8 × 32-dim full covariances
@@ -75,18 +80,19 @@ def fit_parzen(latents: np.ndarray, *, neighbours: int = NEIGHBOURS, scale: floa
     return LatentPrior(np.full(len(z), 1.0 / len(z)), z, np.linalg.cholesky(cov))
 
 
-def prior_reading(model: Any, refine: int) -> Any:
+def prior_reading(model: Reading, refine: int) -> Reading:
     """How a prior's curves are read: in the canonical pose whatever the model's own (the search would read one
     airfoil in one pose and its neighbour in another, and their latents would not lie together), at the model's own
     spacing where it has one, else as given; with `refine` fitting steps."""
+    from curve_vae.inference.choices import Spacing
     from curve_vae.inference.reading import Reading
 
-    spacing = "parameter" if model.spacing == "search" else model.spacing
+    spacing: Spacing = "parameter" if model.spacing == "search" else model.spacing
     return Reading(frame=model.frame, pose="canonical", spacing=spacing, refine=refine)
 
 
 def fit_named_prior(
-    runtime: object,
+    runtime: CurveRuntime,
     curves: list[np.ndarray],
     *,
     name: str,
@@ -95,7 +101,7 @@ def fit_named_prior(
     refine: int = PRIOR_REFINE,
     seed: int = 0,
     source: str = "",
-) -> object:
+) -> NamedPrior:
     """The NamedPrior (inference/priors.py) of a user's curves: read as `prior_reading` says, with `refine` fitting
     steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
     BIC) — and the reference statistics its samples are placed and judged by."""
@@ -104,11 +110,11 @@ def fit_named_prior(
     from curve_vae.geometry.frame import MODEL_CENTER
     from curve_vae.inference.priors import NamedPrior, Reference, frames_array, model_identity
 
-    rt: Any = runtime
-    reading = prior_reading(rt.reading(), refine)
-    prep = rt.prepare(curves, reading)
+    reading = prior_reading(runtime.reading(), refine)
+    prep = runtime.prepare(curves, reading)
     latents = prep.mean.astype(np.float64)
-    decoded = np.stack([r.decoded for r in prep.rows]).astype(np.float64)
+    assert all(r.decoded_yet for r in prep.rows), "prepare decodes (decoded=True)"
+    decoded = np.stack([r.decoded for r in prep.rows if r.decoded is not None]).astype(np.float64)
     closed = [is_closed(c) for c in prep.inputs]
     reach = float(np.linalg.norm(decoded - np.asarray(MODEL_CENTER), axis=-1).max())
     reference = Reference(
@@ -116,11 +122,12 @@ def fit_named_prior(
         frames_array(prep.frames, closed) if prep.frames[0] is not None else np.zeros((len(latents), 7)),
         reach,
         # a closed curve's reconstruction is returned closed (its ends joined): that loop is what may cross itself
-        float(self_intersects(np.stack([joined_ends(d) if c else d for d, c in zip(decoded, closed)])).mean()),
+        float(np.mean(self_intersects(np.stack([joined_ends(d) if c else d for d, c in zip(decoded, closed)])))),
         float(np.mean(closed)),
     )
     if kind == "parzen":
-        mixture, fit = fit_parzen(latents), {"neighbours": NEIGHBOURS, "scale": PARZEN_SCALE}
+        mixture = fit_parzen(latents)
+        fit: dict[str, float | dict[str, float]] = {"neighbours": NEIGHBOURS, "scale": PARZEN_SCALE}
         chosen = f"one component per curve (manifold Parzen windows, {NEIGHBOURS} neighbours, scale {PARZEN_SCALE})"
     elif kind == "gmm":
         mixture, bic = fit_by_bic(latents, components=components, seed=seed)
@@ -135,7 +142,7 @@ def fit_named_prior(
         "chosen_by": chosen,
         **fit,
         "source": source,
-        "model_name": rt.manifest.name,
-        "model_version": rt.manifest.version,
+        "model_name": runtime.manifest.name,
+        "model_version": runtime.manifest.version,
     }
-    return NamedPrior(name, mixture, reference, model_identity(rt.manifest), meta)
+    return NamedPrior(name, mixture, reference, model_identity(runtime.manifest), meta)

@@ -75,4 +75,5 @@ def wrap(proc: Process, model: nn.Module, cfg: TrainConfig) -> nn.Module:
         net = nn.parallel.DistributedDataParallel(
             model, device_ids=[proc.device.index] if proc.device.type == "cuda" else None
         )
-    return torch.compile(net) if cfg.compile else net
+    # torch.compile of a Module is an OptimizedModule (a Module); its stub says only Callable
+    return torch.compile(net) if cfg.compile else net  # type: ignore[return-value]

@@ -65,8 +65,8 @@ class RankerNet(nn.Module):
         for i, m in enumerate(convs):
             out[f"conv{i}_w"], out[f"conv{i}_b"] = _np(m.weight), _np(m.bias)
         lin = [m for m in self.head if isinstance(m, nn.Linear)]
-        for i, m in enumerate(lin):
-            out[f"dense{i}_w"], out[f"dense{i}_b"] = _np(m.weight), _np(m.bias)
+        for i, d in enumerate(lin):
+            out[f"dense{i}_w"], out[f"dense{i}_b"] = _np(d.weight), _np(d.bias)
         return out
 
 
@@ -269,7 +269,8 @@ def export_ranker(
     path = root / "ranker.npz"
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
-            np.savez(fh, kind=RANKER_KIND, **net.weights())
+            # the ignore: numpy's stub, mypy checks **arrays against allow_pickle: bool too
+            np.savez(fh, kind=RANKER_KIND, **net.weights())  # type: ignore[arg-type]
     manifest_path = root / "manifest.json"
     manifest = json.loads(manifest_path.read_text())
     manifest["files"]["ranker.npz"] = {"sha256": file_sha256(path), "bytes": path.stat().st_size}

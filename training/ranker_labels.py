@@ -121,7 +121,8 @@ def label_curves(
         labels = label(runtime, drawn)
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as fh:
-                np.savez(fh, seed=seed, chunk=k, **labels)
+                # the ignore: numpy's stub, mypy checks **arrays against allow_pickle: bool too
+                np.savez(fh, seed=seed, chunk=k, **labels)  # type: ignore[arg-type]
         say(
             f"chunk {k + 1}/{(curves + chunk - 1) // chunk}: {len(drawn)} curves, {len(labels['error'])} readings "
             f"in {time.monotonic() - t0:.0f} s"

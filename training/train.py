@@ -113,8 +113,8 @@ def _batch_terms(model: nn.Module, x: torch.Tensor, cfg: TrainConfig, device: to
     if cfg.match == "mixed":  # index where the curve is its twin (its own spacing), its shape alone elsewhere
         with autocast(device, cfg.bf16):
             curve, mean, log_var = model(x[:, 0], dense=True)
-        terms = {"beta": cfg.beta, "lap_weight": cfg.lap_weight, "stride": SAMPLES_PER_INTERVAL}
-        return mixed_loss(x[:, 0], x[:, 1], curve, mean, log_var, **terms)
+        beta, lap, stride = cfg.beta, cfg.lap_weight, SAMPLES_PER_INTERVAL
+        return mixed_loss(x[:, 0], x[:, 1], curve, mean, log_var, beta=beta, lap_weight=lap, stride=stride)
     with autocast(device, cfg.bf16):
         pred, mean, log_var = model(x, dense=cfg.match == "closest")
     if cfg.match == "closest":
@@ -220,7 +220,7 @@ def _record_epoch(run_dir: Path, ckpt: dict[str, Any], row: dict[str, float], im
         atomic_save(ckpt, run_dir / "best.pt")
     atomic_save(ckpt, run_dir / "last.pt")
     if cfg.snapshots:
-        keep_snapshot(run_dir, ckpt, row["epoch"], cfg.snapshots)
+        keep_snapshot(run_dir, ckpt, int(row["epoch"]), cfg.snapshots)
     with open(run_dir / "log.jsonl", "a") as f:
         f.write(json.dumps(row) + "\n")
     print(  # one line per epoch, with or without the progress bar
