@@ -45,6 +45,11 @@ class Call:
         return None if self.json is None else orjson.dumps(self.json, option=JSON_OPTIONS)
 
 
+def array(values: Any) -> np.ndarray:
+    """float64 in C order, which orjson writes directly: a caller's slice or reversed view (curve[::-1]) included."""
+    return np.ascontiguousarray(values, dtype=np.float64)
+
+
 def _fields(**kw: Any) -> dict[str, Any]:
     """The fields a call was given (None: the service's default)."""
     return {k: v for k, v in kw.items() if v is not None}
@@ -55,7 +60,7 @@ def curves_call(
 ) -> Call:
     """The curves as a .npy body when they share a length and hold at least `npy_points` points in all (no JSON
     to write or parse), else as JSON."""
-    arrays = [np.asarray(c, np.float64) for c in curves]
+    arrays = [array(c) for c in curves]
     same = bool(arrays) and all(a.shape == arrays[0].shape and a.ndim == 2 for a in arrays)
     if same and sum(len(a) for a in arrays) >= npy_points:
         buf = io.BytesIO()
@@ -145,7 +150,7 @@ def output(n_points: int | None, output_as: str | None, metrics: bool | None) ->
 
 
 def decode_call(latents: Any, fields: dict[str, Any]) -> Call:
-    return Call("POST", "/decode", parse_curves, json={"latents": np.asarray(latents, np.float64), **fields})
+    return Call("POST", "/decode", parse_curves, json={"latents": array(latents), **fields})
 
 
 def sample_call(count: int, fields: dict[str, Any]) -> Call:
@@ -153,13 +158,13 @@ def sample_call(count: int, fields: dict[str, Any]) -> Call:
 
 
 def augment_call(curves: Sequence[Any], fields: dict[str, Any], *, npy: bool) -> Call:
-    body = {"curves": [np.asarray(c, np.float64) for c in curves], **fields, **({"format": "npy"} if npy else {})}
+    body = {"curves": [array(c) for c in curves], **fields, **({"format": "npy"} if npy else {})}
     return Call("POST", "/augment", parse_npy if npy else parse_augmented, json=body)
 
 
 def fit_call(curves: Sequence[Any], fields: dict[str, Any]) -> Call:
-    return Call("POST", "/fit", parse_json, json={"curves": [np.asarray(c, np.float64) for c in curves], **fields})
+    return Call("POST", "/fit", parse_json, json={"curves": [array(c) for c in curves], **fields})
 
 
 def revolve_call(curve: Any, fields: dict[str, Any]) -> Call:
-    return Call("POST", "/revolve", parse_bytes, json={"curve": np.asarray(curve, np.float64), **fields})
+    return Call("POST", "/revolve", parse_bytes, json={"curve": array(curve), **fields})

@@ -7,8 +7,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
-
 from curve_vae.client import calls as k
 from curve_vae.inference.choices import FrameMode, Pose, Spacing
 
@@ -81,7 +79,7 @@ class Endpoints:
         fields = {
             **k.reading(frame, pose, spacing, refine),
             **k.output(n_points, output, metrics),
-            **k._fields(steps=steps, weights=None if weights is None else np.asarray(weights, np.float64)),
+            **k._fields(steps=steps, weights=None if weights is None else k.array(weights)),
         }
         return self._call(
             k.curves_call("/interpolate", curves, fields, k.parse_interpolated, npy_points=self.npy_points)
