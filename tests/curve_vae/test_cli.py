@@ -17,6 +17,9 @@ import pytest
 import svgelements as se
 
 from curve_vae.cli import main
+from curve_vae.client import ApiError
+from curve_vae.errors import InvalidInput
+from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.curvefiles import read_curves
 from curve_vae.geometry import random_control_points, sample_bspline
 from tests.helpers import FIXTURES, ROOT, SHIPPED
@@ -358,3 +361,32 @@ def test_a_refusal_of_the_server_is_the_commands_error(live_server, tmp_path, ca
         == 2
     )
     assert "422: curves: mode triplet needs at least 3 curves, got 2" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("raised", "exits"),
+    [
+        pytest.param(InvalidInput("curves: all points coincide"), True, id="input"),
+        pytest.param(ModelLoadError("models/x: manifest.json is missing"), True, id="model"),
+        pytest.param(ApiError(422, "curves: at most 4 curves per request, got 5"), True, id="client"),
+        pytest.param(FileNotFoundError(2, "No such file or directory", "in.json"), True, id="file"),
+        pytest.param(ValueError("operands could not be broadcast together"), False, id="bug-value"),
+        pytest.param(KeyError("mean"), False, id="bug-key"),
+    ],
+)
+def test_what_the_project_raises_is_one_line_and_a_bug_keeps_its_traceback(monkeypatch, capsys, raised, exits):
+    """curve-vae prints a CurveVaeError or an OSError as `curve-vae CMD: error: …` with exit 2; anything else is not
+    the user's doing and propagates, traceback and all."""
+    from curve_vae.commands import curves
+
+    def fails(_args):
+        raise raised
+
+    monkeypatch.setattr(curves, "cmd_encode", fails)
+    if exits:
+        assert main(["encode", "in.json"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("curve-vae encode: error: ") and err.count("\n") == 1
+    else:
+        with pytest.raises(type(raised)):
+            main(["encode", "in.json"])
