@@ -18,10 +18,10 @@ import svgelements as se
 
 from curve_vae.cli import main
 from curve_vae.client import ApiError
-from curve_vae.errors import InvalidInput
-from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.curvefiles import read_curves
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry import random_control_points, sample_bspline
+from curve_vae.inference.manifest import ModelLoadError
 from tests.helpers import FIXTURES, ROOT, SHIPPED
 
 FILES = FIXTURES / "files"
