@@ -66,7 +66,7 @@ def test_export_parity_and_manifest(trained):
     assert (
         main(
             ["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--version", "9.9.9"]
-            + ["--suite-count", "20"]  # the family suite's bookkeeping: tests/training/test_families.py
+            + ["--suite-count", "20"]  # the family suite's bookkeeping: tests/training/test_suite.py
         )
         == 0
     )

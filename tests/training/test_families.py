@@ -1,7 +1,6 @@
-"""The broad training mix and the evaluation suite: spacing, validity, pose, bookkeeping."""
+"""training/families.py: the broad training mix, the families it draws, a user's own curves: spacing, validity, pose."""
 
 import json
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -9,7 +8,6 @@ import pytest
 from curve_vae.geometry import fit_frame, self_intersects, signed_turning, turning_angles
 from curve_vae.geometry.frame import MODEL_CENTER, chord_heading
 from curve_vae.training import families as F
-from curve_vae.training.suite import format_suite, relative_rmse, run_suite, suite_sets
 
 
 @pytest.mark.parametrize("name", [*F.TRAIN_FAMILIES, *F.HELD_OUT])
@@ -58,27 +56,6 @@ def test_broad_mix_is_the_same_however_many_processes_draw_it():
     one = F.broad_mix(n, 5, workers=1)
     np.testing.assert_array_equal(one, F.broad_mix(n, 5, workers=2))
     assert one.shape == (n, 161, 2) and np.isfinite(one).all()
-
-
-def test_suite_bookkeeping_with_a_perfect_reconstructor():
-    class Echo:  # returns the input: every error is 0
-        def reconstruct(self, curves, reading=None):
-            return SimpleNamespace(curves=[np.asarray(c, np.float64) for c in curves])
-
-    test = F.draw_family(F.paper, 12, np.random.default_rng(0), model_size=None)
-    sets = suite_sets(test, 6)
-    report = run_suite(Echo(), sets)
-    assert set(report) == set(sets) and len(sets) >= 10
-    assert {r["kind"] for r in report.values()} >= {"paper", "trained", "held out"}
-    for r in report.values():
-        assert r["n_curves"] == 6
-        assert r["rel_rmse_mean"] == 0 and r["roughness_ratio"] == pytest.approx(1)
-    assert "paper, rotated" in format_suite(report)
-
-
-def test_relative_rmse_is_rmse_over_the_diagonal():
-    a = np.array([[0.0, 0.0], [3.0, 4.0]])
-    assert relative_rmse([a], [a + [0.5, 0.0]])[0] == pytest.approx(0.5 / 5)
 
 
 def test_own_curves_split_by_curve_and_pose_every_training_draw(tmp_path):

@@ -1,5 +1,5 @@
-"""The reading ranker's training stages against a real (untrained, committed) model: labels written in chunks and
-resumed, training resumed where it stopped, the export read back by the runtime as the model's reading."""
+"""training/ranker.py: the reading ranker against a real (untrained, committed) model: the numpy ranker is the torch
+net, training resumes where it stopped, the export is read back by the runtime as the model's reading."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from curve_vae.inference.ranker import RANKED_READS, Ranker, ranker_inputs
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.ranker import RankerNet, export_ranker, pick_ratios, train_ranker
-from curve_vae.training.ranker_labels import label_curves, user_curves
+from curve_vae.training.ranker_labels import label_curves
 from tests.helpers import bspline_curves
 
 
@@ -25,31 +25,6 @@ def labels(closest_model_dir: Path, tmp_path_factory: pytest.TempPathFactory) ->
     out = tmp_path_factory.mktemp("labels")
     label_curves(closest_model_dir, out, curves=24, seed=5, chunk=8, say=lambda _: None)
     return out
-
-
-def test_labels_hold_every_search_candidate_with_its_error(labels: Path):
-    files = sorted(labels.glob("labels-5-*.npz"))
-    assert [f.name for f in files] == [f"labels-5-{k:04d}.npz" for k in range(3)]
-    with np.load(files[0]) as d:
-        assert int(d["seed"]) == 5 and d["points"].shape[1:] == (161, 2)
-        per_curve = np.bincount(d["curve"])
-        assert len(per_curve) == 8 and np.all(per_curve >= 6)  # six poses, each as given (and natural readings)
-        assert set(np.unique(d["pose"])) == set(range(6)) and np.all(d["error"] > 0)
-
-
-def test_labelling_again_resumes_and_writes_only_what_is_missing(labels: Path, closest_model_dir: Path):
-    before = {f.name: f.stat().st_mtime_ns for f in labels.glob("*.npz")}
-    (labels / "labels-5-0001.npz").unlink()
-    said: list[str] = []
-    label_curves(closest_model_dir, labels, curves=24, seed=5, chunk=8, say=said.append)
-    after = {f.name: f.stat().st_mtime_ns for f in labels.glob("*.npz")}
-    assert set(after) == set(before) and len(said) == 1 and said[0].startswith("chunk 2/3")
-    assert after["labels-5-0000.npz"] == before["labels-5-0000.npz"]
-
-
-def test_user_curves_are_seeded_and_moved():
-    a, b = user_curves(6, seed=3), user_curves(6, seed=3)
-    assert all(np.array_equal(x, y) for x, y in zip(a, b)) and len({len(c) for c in a}) > 1
 
 
 def test_the_numpy_ranker_is_the_torch_net():
@@ -115,17 +90,3 @@ def test_export_can_leave_the_models_reading_and_version_as_they_were(
     before_rows = runtime.graphs.rows["encoder"]
     runtime.reconstruct(curves, Reading(pose="learned", spacing="search"))  # there when asked for
     assert runtime.graphs.rows["encoder"] - before_rows == RANKED_READS * len(curves)
-
-
-def test_the_command_line_keeps_a_models_ranker_unless_forced(labels: Path, tmp_path: Path, closest_model_dir: Path):
-    from curve_vae.cli import main
-
-    best = train_ranker(labels, tmp_path / "run", time_budget=1.0, say=lambda _: None)
-    model = tmp_path / "model"
-    shutil.copytree(closest_model_dir, model)
-    assert main(["ranker", "export", str(best), "--model-dir", str(model)]) == 0
-    kept = (model / "ranker.npz").read_bytes(), (model / "manifest.json").read_text()
-    assert main(["ranker", "export", str(best), "--model-dir", str(model), "--version", "2.0.0"]) == 2
-    assert ((model / "ranker.npz").read_bytes(), (model / "manifest.json").read_text()) == kept
-    assert main(["ranker", "export", str(best), "--model-dir", str(model), "--version", "2.0.0", "--force"]) == 0
-    assert Manifest.read(model).version == "2.0.0"

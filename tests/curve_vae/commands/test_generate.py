@@ -1,4 +1,5 @@
-"""`curve-vae sample|augment|fit` offline give what the REST endpoints answer for the same request (issue 5)."""
+"""curve_vae/commands/generate.py: `curve-vae sample` and `augment` offline give what the REST endpoints answer for the
+same request (issue 5), refuse what they cannot do in one line, and need no torch."""
 
 from __future__ import annotations
 
@@ -11,9 +12,7 @@ import numpy as np
 import pytest
 
 from curve_vae.cli import main
-
-ROOT = Path(__file__).resolve().parents[2]
-CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
+from tests.helpers import ROOT
 
 
 @pytest.fixture
@@ -73,14 +72,6 @@ def test_augment_npy_offline_is_the_endpoints_file_byte_for_byte(make_client, mo
     assert np.load(tmp_path / "a.npy").shape == (150, 90, 2)
 
 
-def test_fit_offline_equals_the_endpoint(client, tmp_path):
-    src = tmp_path / "c.json"
-    src.write_text(json.dumps([CURVE, CURVE[::-1]]))
-    assert main(["fit", str(src), "--n-ctrl", "5", "--n-points", "12", "-o", str(tmp_path / "f.json")]) == 0
-    rest = client.post("/fit", json={"curves": [CURVE, CURVE[::-1]], "n_ctrl": 5, "n_points": 12}).json()
-    assert json.loads((tmp_path / "f.json").read_text()) == rest
-
-
 def test_offline_errors_are_one_line(model_dir, seeds, tmp_path, capsys):
     _, path = seeds
     assert main(["augment", str(path), "--count", "2", "--metrics", "-o", str(tmp_path / "a.npy"),
@@ -100,6 +91,7 @@ def test_offline_commands_need_no_torch(model_dir, seeds, tmp_path):
 import sys
 sys.modules["torch"] = None  # any `import torch` now raises ImportError
 from curve_vae.cli import main
+from tests.helpers import ROOT
 assert main(["sample", "--count", "2", "--seed", "1", "--model-dir", {model!r}, "-o", {out_dir!r} + "/s.json"]) == 0
 assert main(["augment", {str(path)!r}, "--count", "3", "--model-dir", {model!r}, "-o", {out_dir!r} + "/a.npy"]) == 0
 assert main(["fit", {str(path)!r}, "--param", "uniform", "-o", {out_dir!r} + "/f.json"]) == 0
@@ -107,3 +99,23 @@ print("ok")
 """
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+def test_a_page_of_the_seeded_sequence_is_that_stretch_of_the_whole(model_dir, seeds, tmp_path):
+    _, path = seeds
+    _run(model_dir, "augment", str(path), "--count", "7", "--seed", "3", "-o", str(tmp_path / "whole.npy"))
+    _run(model_dir, "augment", str(path), "--count", "3", "--seed", "3", "--offset", "4", "-o", str(tmp_path / "p.npy"))
+    np.testing.assert_array_equal(np.load(tmp_path / "p.npy"), np.load(tmp_path / "whole.npy")[4:])
+
+
+@pytest.mark.parametrize("command", ["sample", "augment"])
+def test_an_existing_output_is_kept_unless_forced(command, model_dir, seeds, tmp_path, capsys):
+    _, path = seeds
+    out = tmp_path / "mine.json"
+    out.write_text("the user's own file")
+    argv = [command, *([str(path)] if command == "augment" else []), "--count", "2", "--seed", "1", "-o", str(out)]
+    assert main([*argv, "--model-dir", str(model_dir)]) == 2
+    assert f"{out} exists and is left as it is: pass --force" in capsys.readouterr().err
+    assert out.read_text() == "the user's own file"
+    assert main([*argv, "--model-dir", str(model_dir), "--force"]) == 0
+    assert len(json.loads(out.read_text())["curves"]) == 2

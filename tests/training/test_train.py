@@ -1,4 +1,12 @@
-"""Training the encoder alone: every latent decodes as before; only which latent a curve gets changes."""
+"""training/train.py: the trainer. Training the encoder alone (every latent decodes as before; only which latent a
+curve gets changes), the reconstruction each match measures, and a run killed mid-epoch resumed from its checkpoint."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
@@ -7,9 +15,10 @@ import torch
 from curve_vae.cli import main
 from curve_vae.training.checkpoint import load_checkpoint
 from curve_vae.training.config import ModelConfig, TrainConfig
+from curve_vae.training.data import DataConfig
 from curve_vae.training.losses import vae_loss
 from curve_vae.training.model import VAE
-from curve_vae.training.train import train_one_epoch
+from curve_vae.training.train import train, train_one_epoch
 
 
 def _curves(n: int, seed: int = 0) -> torch.Tensor:
@@ -48,11 +57,6 @@ def test_the_encoder_is_trained_on_the_mean_decoded_as_the_service_decodes_it():
     # trained as a whole VAE, the same weights decode a sample z = μ + σ·ε instead
     sampled = train_one_epoch(model, x, torch.arange(32), opt, None, TrainConfig(batch_size=32), "cpu")
     assert sampled["mse"] != pytest.approx(float(want), rel=1e-5)
-
-
-def test_only_params_and_only_encoder_exclude_each_other():
-    with pytest.raises(ValueError, match="exclude each other"):
-        TrainConfig(only_params=True, only_encoder=True)
 
 
 @pytest.mark.slow
@@ -131,3 +135,58 @@ def test_match_mixed_refuses_a_model_whose_points_are_not_at_even_parameters(tmp
     args = ["--run-dir", "mx", "--init-from", str(start), "--match", "mixed", "--mix", "broad", *tiny, "--no-progress"]
     assert main(["train", *args]) != 0
     assert 'match "mixed" needs the B-spline head at even parameters' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("match", ["closest", "twin", "mixed"])
+def test_a_match_on_the_decoded_spline_without_the_head_is_refused_before_anything_is_drawn(tmp_path, match):
+    cache = tmp_path / "curves.npz"
+    data = DataConfig(n_train=64, n_val=16, n_test=16)
+    with pytest.raises(ValueError, match=f"match '{match}' measures the decoded spline: it needs the B-spline head"):
+        train(tmp_path / "run", ModelConfig(variant="cnn1"), data, TrainConfig(match=match), data_cache=cache)
+    assert not cache.exists() and not (tmp_path / "run").exists()
+
+
+def test_fewer_training_curves_than_one_batch_are_refused_before_any_file_of_the_run(tmp_path):
+    data = DataConfig(n_train=48, n_val=16, n_test=16)
+    cfg = TrainConfig(batch_size=64, epochs=1)
+    with pytest.raises(ValueError, match="48 training curves are fewer than one batch of 64"):
+        train(tmp_path / "run", ModelConfig(variant="cnn1"), data, cfg, data_cache=tmp_path / "d.npz", progress=False)
+    assert not (tmp_path / "run").exists()
+
+
+def test_a_pass_drops_the_ragged_last_batch_and_counts_its_steps():
+    torch.manual_seed(0)
+    model = VAE(ModelConfig(variant="cnn1"))
+    opt = torch.optim.SGD(model.parameters(), lr=0.0)
+    got = train_one_epoch(model, _curves(50), torch.arange(50), opt, None, TrainConfig(batch_size=16), "cpu")
+    assert got["steps"] == 3  # 50 curves: three full batches of 16, the last 2 curves left out
+    assert got["loss"] == pytest.approx(got["mse"] + 1e-3 * got["kl"] + got["lap"], rel=1e-5)  # beta 1e-3, lap 1
+
+
+@pytest.mark.slow
+def test_sigkill_mid_epoch_then_resume(tmp_path):
+    """A training run killed with SIGKILL mid-epoch resumes from its last checkpoint, losing at most that epoch."""
+    run, data = tmp_path / "run", str(tmp_path / "curves.npz")
+    args = [sys.executable, "-m", "curve_vae.cli", "train", "--run-dir", str(run), "--data", data, "--epochs", "3",
+            "--n-train", "768", "--n-val", "64", "--n-test", "32", "--batch-size", "64", "--threads", "1",
+            "--no-progress", "--resume"]  # fmt: skip
+    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=os.environ)
+    log = run / "log.jsonl"
+    deadline = time.monotonic() + 120
+    while not (log.exists() and log.read_text().count("\n") >= 1):  # epoch 1 done and saved ...
+        assert proc.poll() is None and time.monotonic() < deadline, proc.stdout.read()  # type: ignore[union-attr]
+        time.sleep(0.05)
+    time.sleep(0.3)  # ... and epoch 2 under way
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=30)
+    proc.stdout.close()  # type: ignore[union-attr]
+    assert proc.returncode == -signal.SIGKILL
+    done = load_checkpoint(run / "last.pt")["state"]["epoch"]  # the checkpoint on disk is whole
+    logged = log.read_text().count("\n")
+    assert done >= 1 and done == logged  # the checkpoint and the log agree on the epochs completed
+    again = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stdout + again.stderr
+    assert f"resumed {run / 'last.pt'} at epoch {done}/3" in again.stdout
+    rows = [json.loads(line) for line in log.read_text().splitlines()]
+    assert [r["epoch"] for r in rows] == [1, 2, 3]  # nothing lost but the killed epoch, nothing repeated
+    assert not list(run.glob("*.tmp")) and not list(run.glob(".*.tmp"))  # no half-written checkpoint left
