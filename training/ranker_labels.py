@@ -107,14 +107,14 @@ def label_curves(
     chunks already written; stop after `time_budget` seconds (0: no limit) at a chunk's end. Returns the files."""
     out = Path(out_dir)
     runtime = CurveRuntime.load(model_dir, intra_op_threads=1, cache_bytes=0)
-    files, start = [], time.monotonic()
-    for k in range((curves + chunk - 1) // chunk):
+    files, start, total = [], time.monotonic(), (curves + chunk - 1) // chunk
+    for k in range(total):
         path = out / f"labels-{seed}-{k:04d}.npz"
         files.append(path)
         if path.exists():
             continue
         if time_budget and time.monotonic() - start > time_budget:
-            say(f"time budget spent: {k} of {len(files)} chunks; run again to carry on")
+            say(f"time budget spent: {k} of {total} chunks; run again to carry on")
             return [f for f in files if f.exists()]
         t0 = time.monotonic()
         drawn = user_curves(min(chunk, curves - k * chunk), seed * 100_003 + k)
@@ -124,7 +124,7 @@ def label_curves(
                 # the ignore: numpy's stub, mypy checks **arrays against allow_pickle: bool too
                 np.savez(fh, seed=seed, chunk=k, **labels)  # type: ignore[arg-type]
         say(
-            f"chunk {k + 1}/{(curves + chunk - 1) // chunk}: {len(drawn)} curves, {len(labels['error'])} readings "
+            f"chunk {k + 1}/{total}: {len(drawn)} curves, {len(labels['error'])} readings "
             f"in {time.monotonic() - t0:.0f} s"
         )
     return files

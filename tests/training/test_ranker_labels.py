@@ -55,11 +55,6 @@ def test_a_spent_time_budget_stops_at_a_chunks_start_and_returns_the_chunks_writ
     assert len(said) == 1 and said[0].startswith("time budget spent: 1 of ") and said[0].endswith("carry on")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="label_curves counts the chunks in its time-budget message as those reached so far (len(files), k + 1), "
-    "not the run's total: it says '1 of 2 chunks' for a 3-chunk run stopped after its first",
-)
 def test_the_time_budget_message_counts_the_runs_chunks(labels: Path, tmp_path: Path, closest_model_dir: Path):
     out = tmp_path / "labels"
     out.mkdir()
