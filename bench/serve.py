@@ -4,7 +4,7 @@
     .venv/bin/python -m bench.serve              # ~5 minutes on 2 cores; --seconds 10 per load run
     .venv/bin/python -m bench.serve --seconds 1 --runs B   # the test suite's smoke run
 
-It starts `python -m curve_vae.service.cli` (uvicorn, the service's defaults unless a run says otherwise) on a
+It starts `python -m curve_vae.service.server` (uvicorn, the service's defaults unless a run says otherwise) on a
 loopback port for each configuration, drives it with wrk (POST bodies from a small Lua script, bench/post.lua), and
 reads the server's CPU time from /proc (all its processes), so the server's cost per request shows apart from wrk's.
 The headline rows A and B are the request a user sends: no pose or spacing fields, the paper's curves as a caller
@@ -61,7 +61,8 @@ RUNS = (
 
 
 class Server(LiveServer):
-    """`python -m curve_vae.service.cli` on a free loopback port with extra flags and environment, ready when made."""
+    """`python -m curve_vae.service.server` on a free loopback port with extra flags and environment, ready when
+    made."""
 
     def __init__(self, model_dir: Path, *flags: str, env: dict[str, str] | None = None) -> None:
         super().__init__("--model-dir", str(model_dir), "--providers", "cpu", *flags, env=env, cwd=ROOT, capture=False)

@@ -4,7 +4,7 @@
     .venv/bin/python bench/soak.py --clients 8 --duration 5              # the short version CI runs
     .venv/bin/python bench/soak.py --clients 32 --duration 600 --fresh   # new curves every request, 10 minutes
 
-Starts `python -m curve_vae.service.cli` on a free loopback port (the shipped model unless --model-dir), warms
+Starts `python -m curve_vae.service.server` on a free loopback port (the shipped model unless --model-dir), warms
 every endpoint up, reads the server's resident memory, then runs the clients until the time or the
 request budget is spent. Each request of the mix has an expected status (bad inputs are part of the
 mix and must get their 422): any other answer, or no answer, is an error. Reports requests, errors,

@@ -34,7 +34,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("serve", help="run the REST service on a model directory")
     try:
-        from curve_vae.service.cli import configure_parser, run
+        from curve_vae.service.server import configure_parser, run
     except ImportError as e:  # the service's dependencies are part of the base install
         reason = str(e)
         s.set_defaults(func=lambda _a: sys.exit(f"curve-vae serve is unavailable: {reason}"))

@@ -95,7 +95,7 @@ def augment_on_ray(
     returns `out`. Needs a running Ray (ray.init)."""
     import ray
 
-    from curve_vae.inference.models import model_directory
+    from curve_vae.inference.shipped import model_directory
 
     r = reading or Reading()
     blocks = [{"start": s, "stop": min(s + block, count)} for s in range(0, count, block)]

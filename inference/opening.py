@@ -13,8 +13,8 @@ from curve_vae.inference.cache import EncodingCache
 from curve_vae.inference.choices import Placement, choices
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.manifest import Manifest, ModelLoadError
+from curve_vae.inference.named_priors import load_priors
 from curve_vae.inference.prior import LatentPrior
-from curve_vae.inference.priors import load_priors
 from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.sessions import SessionConfig
 

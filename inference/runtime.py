@@ -34,6 +34,7 @@ from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.manifest import Manifest, ModelLoadError  # noqa: F401  (ModelLoadError: part of its API)
+from curve_vae.inference.named_priors import NamedPrior
 from curve_vae.inference.opening import open_model
 from curve_vae.inference.placing import (
     check_finite,
@@ -47,7 +48,6 @@ from curve_vae.inference.placing import (
 )
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
-from curve_vae.inference.priors import NamedPrior
 from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading

@@ -16,8 +16,8 @@ from curve_vae.geometry import sample_bspline, self_intersects
 from curve_vae.geometry.adapt import joined_ends
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.named_priors import NamedPrior
 from curve_vae.inference.prior import LatentPrior
-from curve_vae.inference.priors import NamedPrior
 
 MAX_DRAWS = 10  # per sampled curve: the shipped prior rejects 25% of draws, so 10 fail with probability ~1e-6;
 # and a distribution that rejects almost everything (the standard prior) costs at most 10 decodes a curve
@@ -50,7 +50,7 @@ class Sampler:
     ):
         self.graphs = graphs
         self.prior = prior
-        self.named = named or {}  # priors fitted to users' curves (inference.priors), by name
+        self.named = named or {}  # priors fitted to users' curves (inference.named_priors), by name
         self.disc_center = np.asarray(disc_center, np.float64)
         self.disc_radius = float(disc_radius)
 
@@ -74,7 +74,7 @@ class Sampler:
 
         prior "learned": the Gaussian mixture fitted to the training curves' latent means (the default where the
         model ships one); "standard": the VAE's N(0, I); any other: a prior fitted to a user's curves
-        (inference.priors), its validity judged against its own reference curves. temperature scales the spread
+        (inference.named_priors), its validity judged against its own reference curves. temperature scales the spread
         (see inference/prior.py). valid: a draw whose curve crosses itself or leaves the region of the data is
         rejected and item i draws again, at most max_draws times in all. Item i's draws come from its own generator
         default_rng([seed, i]), so the seed decides every curve, across rejections too; `offset` starts the

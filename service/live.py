@@ -4,7 +4,7 @@ anyone scripting against a local service.
     with LiveServer("--model-dir", "models") as server:
         httpx.post(f"{server.url}/reconstruct", json={"curves": [...]})
 
-`command` defaults to `python -m curve_vae.service.cli` (what `curve-vae serve` runs) in this interpreter; the
+`command` defaults to `python -m curve_vae.service.server` (what `curve-vae serve` runs) in this interpreter; the
 wheel's test passes its installed `curve-vae serve` instead. Standard library only.
 """
 
@@ -42,7 +42,7 @@ class LiveServer:
     ) -> None:
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
-        base = list(command) if command is not None else [sys.executable, "-m", "curve_vae.service.cli"]
+        base = list(command) if command is not None else [sys.executable, "-m", "curve_vae.service.server"]
         self.cmd = [*base, "--port", str(self.port), "--log-level", log_level, *args]
         out = subprocess.PIPE if capture else None
         self.proc = subprocess.Popen(

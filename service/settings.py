@@ -15,7 +15,7 @@ from pydantic import Field, field_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 from curve_vae.inference.choices import Placement, Providers
-from curve_vae.inference.models import SHIPPED, model_directory
+from curve_vae.inference.shipped import SHIPPED, model_directory
 
 
 class Settings(BaseSettings):
@@ -27,7 +27,7 @@ class Settings(BaseSettings):
     port: int = Field(default=8000, ge=0, le=65535)  # 0 picks a free port
     workers: int = Field(default=1, ge=1)  # uvicorn worker processes, each with its own ONNX sessions
     log_level: Literal["critical", "error", "warning", "info", "debug", "trace"] = "info"
-    # encoder.onnx, decoder.onnx and manifest.json; or a shipped model's name: "default", "paper" (inference/models.py)
+    # encoder.onnx, decoder.onnx and manifest.json; or a shipped model's name: "default", "paper" (inference/shipped.py)
     model_dir: Path = SHIPPED
     providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
     # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among

@@ -41,7 +41,7 @@ for _part_name, _allowed in ALLOWED.items():  # the exceptions' root is beneath 
     if _part_name != "curve_vae.errors":
         _allowed.add("curve_vae.errors")
 #: `curve-vae serve` is the one command that starts the HTTP layer.
-SERVE_ENTRY = ("curve_vae.cli", "curve_vae.service.cli")
+SERVE_ENTRY = ("curve_vae.cli", "curve_vae.service.server")
 NO_TORCH = (
     "curve_vae.geometry",
     "curve_vae.base",

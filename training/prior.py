@@ -15,7 +15,7 @@ from curve_vae.errors import InvalidInput
 from curve_vae.inference.prior import LatentPrior
 
 if TYPE_CHECKING:
-    from curve_vae.inference.priors import NamedPrior
+    from curve_vae.inference.named_priors import NamedPrior
     from curve_vae.inference.reading import Reading
     from curve_vae.inference.runtime import CurveRuntime
 
@@ -102,13 +102,13 @@ def fit_named_prior(
     seed: int = 0,
     source: str = "",
 ) -> NamedPrior:
-    """The NamedPrior (inference/priors.py) of a user's curves: read as `prior_reading` says, with `refine` fitting
-    steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
+    """The NamedPrior (inference/named_priors.py) of a user's curves: read as `prior_reading` says, with `refine`
+    fitting steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
     BIC) — and the reference statistics its samples are placed and judged by."""
     from curve_vae.geometry import self_intersects
     from curve_vae.geometry.adapt import is_closed, joined_ends
     from curve_vae.geometry.frame import MODEL_CENTER
-    from curve_vae.inference.priors import NamedPrior, Reference, frames_array, model_identity
+    from curve_vae.inference.named_priors import NamedPrior, Reference, frames_array, model_identity
 
     reading = prior_reading(runtime.reading(), refine)
     prep = runtime.prepare(curves, reading)

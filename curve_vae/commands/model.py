@@ -140,7 +140,7 @@ def _print_measures(report: dict) -> None:
 
 
 def cmd_triton(a: argparse.Namespace) -> int:
-    from curve_vae.inference.models import model_directory
+    from curve_vae.inference.shipped import model_directory
     from curve_vae.triton import smoke_test, write_repository
 
     folders = write_repository(

@@ -164,8 +164,8 @@ def reading_fields(a: argparse.Namespace) -> dict[str, Any]:
 
 
 def model_runtime(a: argparse.Namespace, priors_dir: Path | None = None):
-    from curve_vae.inference.models import model_directory
     from curve_vae.inference.runtime import CurveRuntime
+    from curve_vae.inference.shipped import model_directory
 
     model_dir = model_directory(a.model_dir)
     flag: str | None = getattr(a, "priors_dir", "") or None  # --priors-dir, where the command has it

@@ -334,7 +334,7 @@ def test_missing_or_truncated_model_files_stop_the_server_naming_the_file(model_
     with pytest.raises(ModelLoadError, match=message):
         CurveRuntime.load(copy, providers="cpu")
     serve = subprocess.run(
-        [sys.executable, "-m", "curve_vae.service.cli", "--model-dir", str(copy), "--port", "0"],
+        [sys.executable, "-m", "curve_vae.service.server", "--model-dir", str(copy), "--port", "0"],
         capture_output=True,
         text=True,
         timeout=60,

@@ -53,7 +53,7 @@ sys.modules["torch"] = None  # any `import torch` now raises ImportError
 from fastapi.testclient import TestClient
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
-import curve_vae.service.cli, curve_vae.service.openapi
+import curve_vae.service.server, curve_vae.service.openapi
 with TestClient(create_app(Settings(model_dir={str(model_dir)!r}, providers="cpu"))) as client:
     r = client.post("/reconstruct", json={{"curves": [[[0, 0], [1, 2], [2, 3], [3, 3], [4, 1]]]}})
     assert r.status_code == 200, r.text
@@ -66,7 +66,7 @@ print("ok")
 
 def test_importing_the_app_loads_no_torch():
     code = (
-        "import sys, curve_vae.service.app, curve_vae.service.cli, curve_vae.inference.runtime; "
+        "import sys, curve_vae.service.app, curve_vae.service.server, curve_vae.inference.runtime; "
         "assert 'torch' not in sys.modules; print('ok')"
     )
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)

@@ -1,4 +1,4 @@
-"""`curve-vae serve` (service.cli): a real uvicorn process on a loopback port, called with httpx; its flags, defaults
+"""`curve-vae serve` (service.server): a real uvicorn process on a loopback port, called with httpx; its flags, defaults
 and configuration errors, workers, and shutdown on SIGTERM (requests in flight finish, exit 0)."""
 
 from __future__ import annotations
@@ -101,7 +101,7 @@ def test_a_model_that_fails_at_startup_stops_the_server(server_factory, model_di
 def _serve(*args: str) -> subprocess.CompletedProcess[str]:
     import sys
 
-    cmd = [sys.executable, "-m", "curve_vae.service.cli", *args]
+    cmd = [sys.executable, "-m", "curve_vae.service.server", *args]
     return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=60)
 
 
@@ -115,7 +115,7 @@ def test_cuda_where_unavailable_is_a_clear_startup_error(model_dir):
 def test_configuration_errors(tmp_path, model_dir, capsys):
     import argparse
 
-    from curve_vae.service.cli import configure_parser, run
+    from curve_vae.service.server import configure_parser, run
 
     parser = argparse.ArgumentParser()
     configure_parser(parser)
@@ -135,7 +135,7 @@ def test_help_names_defaults_and_variables():
 def test_flags_override_the_environment(monkeypatch):
     import argparse
 
-    from curve_vae.service.cli import configure_parser, settings_from_args
+    from curve_vae.service.server import configure_parser, settings_from_args
 
     monkeypatch.setenv("CURVE_VAE_PORT", "9001")
     monkeypatch.setenv("CURVE_VAE_WORKERS", "3")

@@ -185,7 +185,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """`python -m curve_vae.service.cli`: the same as `curve-vae serve`."""
+    """`python -m curve_vae.service.server`: the same as `curve-vae serve`."""
     parser = argparse.ArgumentParser(prog="curve-vae serve", description="Serve the curve VAE over REST.")
     configure_parser(parser)
     return run(parser.parse_args(argv))
