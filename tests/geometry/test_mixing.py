@@ -37,3 +37,11 @@ def test_the_size_is_counted_without_building_the_grid():
 def test_too_few_curves_or_steps_are_refused_naming_both(n_curves, steps):
     with pytest.raises(ValueError, match=f"need ≥ 2 curves and ≥ 2 steps, got {n_curves} and {steps}"):
         simplex_grid(n_curves, steps)
+
+
+def test_pair_steps_sweep_from_first_to_second_curve():
+    np.testing.assert_allclose(simplex_grid(2, 5), [[1, 0], [0.75, 0.25], [0.5, 0.5], [0.25, 0.75], [0, 1]])
+
+
+def test_triplet_grid_size():
+    assert len(simplex_grid(3, 5)) == 15  # steps·(steps+1)/2

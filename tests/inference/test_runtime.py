@@ -1,4 +1,4 @@
-"""CurveRuntime without HTTP: loading checks, providers, weight grids, frames and lengths (issue 4, item 3)."""
+"""CurveRuntime without HTTP: loading checks, frames and lengths, interpolation, inputs the model cannot take."""
 
 from __future__ import annotations
 
@@ -10,12 +10,11 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 
-from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve, simplex_grid, simplex_grid_size
+from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve, simplex_grid
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.inference.sessions import resolve_providers
 
 # ----------------------------------------------------------------------------- loading
 
@@ -69,42 +68,6 @@ def test_manifest_without_checksum_is_a_startup_error(model_dir, tmp_path):
     (copy / "manifest.json").write_text(json.dumps(manifest))
     with pytest.raises(ModelLoadError, match=r"no sha256 for encoder\.onnx"):
         CurveRuntime.load(copy, providers="cpu")
-
-
-@pytest.mark.skipif("CUDAExecutionProvider" in ort.get_available_providers(), reason="CUDA is available here")
-def test_cuda_where_it_cannot_load_is_an_error_naming_the_fix():
-    with pytest.raises(ModelLoadError, match="onnxruntime-gpu"):
-        resolve_providers("cuda")
-
-
-def test_auto_takes_cuda_only_when_available():
-    expected = (
-        "CUDAExecutionProvider" if "CUDAExecutionProvider" in ort.get_available_providers() else "CPUExecutionProvider"
-    )
-    assert resolve_providers("auto")[0] == expected
-    assert resolve_providers("cpu") == ["CPUExecutionProvider"]
-
-
-# ----------------------------------------------------------------------------- weight grids
-
-
-def test_pair_steps_sweep_from_first_to_second_curve():
-    np.testing.assert_allclose(simplex_grid(2, 5), [[1, 0], [0.75, 0.25], [0.5, 0.5], [0.25, 0.75], [0, 1]])
-
-
-@pytest.mark.parametrize("n_curves,steps", [(2, 2), (3, 2), (3, 3), (3, 6), (4, 4)])
-def test_grids_are_barycentric(n_curves, steps):
-    w = simplex_grid(n_curves, steps)
-    assert w.shape == (simplex_grid_size(n_curves, steps), n_curves)
-    np.testing.assert_allclose(w.sum(axis=1), 1.0)
-    assert (w >= 0).all() and len(np.unique(w, axis=0)) == len(w)
-    np.testing.assert_array_equal(w[0], np.eye(n_curves)[0])
-    np.testing.assert_array_equal(w[-1], np.eye(n_curves)[-1])
-    assert set(np.round(w.ravel() * (steps - 1), 9)) <= set(range(steps))  # on the grid
-
-
-def test_triplet_grid_size():
-    assert len(simplex_grid(3, 5)) == 15  # steps·(steps+1)/2
 
 
 # ----------------------------------------------------------------------------- frames and lengths (item 3)

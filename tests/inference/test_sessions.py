@@ -4,6 +4,7 @@ a provider cannot be had."""
 
 import threading
 
+import onnxruntime as ort
 import pytest
 
 from curve_vae.errors import InvalidInput
@@ -73,3 +74,17 @@ def test_requiring_cuda_on_sessions_that_run_without_it_names_the_fix(model_dir)
 def test_an_unknown_provider_choice_is_refused_naming_the_choices(choice):
     with pytest.raises(ModelLoadError, match=f"providers must be cpu, cuda or auto, got {choice!r}"):
         resolve_providers(choice)
+
+
+@pytest.mark.skipif("CUDAExecutionProvider" in ort.get_available_providers(), reason="CUDA is available here")
+def test_cuda_where_it_cannot_load_is_an_error_naming_the_fix():
+    with pytest.raises(ModelLoadError, match="onnxruntime-gpu"):
+        resolve_providers("cuda")
+
+
+def test_auto_takes_cuda_only_when_available():
+    expected = (
+        "CUDAExecutionProvider" if "CUDAExecutionProvider" in ort.get_available_providers() else "CPUExecutionProvider"
+    )
+    assert resolve_providers("auto")[0] == expected
+    assert resolve_providers("cpu") == ["CPUExecutionProvider"]
