@@ -29,6 +29,7 @@ ROW_LABELS = {
     "one_session": "B, one session pair for both threads (`--sessions 1`)",
     "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
     "micro_batch_one": "B, one pass, micro-batching on",
+    "workers_one": "B, one pass, `--workers 2 --inference-concurrency 1`",
 }
 
 
@@ -71,6 +72,7 @@ def _table(r: dict[str, Any]) -> list[str]:
         "one_session",
         "micro_batch",
         "micro_batch_one",
+        "workers_one",
     )
     for key, label in ROW_LABELS.items():
         if key not in r:

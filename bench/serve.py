@@ -288,6 +288,10 @@ def _default_server_runs(
             cached.stop()
 
 
+ONE_PASS_VARIANTS = ("micro_batch", "workers")  # variants also run with one-pass bodies when one_pass is asked for
+ONE_PASS_NAMES = tuple(f"{v}_one" for v in ONE_PASS_VARIANTS)
+
+
 def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: set[str]) -> None:
     """B against a server of each asked-for variant (VARIANTS), one server each."""
     single = json_body(_callers(1, seed=1))
@@ -296,8 +300,9 @@ def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: se
             server = Server(model_dir, *flags, env=NO_CACHE)
             try:
                 load(name, server, "/reconstruct", single)
-                if name == "micro_batch" and "one_pass" in runs:  # does sharing graph runs help a one-pass request?
-                    load("micro_batch_one", server, "/reconstruct", json_body(_callers(1, seed=1), **ONE_PASS))
+                if name in ONE_PASS_VARIANTS and "one_pass" in runs:  # does sharing graph runs, or a second
+                    # process (no GIL between the event loop and the inference threads), help a one-pass request?
+                    load(f"{name}_one", server, "/reconstruct", json_body(_callers(1, seed=1), **ONE_PASS))
             finally:
                 server.stop()
 
@@ -313,7 +318,7 @@ def _ceiling_again(report: dict[str, Any], model_dir: Path, secs: float) -> None
         inproc[key] = max(inproc[key], again[key])
     inproc["ceiling"] = top = max(inproc["ceiling"], again["ceiling"])
     for name, x in report.items():
-        if name in ("A", "A_fast", "A_one", "B", "B_fast", "B_one", "B_npy", "B_cached", "micro_batch_one", *VARIANTS):
+        if name in ("A", "A_fast", "A_one", "B", "B_fast", "B_one", "B_npy", "B_cached", *VARIANTS, *ONE_PASS_NAMES):
             x["ratio"] = x.get("curves_per_s", x["rps"]) / top
 
 
