@@ -66,11 +66,16 @@ def natural_readings(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: i
 
 
 def natural_readings_of(
-    curves: Sequence[np.ndarray], *, n_ctrl: int = NATURAL_CTRL, steps: int = 40
+    curves: Sequence[np.ndarray],
+    *,
+    n_ctrl: int = NATURAL_CTRL,
+    steps: int = 40,
+    scout: int = NATURAL_SCOUT_STEPS,
 ) -> list[list[np.ndarray]]:
     """`natural_readings` of many polylines at once: the curves fitted with as many points are fitted together,
     every start of every curve one row of one Levenberg–Marquardt (a batch costs about what its longest curve's
-    fit does, not the sum)."""
+    fit does, not the sum). `scout`: the steps every start runs before only the closest and the arc-length one go
+    on (of `steps` in all)."""
     out: list[list[np.ndarray]] = [[] for _ in curves]
     fits: dict[int, list[tuple[int, np.ndarray, bool, np.ndarray | None]]] = {}  # fitted length -> curves
     for i, points in enumerate(curves):
@@ -93,7 +98,7 @@ def natural_readings_of(
             some = np.unique(np.round(np.linspace(0, len(pts) - 1, NATURAL_FIT_POINTS)).astype(int))
         fits.setdefault(len(pts) if some is None else len(some), []).append((i, pts, flip, some))
     for group in fits.values():
-        fitted = _fit([pts if some is None else pts[some] for _, pts, _, some in group], n_ctrl, steps)
+        fitted = _fit([pts if some is None else pts[some] for _, pts, _, some in group], n_ctrl, steps, scout)
         for (i, pts, flip, some), readings in zip(group, fitted):
             if some is not None:
                 u = arc_fractions(pts)
@@ -120,20 +125,20 @@ def _starts(pts: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-def _fit(curves: list[np.ndarray], n_ctrl: int, steps: int) -> list[list[np.ndarray]]:
+def _fit(curves: list[np.ndarray], n_ctrl: int, steps: int, scout: int) -> list[list[np.ndarray]]:
     """`natural_readings_of`' fit of polylines of one length (n, 2) as listed, all at once: every start of every
     curve scouts, then each curve carries on with its closest start and the arc-length one."""
     starts = [_starts(pts) for pts in curves]
     owner = np.concatenate([np.full(len(st), i) for i, st in enumerate(starts)])
     first = np.concatenate([[0], np.cumsum([len(st) for st in starts])[:-1]])  # each curve's arc-length row
     fit = _BatchFit(np.stack(curves)[owner], np.concatenate(starts), n_ctrl)
-    fit.run(min(NATURAL_SCOUT_STEPS, steps))
+    fit.run(min(scout, steps))
     rows: list[int] = []
     for i in range(len(curves)):
         best = int(first[i] + fit.cost[owner == i].argmin())
         rows += [best, int(first[i])] if best != first[i] else [best]
     fit.keep(rows)
-    fit.run(steps - min(NATURAL_SCOUT_STEPS, steps))
+    fit.run(steps - min(scout, steps))
     owner = owner[rows]
     out = []
     for i in range(len(curves)):

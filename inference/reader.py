@@ -50,6 +50,11 @@ from curve_vae.inference.reading import Reading
 SAME_READING = 1e-4
 #: Curves whose natural readings are fitted together (a batch's fit holds ~9 starts × points × 10 per curve).
 NATURAL_BATCH = 32
+#: The natural fit's (scout, total) steps for pose "learned", whose ranker keeps the closer of two candidates: the
+#: family suite (200 a set) reads as close with 8 and 24 as with the fit's own 15 and 40 (0.97–1.04× per set, every
+#: set within 1.17× of the search) and a single curve costs ~29% less (docs/RESULTS.md). The search and spacing
+#: "natural" keep the full fit.
+LEARNED_NATURAL_STEPS = (8, 24)
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -206,7 +211,8 @@ class Reader:
                 posed = [[f] for f in canonical_frames(inputs)]
         except ValueError:
             pass  # the curve whose points coincide is named below
-        natural = self._natural_readings(inputs, index) if reading.spacing in ("search", "natural") else None
+        steps = LEARNED_NATURAL_STEPS if (reading.pose, reading.spacing) == ("learned", "search") else None
+        natural = self._natural_readings(inputs, index, steps) if reading.spacing in ("search", "natural") else None
         stage: list[Candidate] = []
         with np.errstate(all="ignore"):
             for c, (i, pts) in enumerate(zip(index, inputs)):
@@ -237,15 +243,18 @@ class Reader:
         return stage
 
     @staticmethod
-    def _natural_readings(inputs: list[np.ndarray], index: list[int]) -> list[list[np.ndarray]]:
-        """Each curve's natural readings (geometry.natural_readings_of), NATURAL_BATCH curves fitted at once; an
-        abandoned request stops between batches."""
+    def _natural_readings(
+        inputs: list[np.ndarray], index: list[int], steps: tuple[int, int] | None = None
+    ) -> list[list[np.ndarray]]:
+        """Each curve's natural readings (geometry.natural_readings_of; `steps`: its scout and total steps, None:
+        the fit's own), NATURAL_BATCH curves fitted at once; an abandoned request stops between batches."""
+        fit = {} if steps is None else {"scout": steps[0], "steps": steps[1]}
         out: list[list[np.ndarray]] = []
         for start in range(0, len(inputs), NATURAL_BATCH):
             checkpoint()
             part = inputs[start : start + NATURAL_BATCH]
             try:
-                out += natural_readings_of(part)
+                out += natural_readings_of(part, **fit)
             except ValueError:  # all points of one coincide: name it
                 for k, pts in enumerate(part):
                     if not np.ptp(pts, axis=0).max() > 0:

@@ -126,3 +126,20 @@ def test_a_long_curve_is_fitted_on_some_of_its_points_and_the_rest_follow_by_arc
     np.testing.assert_allclose(np.interp(np.linspace(0, 1, 161), np.linspace(0, 1, 4096), u_many), u_few, atol=2e-3)
     assert u_many[0] == 0.0 and u_many[-1] == 1.0 and np.all(np.diff(u_many) >= 0)
     np.testing.assert_allclose(natural_params(many[::-1]), 1.0 - u_many[::-1], atol=1e-9)
+
+
+def test_the_scout_and_total_steps_are_the_callers():
+    """`scout` and `steps` set the fit's two stages: the defaults are NATURAL_SCOUT_STEPS and 40, and a shorter fit
+    still gives parameters from 0 to 1 in order, near the full fit's."""
+    from curve_vae.geometry.natural import NATURAL_SCOUT_STEPS, natural_readings_of
+
+    rng = np.random.default_rng(5)
+    curve = resample(sample_bspline(random_control_points(rng, 1), 641)[0], 161)
+    full = natural_readings_of([curve])[0]
+    assert all(
+        np.array_equal(a, b) for a, b in zip(full, natural_readings_of([curve], steps=40, scout=NATURAL_SCOUT_STEPS)[0])
+    )
+    short = natural_readings_of([curve], steps=24, scout=8)[0]
+    for u in short:
+        assert u[0] == 0.0 and u[-1] == 1.0 and (np.diff(u) >= 0).all()
+    assert np.abs(short[0] - full[0]).max() < 0.05

@@ -307,3 +307,31 @@ def test_points_beyond_float32_in_the_models_plane_are_named(runtime):
     huge[1] *= 1e300
     with pytest.raises(InputError, match=r'curves\[1\]: coordinates beyond float32 range; use frame "auto"'):
         runtime.reconstruct(list(huge), Reading(frame="model"))
+
+
+def test_the_learned_reading_fits_natural_spacings_in_fewer_steps_and_the_search_in_the_full_fit(
+    shipped_runtime, monkeypatch
+):
+    """Pose "learned" with spacing "search" reads each curve's natural spacings with LEARNED_NATURAL_STEPS (its ranker
+    keeps the closer of two candidates, and the suite reads as close); the search and spacing "natural" keep the fit's
+    own steps."""
+    asked: list[dict] = []
+    real = reader_module.natural_readings_of
+
+    def recording(curves, **kw):
+        asked.append(kw)
+        return real(curves, **kw)
+
+    monkeypatch.setattr(reader_module, "natural_readings_of", recording)
+    t = np.linspace(0, np.pi, 80)
+    curve = np.c_[np.cos(t), 0.6 * np.sin(t) + 0.1 * np.sin(3 * t)] * 20
+    scout, steps = reader_module.LEARNED_NATURAL_STEPS
+    for reading, expected in (
+        (Reading(pose="learned", spacing="search"), {"scout": scout, "steps": steps}),
+        (Reading(pose="search", spacing="search"), {}),
+        (Reading(pose="learned", spacing="natural"), {}),
+        (Reading(pose="canonical", spacing="natural"), {}),
+    ):
+        asked.clear()
+        shipped_runtime.reconstruct([curve], reading)
+        assert asked == [expected], reading
