@@ -52,8 +52,8 @@ SAME_READING = 1e-4
 NATURAL_BATCH = 32
 #: The natural fit's (scout, total) steps for pose "learned", whose ranker keeps the closer of two candidates: the
 #: family suite (200 a set) reads as close with 8 and 24 as with the fit's own 15 and 40 (0.97–1.04× per set, every
-#: set within 1.17× of the search) and a single curve costs ~29% less (docs/RESULTS.md). The search and spacing
-#: "natural" keep the full fit.
+#: set within 1.17× of the search; docs/RESULTS.md) and one curve of the default request costs 20.4 ms in-process
+#: against 29.5 (docs/BENCHMARKS.md, service 0.16.0). The search and spacing "natural" keep the full fit.
 LEARNED_NATURAL_STEPS = (8, 24)
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3

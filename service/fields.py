@@ -50,6 +50,9 @@ def reading_field(option: ReadingOption) -> tuple[Any, Any]:
     return Annotated[option.kind, field], option.default
 
 
+#: How /decode and /sample space the curves they return (no input to read): "parameter" by default.
+DecodedSpacing = Annotated[choices.Spacing, Field(description=choices.SPACING.description("parameter"))]
+
 NPoints = Annotated[
     int | None,
     Field(

@@ -20,6 +20,7 @@ from curve_vae.inference.reading import Reading, reading_options
 from curve_vae.service.fields import (  # noqa: F401  (FrameInfo: part of the schemas' API)
     MAX_SAFE_INTEGER,
     Curve,
+    DecodedSpacing,
     FiniteFloat,
     FrameInfo,
     MetricsFlag,
@@ -80,7 +81,7 @@ class DecodeRequest(_Request, OutputIn):
     latents: list[list[FiniteFloat]] = Field(
         min_length=1, description="One or more latent vectors, each of the model's latent_dim (see GET /model)."
     )
-    spacing: choices.Spacing = Field("parameter", description=choices.SPACING.description("parameter"))
+    spacing: DecodedSpacing = "parameter"
     frames: list[FrameInfo] | None = Field(
         None,
         description="Optional frame per latent (as /encode returns them): curves are mapped into it. "
@@ -155,7 +156,7 @@ class SampleRequest(_Request, OutputIn):
         "paper's generator rejects self-intersecting curves), at most 10 draws per curve; the seed still decides "
         "every curve. false: keep every draw.",
     )
-    spacing: choices.Spacing = Field("parameter", description=choices.SPACING.description("parameter"))
+    spacing: DecodedSpacing = "parameter"
     frame: FrameInfo | None = Field(
         None,
         description="Map every curve into this frame (centre and size, e.g. one /encode returned). Omitted: the "
