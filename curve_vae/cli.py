@@ -1,8 +1,8 @@
 """`curve-vae` command line: train, export and serve the model; reconstruct, encode, sample, augment, fit and revolve
 curves; fit priors to your own.
 
-Commands: dataset, train, average, ranker, export, evaluate, triton, reconstruct, encode, sample, augment, fit, revolve,
-prior, evaluate-prior, serve.
+Commands: dataset, train, average, ranker, spacer, export, evaluate, triton, reconstruct, encode, sample, augment, fit,
+revolve, prior, evaluate-prior, serve.
 
 The commands live in `curve_vae/commands/`, one module per group; this module assembles the parser.
 Each subcommand imports what it needs when it runs, so `curve-vae serve` and the offline
@@ -17,7 +17,7 @@ import warnings
 from typing import TextIO
 
 from curve_vae import __version__
-from curve_vae.commands import curves, data, design, generate, model, priors, ranker, train
+from curve_vae.commands import curves, data, design, generate, model, priors, ranker, spacer, train
 from curve_vae.errors import CurveVaeError
 
 
@@ -29,7 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"curve-vae {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for group in (data, train, ranker, model, curves, generate, design, priors):
+    for group in (data, train, ranker, spacer, model, curves, generate, design, priors):
         group.register(sub)
 
     s = sub.add_parser("serve", help="run the REST service on a model directory")

@@ -16,7 +16,7 @@ with the one from the arc-length fractions. The closest lands on a paper curve's
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
@@ -39,6 +39,9 @@ NATURAL_STARTS: tuple[tuple[float, float], ...] = tuple((s, w) for s in (0.5, 1.
 
 #: Steps every start runs before the fit keeps only the closest and the arc-length one.
 NATURAL_SCOUT_STEPS = 15
+
+#: A guess at polylines' parameters: (n, 2) polylines of one length -> each one's parameters (n,).
+Guess = Callable[[list[np.ndarray]], list[np.ndarray]]
 
 
 def natural_params(points: np.ndarray, *, n_ctrl: int = NATURAL_CTRL, steps: int = 40) -> np.ndarray:
@@ -71,11 +74,14 @@ def natural_readings_of(
     n_ctrl: int = NATURAL_CTRL,
     steps: int = 40,
     scout: int = NATURAL_SCOUT_STEPS,
+    guess: Guess | None = None,
 ) -> list[list[np.ndarray]]:
     """`natural_readings` of many polylines at once: the curves fitted with as many points are fitted together,
     every start of every curve one row of one Levenberg–Marquardt (a batch costs about what its longest curve's
     fit does, not the sum). `scout`: the steps every start runs before only the closest and the arc-length one go
-    on (of `steps` in all)."""
+    on (of `steps` in all). `guess`: where to start besides the arc-length fractions, instead of NATURAL_STARTS'
+    stretched lengths — given the polylines as the fit sees them (each scaled, from the end it turns most towards,
+    at most NATURAL_FIT_POINTS), their parameters (inference.spacer's guesses)."""
     out: list[list[np.ndarray]] = [[] for _ in curves]
     fits: dict[int, list[tuple[int, np.ndarray, bool, np.ndarray | None]]] = {}  # fitted length -> curves
     for i, points in enumerate(curves):
@@ -98,13 +104,20 @@ def natural_readings_of(
             some = np.unique(np.round(np.linspace(0, len(pts) - 1, NATURAL_FIT_POINTS)).astype(int))
         fits.setdefault(len(pts) if some is None else len(some), []).append((i, pts, flip, some))
     for group in fits.values():
-        fitted = _fit([pts if some is None else pts[some] for _, pts, _, some in group], n_ctrl, steps, scout)
+        fitted = _fit([pts if some is None else pts[some] for _, pts, _, some in group], n_ctrl, steps, scout, guess)
         for (i, pts, flip, some), readings in zip(group, fitted):
             if some is not None:
                 u = arc_fractions(pts)
                 readings = [np.interp(u, u[some], r) for r in readings]
             out[i] = [(1.0 - r)[::-1] for r in readings] if flip else readings
     return out
+
+
+def _rising(u: np.ndarray) -> np.ndarray:
+    """A guess as the fit takes parameters: within [0, 1], never falling, its ends at 0 and 1."""
+    u = np.maximum.accumulate(np.clip(np.asarray(u, np.float64), 0.0, 1.0))
+    u[0], u[-1] = 0.0, 1.0
+    return u
 
 
 def _starts(pts: np.ndarray) -> np.ndarray:
@@ -125,10 +138,15 @@ def _starts(pts: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-def _fit(curves: list[np.ndarray], n_ctrl: int, steps: int, scout: int) -> list[list[np.ndarray]]:
+def _fit(
+    curves: list[np.ndarray], n_ctrl: int, steps: int, scout: int, guess: Guess | None = None
+) -> list[list[np.ndarray]]:
     """`natural_readings_of`' fit of polylines of one length (n, 2) as listed, all at once: every start of every
     curve scouts, then each curve carries on with its closest start and the arc-length one."""
-    starts = [_starts(pts) for pts in curves]
+    if guess is None:
+        starts = [_starts(pts) for pts in curves]
+    else:
+        starts = [np.stack([arc_fractions(pts), _rising(g)]) for pts, g in zip(curves, guess(curves))]
     owner = np.concatenate([np.full(len(st), i) for i, st in enumerate(starts)])
     first = np.concatenate([[0], np.cumsum([len(st) for st in starts])[:-1]])  # each curve's arc-length row
     fit = _BatchFit(np.stack(curves)[owner], np.concatenate(starts), n_ctrl)

@@ -93,6 +93,14 @@ class RankerEntry(_Part):
     kind: str
 
 
+class SpacerEntry(_Part):
+    """The spacing guesser (inference.spacer): where each point of a curve would sit on one of the paper's splines,
+    guessed from its shape, so that reading pose "learned" starts its natural fit there."""
+
+    file: str = "spacer.npz"
+    kind: str
+
+
 class FrameSpec(_Part):
     """The plane the graphs' curves live in (the paper's 128×128, centred on (64, 64)) and the size of a posed
     curve's bounding box there (the training curves' median)."""
@@ -135,6 +143,7 @@ class Manifest(BaseModel):
     frame: FrameSpec
     reading: ReadingSpec = ReadingSpec()
     ranker: RankerEntry | None = None
+    spacer: SpacerEntry | None = None
     architecture: dict[str, Any] | None = Field(None, alias="model_config")  # the torch ModelConfig, as a dict
     training: dict[str, Any] | None = None
     metrics: dict[str, Any] | None = None
@@ -157,11 +166,10 @@ class Manifest(BaseModel):
         return float(((self.training or {}).get("data") or {}).get("radius", 64.0))
 
     def checked_files(self) -> list[str]:
-        """The files whose sha256 must match: both graphs, the prior and the ranker (never vae.pt: serving does not
-        read it)."""
+        """The files whose sha256 must match: both graphs, the prior, the ranker and the spacing guesser (never
+        vae.pt: serving does not read it)."""
         names = [self.graphs.encoder.file, self.graphs.decoder.file]
-        names += [self.prior.file] if self.prior is not None else []
-        return names + ([self.ranker.file] if self.ranker is not None else [])
+        return names + [part.file for part in (self.prior, self.ranker, self.spacer) if part is not None]
 
     def to_json(self) -> dict[str, Any]:
         """As written to manifest.json (the ModelConfig under its own name, model_config)."""

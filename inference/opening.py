@@ -16,6 +16,7 @@ from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.named_priors import load_priors
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
+from curve_vae.inference.spacer import Spacer
 from curve_vae.inference.sessions import SessionConfig
 
 T = TypeVar("T")
@@ -46,6 +47,7 @@ def open_model(
             f"the model {manifest.latent_dim}"
         )
     ranker = _load_part(root, manifest.ranker, "reading ranker", Ranker.load)
+    spacer = _load_part(root, manifest.spacer, "spacing guesser", Spacer.load)
     graphs = ModelGraphs.open(
         root, manifest, providers=providers, sessions=sessions, batch_size=batch_size, warm_up=warm_up
     )
@@ -60,6 +62,7 @@ def open_model(
         "model_dir": root,
         "priors": named,
         "ranker": ranker,
+        "spacer": spacer,
     }
 
 

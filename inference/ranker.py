@@ -66,8 +66,9 @@ class Ranker:
         for w, b in self.convs:
             padded = np.pad(h, ((0, 0), (2, 2), (0, 0)))
             windows = sliding_window_view(padded, w.shape[2], axis=1)[:, ::2]  # (k, n_out, c, 5)
-            flat = windows.reshape(*windows.shape[:2], -1)  # (k, n_out, c·5), as w (o, c, 5) flattens
-            h = np.maximum(flat @ w.reshape(len(w), -1).T + b, 0.0)
+            k, n_out = windows.shape[:2]
+            flat = windows.reshape(k * n_out, -1)  # (k·n_out, c·5), as w (o, c, 5) flattens: one matrix product
+            h = np.maximum(flat @ w.reshape(len(w), -1).T + b, 0.0).reshape(k, n_out, len(w))
         z = np.concatenate([h.mean(1), h.max(1)], axis=1)
         (w0, b0), (w1, b1) = self.dense
         z = np.maximum(z @ w0.T + b0, 0.0)

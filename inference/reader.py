@@ -13,7 +13,7 @@ with the same reading come from the encoding cache. `refine` fits each latent cl
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -44,6 +44,7 @@ from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.prepared import Prepared, ReadCurve
 from curve_vae.inference.ranker import RANKED_READS, Ranker
 from curve_vae.inference.reading import Reading
+from curve_vae.inference.spacer import Spacer
 
 #: A natural reading whose parameters are all within this of the points' index fractions reads the curve as given:
 #: spacing "search" does not try it beside "parameter".
@@ -55,6 +56,9 @@ NATURAL_BATCH = 32
 #: set within 1.17× of the search; docs/RESULTS.md) and one curve of the default request costs 20.4 ms in-process
 #: against 29.5 (docs/BENCHMARKS.md, service 0.16.0). The search and spacing "natural" keep the full fit.
 LEARNED_NATURAL_STEPS = (8, 24)
+#: The same when the model ships a spacing guesser (inference.spacer): the fit starts from its guess and the
+#: arc-length fractions alone, and needs fewer steps (docs/RESULTS.md, "The spacing guesser").
+GUESSED_NATURAL_STEPS = (4, 8)
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -81,9 +85,11 @@ class Reader:
         fitter: Fitter | None = None,
         cache: EncodingCache | None = None,
         ranker: Ranker | None = None,
+        spacer: Spacer | None = None,
     ) -> None:
         self.graphs = graphs
         self.ranker = ranker  # pose "learned": which candidates to encode
+        self.spacer = spacer  # pose "learned": where the natural fit starts
         self.closest = closest  # each caller point placed at its closest point on the decoded spline
         self.fitter = fitter
         self.cache = cache
@@ -211,8 +217,11 @@ class Reader:
                 posed = [[f] for f in canonical_frames(inputs)]
         except ValueError:
             pass  # the curve whose points coincide is named below
-        steps = LEARNED_NATURAL_STEPS if (reading.pose, reading.spacing) == ("learned", "search") else None
-        natural = self._natural_readings(inputs, index, steps) if reading.spacing in ("search", "natural") else None
+        natural = (
+            self._natural_readings(inputs, index, self._natural_fit(reading))
+            if reading.spacing in ("search", "natural")
+            else None
+        )
         stage: list[Candidate] = []
         with np.errstate(all="ignore"):
             for c, (i, pts) in enumerate(zip(index, inputs)):
@@ -242,13 +251,22 @@ class Reader:
                 stage += [Candidate(c, f, s, n, p) for p, f in enumerate(frames) for s, n in spaced]
         return stage
 
+    def _natural_fit(self, reading: Reading) -> dict[str, Any]:
+        """How the natural fit runs for `reading` (geometry.natural_readings_of's options): pose "learned" with
+        spacing "search" from the spacing guesser's guesses where the model has one, in fewer steps either way;
+        anything else, the fit's own."""
+        if (reading.pose, reading.spacing) != ("learned", "search"):
+            return {}
+        if self.spacer is not None:
+            scout, steps = GUESSED_NATURAL_STEPS
+            return {"scout": scout, "steps": steps, "guess": self.spacer.guesses}
+        scout, steps = LEARNED_NATURAL_STEPS
+        return {"scout": scout, "steps": steps}
+
     @staticmethod
-    def _natural_readings(
-        inputs: list[np.ndarray], index: list[int], steps: tuple[int, int] | None = None
-    ) -> list[list[np.ndarray]]:
-        """Each curve's natural readings (geometry.natural_readings_of; `steps`: its scout and total steps, None:
-        the fit's own), NATURAL_BATCH curves fitted at once; an abandoned request stops between batches."""
-        fit = {} if steps is None else {"scout": steps[0], "steps": steps[1]}
+    def _natural_readings(inputs: list[np.ndarray], index: list[int], fit: dict[str, Any]) -> list[list[np.ndarray]]:
+        """Each curve's natural readings (geometry.natural_readings_of, with `fit`'s options), NATURAL_BATCH
+        curves fitted at once; an abandoned request stops between batches."""
         out: list[list[np.ndarray]] = []
         for start in range(0, len(inputs), NATURAL_BATCH):
             checkpoint()

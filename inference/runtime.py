@@ -49,6 +49,7 @@ from curve_vae.inference.placing import (
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
+from curve_vae.inference.spacer import Spacer
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import (
@@ -81,6 +82,7 @@ class CurveRuntime:
         model_dir: str | Path | None = None,
         priors: dict[str, NamedPrior] | None = None,
         ranker: Ranker | None = None,
+        spacer: Spacer | None = None,
     ) -> None:
         self.graphs = graphs
         self.manifest: Manifest = graphs.manifest
@@ -91,7 +93,12 @@ class CurveRuntime:
         self.fitter = Fitter(graphs) if graphs.has_splines else None
         self.cache = cache
         self.reader = Reader(
-            graphs, closest=placed and graphs.has_splines, fitter=self.fitter, cache=cache, ranker=ranker
+            graphs,
+            closest=placed and graphs.has_splines,
+            fitter=self.fitter,
+            cache=cache,
+            ranker=ranker,
+            spacer=spacer,
         )
         disc = np.asarray(self.manifest.frame.center, np.float64)
         self.priors = priors or {}

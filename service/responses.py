@@ -162,6 +162,12 @@ class ModelInfo(BaseModel):
         "its picks came on curves held out of its training (best_of_2: the closer of its first two, ÷ the best of "
         "all the search's candidates).",
     )
+    spacer: dict[str, Any] | None = Field(
+        None,
+        description='The spacing guesser pose "learned" starts its natural fit from, when the model ships one: its '
+        "file, kind, and how far its parameters were from the generator's on the paper's curves held out of its "
+        "training (mae, rms).",
+    )
     cache: dict[str, int] | None = Field(
         None, description="The encoding cache of this worker: entries, bytes held and allowed, hits and misses."
     )

@@ -62,6 +62,7 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
         "model_size": runtime.model_size,
         "reading": m.reading.model_dump(include={"pose", "spacing"}),
         "ranker": m.ranker.model_dump(include={"file", "kind", "held_out"}) if m.ranker else None,
+        "spacer": m.spacer.model_dump(include={"file", "kind", "held_out"}) if m.spacer else None,
         "prior": m.prior.model_dump(include={"kind", "components", "fitted_on"}) if m.prior else None,
         "priors": {name: p.describe() for name, p in runtime.priors.items()},
         "spline": (

@@ -143,3 +143,41 @@ def test_the_scout_and_total_steps_are_the_callers():
     for u in short:
         assert u[0] == 0.0 and u[-1] == 1.0 and (np.diff(u) >= 0).all()
     assert np.abs(short[0] - full[0]).max() < 0.05
+
+
+def test_a_guess_is_where_the_fit_starts_beside_the_arc_length_fractions():
+    """`guess` replaces the stretched starts: given the generator's own parameters of paper curves drawn by arc length,
+    the fit with no steps gives them back (clipped to rise from 0 to 1) and the arc-length fractions as the second
+    reading; the guess sees each curve as the fit does (from the end it turns most towards)."""
+    from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline
+    from curve_vae.geometry.natural import natural_readings_of
+
+    rng = np.random.default_rng(8)
+    ctrl = random_control_points(rng, 4)
+    truth = [arc_length_params(c, 150) for c in ctrl]
+    curves = [evaluate_bspline(c, u) for c, u in zip(ctrl, truth)]
+    seen: list[int] = []
+
+    def guess(fitted):
+        seen.append(len(fitted))
+        out = []
+        for pts in fitted:
+            k = next(i for i, c in enumerate(curves) if np.allclose(_unit(c), pts) or np.allclose(_unit(c)[::-1], pts))
+            flipped = not np.allclose(_unit(curves[k]), pts)
+            out.append((1.0 - truth[k])[::-1] if flipped else truth[k])
+        out[0] = out[0] * 1.5 - 0.1  # beyond [0, 1] at both ends: clipped, the ends pinned
+        return out
+
+    readings = natural_readings_of(curves, steps=0, scout=0, guess=guess)
+    assert seen == [4]  # one call for the curves fitted together
+    for k, (c, u, rd) in enumerate(zip(curves, truth, readings)):
+        assert all(r[0] == 0.0 and r[-1] == 1.0 and (np.diff(r) >= 0).all() and r.max() <= 1.0 for r in rd)
+        assert any(np.allclose(r, arc_fractions(c)) for r in rd)
+        if k:  # the generator's parameters: the closer start, kept first
+            assert len(rd) == 2
+            np.testing.assert_allclose(rd[0], u, atol=1e-12)
+
+
+def _unit(c: np.ndarray) -> np.ndarray:
+    """A curve as natural_readings_of scales it: from its first point, by its larger extent."""
+    return (c - c[0]) / np.ptp(c, axis=0).max()

@@ -42,10 +42,10 @@ def _replace_file(src: Path, out: Path, name: str, write) -> Path:
 
 def test_the_parts_are_the_directorys_and_make_a_runtime(model_dir):
     parts = open_model(model_dir, **OPTIONS)
-    assert set(parts) == {"graphs", "prior", "closest", "cache", "model_dir", "priors", "ranker"}
+    assert set(parts) == {"graphs", "prior", "closest", "cache", "model_dir", "priors", "ranker", "spacer"}
     on_disk = LatentPrior.load(model_dir / "prior.npz")
     np.testing.assert_array_equal(parts["prior"].means, on_disk.means)
-    assert parts["ranker"] is None and parts["cache"] is None and parts["priors"] == {}
+    assert parts["ranker"] is None and parts["spacer"] is None and parts["cache"] is None and parts["priors"] == {}
     assert parts["closest"] is None  # "model": as the manifest's spline.placement says
     assert open_model(model_dir, **{**OPTIONS, "placement": "index", "cache_bytes": 1 << 20})["closest"] is False
     runtime = CurveRuntime(**parts)
@@ -78,6 +78,18 @@ def test_a_ranker_that_is_not_one_names_its_file(model_dir, tmp_path):
     manifest["ranker"] = {"file": "ranker.npz", "kind": "conv1d-ranker"}
     (bad / "manifest.json").write_text(json.dumps(manifest))
     with pytest.raises(ModelLoadError, match=r"ranker\.npz: not a usable reading ranker"):
+        open_model(bad, **OPTIONS)
+
+
+def test_a_spacing_guesser_that_is_not_one_names_its_file(model_dir, tmp_path):
+    def spacer(path: Path) -> None:
+        np.savez(path, kind="dilated-conv1d-cumsoftmax-v1", inp_w=np.zeros(3))
+
+    bad = _replace_file(model_dir, tmp_path / "m", "spacer.npz", spacer)
+    manifest = json.loads((bad / "manifest.json").read_text())
+    manifest["spacer"] = {"file": "spacer.npz", "kind": "dilated-conv1d-cumsoftmax-v1"}
+    (bad / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ModelLoadError, match=r"spacer\.npz: not a usable spacing guesser \(not a spacing guesser: no"):
         open_model(bad, **OPTIONS)
 
 

@@ -309,14 +309,15 @@ def test_points_beyond_float32_in_the_models_plane_are_named(runtime):
         runtime.reconstruct(list(huge), Reading(frame="model"))
 
 
-def test_the_learned_reading_fits_natural_spacings_in_fewer_steps_and_the_search_in_the_full_fit(
+def test_without_a_spacing_guesser_the_learned_reading_fits_in_fewer_steps_and_the_search_in_the_full_fit(
     shipped_runtime, monkeypatch
 ):
-    """Pose "learned" with spacing "search" reads each curve's natural spacings with LEARNED_NATURAL_STEPS (its ranker
-    keeps the closer of two candidates, and the suite reads as close); the search and spacing "natural" keep the fit's
-    own steps."""
+    """For a model with a ranker and no spacing guesser, pose "learned" with spacing "search" reads each curve's
+    natural spacings with LEARNED_NATURAL_STEPS (its ranker keeps the closer of two candidates, and the suite reads as
+    close); the search and spacing "natural" keep the fit's own steps (with a guesser: tests/inference/test_spacer)."""
     asked: list[dict] = []
     real = reader_module.natural_readings_of
+    monkeypatch.setattr(shipped_runtime.reader, "spacer", None)
 
     def recording(curves, **kw):
         asked.append(kw)

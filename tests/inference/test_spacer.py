@@ -1,0 +1,112 @@
+"""The spacing guesser in numpy: its inputs, its guesses, its file, and the reading it starts (pose "learned" fits
+natural spacings from its guess in GUESSED_NATURAL_STEPS)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from curve_vae.errors import InvalidInput
+from curve_vae.geometry import arc_length_params, random_control_points, sample_bspline
+from curve_vae.geometry.bspline import evaluate_bspline
+from curve_vae.inference import reader as reader_module
+from curve_vae.inference.reading import Reading
+from curve_vae.inference.spacer import GRID, SPACER_KIND, Spacer, on_grid, spacer_inputs
+
+
+def random_weights(seed: int = 0, channels: int = 8) -> dict[str, np.ndarray]:
+    """Weights of the guesser's shape (training/spacer.py's SpacerNet, narrower), drawn at random."""
+    rng = np.random.default_rng(seed)
+    dilations = (1, 2, 4, 1)
+    shapes = {"inp": (channels, 3, 5), "mix": (channels, channels), "out": (1, channels, 2)}
+    for i, _ in enumerate(dilations):
+        shapes[f"block{i}_a"], shapes[f"block{i}_b"] = (channels, channels, 3), (channels, channels, 1)
+    out = {"dilations": np.array(dilations), "mix_after": np.array(1)}
+    for name, shape in shapes.items():
+        out[f"{name}_w"] = (rng.normal(size=shape) / np.sqrt(np.prod(shape[1:]))).astype(np.float32)
+        out[f"{name}_b"] = (0.1 * rng.normal(size=shape[0])).astype(np.float32)
+    return out
+
+
+def _turned(c: np.ndarray, angle: float, scale: float, shift: tuple[float, float]) -> np.ndarray:
+    rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    return c @ rot.T * scale + np.asarray(shift)
+
+
+def test_the_inputs_are_the_shapes_turning_along_its_length_whatever_its_pose():
+    c = sample_bspline(random_control_points(np.random.default_rng(1), 1), 300)[0]
+    x = spacer_inputs(on_grid([c]))
+    assert x.shape == (1, 3, GRID) and x.dtype == np.float32
+    moved = spacer_inputs(on_grid([_turned(c, 2.0, 7.5, (-300.0, 40.0))]))
+    np.testing.assert_allclose(moved, x, atol=2e-5)
+    mirrored = spacer_inputs(on_grid([c * [-1.0, 1.0]]))
+    np.testing.assert_allclose(mirrored[:, 0], -x[:, 0], atol=2e-5)  # the turning changes sign, nothing else
+    np.testing.assert_allclose(mirrored[:, 1:], x[:, 1:], atol=2e-5)
+    assert x[0, 0, 0] == x[0, 0, -1] == 0.0 and x[0, 2, 0] == -1.0 and x[0, 2, -1] == 1.0
+    line = spacer_inputs(on_grid([np.c_[np.linspace(0, 5, 40), np.zeros(40)]]))
+    assert not line[:, :2].any()  # a straight line does not turn
+
+
+def test_guesses_rise_from_0_to_1_at_each_curves_own_points_and_follow_the_shape():
+    spacer = Spacer(random_weights())
+    rng = np.random.default_rng(2)
+    curves = [sample_bspline(random_control_points(rng, 1), n)[0] for n in (20, 161, 777)]
+    guesses = spacer.guesses(curves)
+    for c, u in zip(curves, guesses):
+        assert u.shape == (len(c),) and u[0] == 0.0 and u[-1] == pytest.approx(1.0) and (np.diff(u) >= 0).all()
+    again = spacer.guesses([_turned(c, -0.7, 0.01, (3.0, 3.0)) for c in curves])
+    for u, v in zip(guesses, again):
+        np.testing.assert_allclose(v, u, atol=1e-5)
+    assert spacer.guesses([]) == []
+
+
+def test_a_file_of_another_kind_or_without_its_weights_is_refused(tmp_path: Path):
+    np.savez(tmp_path / "other.npz", kind="something-else", **random_weights())
+    with pytest.raises(InvalidInput, match="a spacing guesser of kind 'something-else'"):
+        Spacer.load(tmp_path / "other.npz")
+    partial = {k: v for k, v in random_weights().items() if k != "mix_w"}
+    np.savez(tmp_path / "partial.npz", kind=SPACER_KIND, **partial)
+    with pytest.raises(InvalidInput, match="not a spacing guesser: no mix_w weights"):
+        Spacer.load(tmp_path / "partial.npz")
+
+
+def test_the_shipped_guesser_puts_the_papers_curves_drawn_by_arc_length_near_their_own_parameters(shipped_runtime):
+    """Its guesses of the paper's test-like curves drawn by arc length: within a few hundredths of the generator's
+    parameters (trained on the paper's curves; its held-out error is in the manifest), far closer than the arc-length
+    fractions it replaces as the fit's start."""
+    spacer = shipped_runtime.reader.spacer
+    assert spacer is not None and shipped_runtime.manifest.spacer is not None
+    ctrl = random_control_points(np.random.default_rng(11), 40)
+    truth = [arc_length_params(c, 161) for c in ctrl]
+    drawn = [evaluate_bspline(c, u) for c, u in zip(ctrl, truth)]
+    guessed = spacer.guesses(drawn)
+    off = np.array([np.sqrt(((g - u) ** 2).mean()) for g, u in zip(guessed, truth)])
+    by_arc = np.array([np.sqrt(((np.linspace(0, 1, 161) - u) ** 2).mean()) for u in truth])
+    assert np.median(off) < 0.03 and np.median(off) < 0.3 * np.median(by_arc), (np.median(off), np.median(by_arc))
+
+
+def test_the_learned_reading_starts_its_natural_fit_from_the_guess(shipped_runtime, monkeypatch):
+    """Pose "learned" with spacing "search" fits natural spacings from the guesser's guesses in GUESSED_NATURAL_STEPS;
+    the search and spacing "natural" keep the fit's own starts and steps."""
+    asked: list[dict] = []
+    real = reader_module.natural_readings_of
+
+    def recording(curves, **kw):
+        asked.append(kw)
+        return real(curves, **kw)
+
+    monkeypatch.setattr(reader_module, "natural_readings_of", recording)
+    t = np.linspace(0, np.pi, 80)
+    curve = np.c_[np.cos(t), 0.6 * np.sin(t) + 0.1 * np.sin(3 * t)] * 20
+    scout, steps = reader_module.GUESSED_NATURAL_STEPS
+    spacer = shipped_runtime.reader.spacer
+    for reading, expected in (
+        (Reading(pose="learned", spacing="search"), {"scout": scout, "steps": steps, "guess": spacer.guesses}),
+        (Reading(pose="search", spacing="search"), {}),
+        (Reading(pose="learned", spacing="natural"), {}),
+    ):
+        asked.clear()
+        shipped_runtime.reconstruct([curve], reading)
+        assert asked == [expected], reading

@@ -1,0 +1,179 @@
+"""The spacing guesser: a small network that tells, from a curve's shape alone, the parameter each of its points would
+have on one of the paper's splines, so that the natural fit (geometry.natural) starts there and needs a few steps
+from one guess where it otherwise scouts nine starts (reading pose "learned"; inference.spacer runs it in numpy).
+
+    paper curve, drawn densely --by arc length--> (GRID, 2) --spacer_inputs--> the net --> (GRID,) parameters
+        loss: L1 against the generator's own parameters at those points (known exactly: nothing to label)
+
+The curves are drawn afresh for every step from `seed` and the step's number, mirrored and reversed at random, so
+a resumed run sees what an unbroken one would; a fixed held-out set (its own seed) measures each checkpoint.
+Training is time-budgeted and resumable (`spacer-last.pt`, written atomically every EVAL_EVERY steps, with the
+time spent); `spacer-best.pt` keeps the step whose held-out error was least. `export_spacer` writes the weights as
+spacer.npz beside the model's graphs and names them in the manifest.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+from curve_vae.files import atomic_path, atomic_write_text
+from curve_vae.geometry import random_control_points, sample_bspline
+from curve_vae.geometry.frame import arc_fractions
+from curve_vae.inference.manifest import file_sha256
+from curve_vae.inference.spacer import GRID, SPACER_KIND, on_grid, spacer_inputs
+from curve_vae.training.checkpoint import atomic_save
+
+#: Channels of the residual blocks; each block's dilation (two sweeps that together see the whole grid).
+CHANNELS = 32
+DILATIONS = (1, 2, 4, 8, 16, 32, 1, 2, 4, 8, 16, 32)
+#: The block after which the grid's mean is mixed back into every point (the curve as a whole).
+MIX_AFTER = len(DILATIONS) // 2 - 1
+#: Points each training curve is drawn at before it is read by arc length: the grid's points interpolate finely.
+DENSE = 2049
+#: Held-out curves, and how often (steps) they are measured and the run saved.
+HELD_OUT = 1000
+EVAL_EVERY = 100
+
+
+class SpacerNet(nn.Module):
+    """(B, 3, GRID) spacer inputs -> (B, GRID) parameters, 0 to 1, rising (inference.spacer's diagram)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        c = CHANNELS
+        self.inp = nn.Conv1d(3, c, 5, padding=2)
+        self.a = nn.ModuleList([nn.Conv1d(c, c, 3, padding=d, dilation=d) for d in DILATIONS])
+        self.b = nn.ModuleList([nn.Conv1d(c, c, 1) for _ in DILATIONS])
+        self.mix = nn.Linear(c, c)
+        self.out = nn.Conv1d(c, 1, 2)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        h = self.inp(x)
+        for i, (a, b) in enumerate(zip(self.a, self.b)):
+            h = h + b(torch.relu(a(torch.relu(h))))
+            if i == MIX_AFTER:
+                h = h + self.mix(h.mean(2))[..., None]
+        step = torch.softmax(self.out(torch.relu(h))[:, 0], dim=1)
+        return torch.cat([torch.zeros_like(step[:, :1]), torch.cumsum(step, dim=1)], dim=1)
+
+    def weights(self) -> dict[str, np.ndarray]:
+        """The weights as inference.spacer reads them."""
+        out = {"dilations": np.array(DILATIONS), "mix_after": np.array(MIX_AFTER)}
+        named: dict[str, nn.Module] = {"inp": self.inp, "mix": self.mix, "out": self.out}
+        for i, (a, b) in enumerate(zip(self.a, self.b)):
+            named[f"block{i}_a"], named[f"block{i}_b"] = a, b
+        for name, m in named.items():
+            out[f"{name}_w"] = m.weight.detach().cpu().numpy().astype(np.float32)
+            out[f"{name}_b"] = m.bias.detach().cpu().numpy().astype(np.float32)
+        return out
+
+
+def paper_examples(rng: np.random.Generator, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """`count` of the paper's curves, each mirrored and reversed at random: their spacer inputs (count, 3, GRID)
+    and the generator's parameters at the grid's points (count, GRID)."""
+    dense = sample_bspline(random_control_points(rng, count), DENSE)
+    back = rng.random(count) < 0.5
+    dense[back] = dense[back, ::-1]  # a reversed spline is the spline of its reversed control points: u runs 0 to 1
+    dense[rng.random(count) < 0.5, :, 0] *= -1.0
+    at = np.linspace(0.0, 1.0, GRID)
+    params = np.linspace(0.0, 1.0, DENSE)
+    u = np.stack([np.interp(at, arc_fractions(c), params) for c in dense])
+    return spacer_inputs(on_grid(dense)), u.astype(np.float32)
+
+
+def held_out_error(net: SpacerNet, x: np.ndarray, u: np.ndarray) -> dict[str, float]:
+    """The net's parameters against the generator's on held-out curves: mean absolute and root mean square."""
+    net.eval()
+    with torch.no_grad():
+        d = net(torch.from_numpy(x)).numpy() - u
+    return {"mae": float(np.abs(d).mean()), "rms": float(np.sqrt((d**2).mean()))}
+
+
+def train_spacer(
+    run_dir: str | Path,
+    *,
+    time_budget: float,
+    resume: bool = False,
+    lr: float = 1e-3,
+    batch: int = 128,
+    seed: int = 0,
+    say: Callable[[str], None] = print,
+) -> Path:
+    """Train a spacing guesser for `time_budget` seconds in all (the learning rate cosine over the budget); `resume`
+    carries on from RUN_DIR/spacer-last.pt with the time it had left. Returns the best checkpoint's path."""
+    out = Path(run_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    last, best_path = out / "spacer-last.pt", out / "spacer-best.pt"
+    torch.manual_seed(seed)
+    net = SpacerNet()
+    opt = torch.optim.Adam(net.parameters(), lr=lr)
+    state: dict[str, Any] = {"step": 0, "spent": 0.0, "best": float("inf"), "seed": seed, "lr": lr, "batch": batch}
+    if resume and last.exists():
+        ck = torch.load(last, map_location="cpu", weights_only=False)
+        net.load_state_dict(ck["model"])
+        opt.load_state_dict(ck["optimizer"])
+        state = ck["state"]
+        say(f"resumed at step {state['step']}, {state['spent']:.0f} s of {time_budget:.0f} spent")
+    held_x, held_u = paper_examples(np.random.default_rng([state["seed"], 1 << 30]), HELD_OUT)
+    start = time.monotonic() - state["spent"]
+    while (spent := time.monotonic() - start) < time_budget:
+        for g in opt.param_groups:
+            g["lr"] = state["lr"] * 0.5 * (1 + np.cos(np.pi * spent / time_budget))
+        net.train()
+        x, u = paper_examples(np.random.default_rng([state["seed"], state["step"]]), state["batch"])
+        loss = (net(torch.from_numpy(x)) - torch.from_numpy(u)).abs().mean()
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        state["step"] += 1
+        if state["step"] % EVAL_EVERY == 0 or time.monotonic() - start >= time_budget:
+            state["spent"] = time.monotonic() - start
+            err = held_out_error(net, held_x, held_u)
+            say(
+                f"step {state['step']}: loss {loss.item():.4f}, held-out parameters off by {err['mae']:.4f} "
+                f"(rms {err['rms']:.4f}), {state['spent']:.0f}/{time_budget:.0f} s"
+            )
+            if err["rms"] < state["best"]:
+                state["best"] = err["rms"]
+                trained = {"steps": state["step"], "seconds": round(state["spent"], 1), "curves": state["step"] * batch}
+                trained |= {"seed": state["seed"], "lr": state["lr"], "batch": state["batch"]}
+                atomic_save({"model": net.state_dict(), "held_out": err, "trained": trained}, best_path)
+            atomic_save({"model": net.state_dict(), "optimizer": opt.state_dict(), "state": state}, last)
+    return best_path
+
+
+def export_spacer(
+    checkpoint: str | Path, model_dir: str | Path, *, meta: dict[str, Any] | None = None, version: str | None = None
+) -> Path:
+    """Write the checkpoint's weights as `spacer.npz` in `model_dir` and name it in the manifest with how it was
+    trained and how it measured (both written atomically); `version`: the model's new version. Returns its path."""
+    ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
+    net = SpacerNet()
+    net.load_state_dict(ck["model"])
+    root = Path(model_dir)
+    path = root / "spacer.npz"
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, kind=SPACER_KIND, **net.weights())  # type: ignore[arg-type]  # as export_ranker's
+    manifest_path = root / "manifest.json"
+    manifest = json.loads(manifest_path.read_text())
+    manifest["files"]["spacer.npz"] = {"sha256": file_sha256(path), "bytes": path.stat().st_size}
+    manifest["spacer"] = {
+        "file": "spacer.npz",
+        "kind": SPACER_KIND,
+        **(meta or {}),
+        "held_out": ck.get("held_out"),
+        "trained": ck.get("trained"),
+    }
+    if version is not None:
+        manifest["version"] = version
+    atomic_write_text(manifest_path, json.dumps(manifest, indent=2) + "\n")
+    return path
