@@ -93,6 +93,14 @@ class FrameRows:
         p = p * (model_size / self.size)[own, None] + np.asarray(MODEL_CENTER)
         return p[curves.reversed_where(self.reverse)]
 
+    def to_model_rows(self, rows: np.ndarray, model_size: float) -> np.ndarray:
+        """`Frame.to_model` of curves of one length (B, n, 2), each through its own frame, in the model's order."""
+        d = rows - self.center[:, None]
+        p = d[..., :1] * self.linear[:, None, 0] + d[..., 1:] * self.linear[:, None, 1]  # p @ M, row by row
+        p = p * (model_size / self.size)[:, None, None] + np.asarray(MODEL_CENTER)
+        p[self.reverse] = p[self.reverse, ::-1]
+        return p
+
     def from_model(self, curves: Ragged, model_size: float) -> np.ndarray:
         """`Frame.from_model` of every curve (N, 2): model-plane points back to their curves' frames and order."""
         own = curves.owner

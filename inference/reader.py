@@ -291,6 +291,8 @@ class Reader:
         g = self.graphs
         if stage and all(c.spacing == "parameter" for c in stage):
             return self._model_points_as_given(inputs, index, stage)
+        if stage and all(c.spacing in ("parameter", "natural") and c.frame is not None for c in stage):
+            return self._model_points_read(inputs, index, stage)
         rows, fractions = [], []
         with np.errstate(all="ignore"):
             for c, f, spacing, natural, _ in stage:
@@ -329,11 +331,43 @@ class Reader:
             for n in np.unique(curves.lengths):
                 rows = np.flatnonzero(curves.lengths == n)
                 out[rows] = resample_index(np.stack([parts[r] for r in rows]), g.n_points)
-        bad = ~(np.abs(out) <= F32_MAX).reshape(len(out), -1).all(axis=1)  # also true for inf and nan
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise InputError(("curves", index[stage[k].curve]), _beyond(framed[k] is not None))
+        _check_float32(out, stage, index)
         fractions = [None if n == g.n_points else np.linspace(0.0, 1.0, n) for n in curves.lengths]
+        return out.astype(np.float32), fractions
+
+    def _model_points_read(
+        self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
+    ) -> tuple[np.ndarray, list[np.ndarray | None]]:
+        """`to_model_plane` with spacing "parameter" or "natural" for every candidate at once: each reading of a curve
+        taken to the model's count once, in the caller's plane (a frame maps interpolated points as it maps the
+        points), then every candidate through its frame (geometry.batch)."""
+        g = self.graphs
+        grid = np.linspace(0.0, 1.0, g.n_points)
+        # (curve, its reading's id, reversed): a curve's poses share its readings, each read in the model's order (so
+        # that a curve and its reversal are read alike to the last bit)
+        read: dict[tuple[int, int, bool], np.ndarray] = {}
+        rows: list[np.ndarray] = []
+        fractions: list[np.ndarray | None] = []
+        with np.errstate(all="ignore"):
+            for c in stage:
+                pts = inputs[c.curve]
+                back = c.frame is not None and c.frame.reverse
+                key = (c.curve, id(c.natural), back)
+                if c.natural is None:
+                    fractions.append(None if len(pts) == g.n_points else np.linspace(0.0, 1.0, len(pts)))
+                    if key not in read:
+                        read[key] = resample_index(pts[None], g.n_points)[0]
+                else:  # where the caller's points sit, in the model's order
+                    fractions.append((1.0 - c.natural)[::-1] if back else c.natural)
+                    if key not in read:
+                        at = fractions[-1] + np.arange(len(pts)) * 1e-12  # strictly increasing, for np.interp
+                        ordered = pts[::-1] if back else pts
+                        m = np.stack([np.interp(grid, at, ordered[:, 0]), np.interp(grid, at, ordered[:, 1])], axis=1)
+                        read[key] = m[::-1] if back else m  # in the caller's order: the frame turns it round
+                rows.append(read[key])
+            frames = FrameRows.of([c.frame for c in stage if c.frame is not None])
+            out = frames.to_model_rows(np.stack(rows), g.model_size)
+        _check_float32(out, stage, index)
         return out.astype(np.float32), fractions
 
     # ----------------------------------------------------------------------------------- decoding, placement
@@ -393,6 +427,14 @@ def _beyond(framed: bool) -> str:
         if framed
         else 'coordinates beyond float32 range; use frame "auto"'
     )
+
+
+def _check_float32(out: np.ndarray, stage: list[Candidate], index: list[int]) -> None:
+    """Names the first candidate's curve whose model-plane points (k, n, 2) are not all finite float32 numbers."""
+    bad = ~(np.abs(out) <= F32_MAX).reshape(len(out), -1).all(axis=1)  # also true for inf and nan
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(("curves", index[stage[k].curve]), _beyond(stage[k].frame is not None))
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:

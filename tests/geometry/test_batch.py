@@ -50,6 +50,10 @@ def test_frame_rows_map_every_curve_as_its_own_frame_does(model_size):
         np.testing.assert_allclose(m, f.to_model(c, model_size), rtol=0, atol=1e-12 * model_size)
     back = rows.from_model(Ragged(into, batch.lengths), model_size)
     np.testing.assert_allclose(back, batch.points, rtol=0, atol=1e-9 * np.abs(batch.points).max())
+    same = [c[: min(len(c) for c in curves)] for c in curves]  # curves of one length, as rows
+    by_rows = rows.to_model_rows(np.stack(same), model_size)
+    for f, c, m in zip(frames, same, by_rows):
+        np.testing.assert_allclose(m, f.to_model(c, model_size), rtol=0, atol=1e-12 * model_size)
 
 
 def test_points_that_all_coincide_are_refused():
