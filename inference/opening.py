@@ -16,8 +16,8 @@ from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.named_priors import load_priors
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
-from curve_vae.inference.spacer import Spacer
 from curve_vae.inference.sessions import SessionConfig
+from curve_vae.inference.spacer import Spacer
 
 T = TypeVar("T")
 

@@ -13,21 +13,18 @@ with the same reading come from the encoding cache. `refine` fits each latent cl
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from curve_vae.geometry import (
-    BeyondFloat32,
     Frame,
     canonical_frame,
     fit_frame,
     natural_readings_of,
     ordered_closest_params,
     pose_frames,
-    to_model_plane,
 )
-from curve_vae.geometry.adapt import F32_MAX
 from curve_vae.geometry.batch import (
     FrameRows,
     Ragged,
@@ -35,9 +32,9 @@ from curve_vae.geometry.batch import (
     shared_canonical_frames,
     shared_pose_frames,
 )
-from curve_vae.geometry.frame import resample_index
 from curve_vae.inference.cache import EncodingCache
 from curve_vae.inference.cancel import checkpoint
+from curve_vae.inference.candidates import Candidate, model_points
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
@@ -62,16 +59,6 @@ GUESSED_NATURAL_STEPS = (4, 8)
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
-
-
-class Candidate(NamedTuple):
-    """One way of reading one curve: its frame (with the pose), its spacing and natural parameters."""
-
-    curve: int  # which of the curves read
-    frame: Frame | None
-    spacing: str
-    natural: np.ndarray | None  # the natural reading's parameters, with spacing "natural"
-    pose: int  # which of the curve's pose candidates (in a shared set, candidate k is one pose for every curve)
 
 
 class Reader:
@@ -142,7 +129,9 @@ class Reader:
         """Curves not in the cache: their candidates, encoded; with several per curve, decoded and the closest kept
         (shared: each curve's closest in the one pose whose candidates are closest over the whole set)."""
         stage = self._candidates(inputs, index, reading, shared=shared)
-        models, fractions = self._model_points(inputs, index, stage)
+        models, fractions = model_points(
+            inputs, index, stage, n_points=self.graphs.n_points, model_size=self.graphs.model_size
+        )
         if reading.pose == "learned" and stage:
             keep = self._ranked(stage, models, shared=shared)
             stage, models, fractions = [stage[k] for k in keep], models[keep], [fractions[k] for k in keep]
@@ -283,93 +272,6 @@ class Reader:
                 raise
         return out
 
-    def _model_points(
-        self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
-    ) -> tuple[np.ndarray, list[np.ndarray | None]]:
-        """Each candidate's model-plane points (k, n_points, 2) float32 and where its curve's points sit along them.
-        Candidates read at their points as given are mapped all at once (`_model_points_as_given`)."""
-        g = self.graphs
-        if stage and all(c.spacing == "parameter" for c in stage):
-            return self._model_points_as_given(inputs, index, stage)
-        if stage and all(c.spacing in ("parameter", "natural") and c.frame is not None for c in stage):
-            return self._model_points_read(inputs, index, stage)
-        rows, fractions = [], []
-        with np.errstate(all="ignore"):
-            for c, f, spacing, natural, _ in stage:
-                try:
-                    m, fraction = to_model_plane(
-                        inputs[c], f, model_size=g.model_size, n_points=g.n_points, spacing=spacing, natural=natural
-                    )
-                except BeyondFloat32:
-                    raise InputError(("curves", index[c]), _beyond(f is not None)) from None
-                rows.append(m)
-                fractions.append(fraction)
-        batch = np.stack(rows).astype(np.float32) if rows else np.zeros((0, g.n_points, 2), np.float32)
-        return batch, fractions
-
-    def _model_points_as_given(
-        self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
-    ) -> tuple[np.ndarray, list[np.ndarray | None]]:
-        """`to_model_plane` with spacing "parameter" for every candidate at once: each curve through its frame
-        (geometry.batch), then the curves of each length to the model's count along their point index."""
-        g = self.graphs
-        curves = Ragged.of([inputs[c.curve] for c in stage])
-        framed = [c.frame for c in stage]
-        with np.errstate(all="ignore"):
-            frames = [f for f in framed if f is not None]
-            if len(frames) == len(framed):  # every candidate has a frame
-                flat = FrameRows.of(frames).to_model(curves, g.model_size)
-            else:
-                flat = np.concatenate(
-                    [
-                        f.to_model(p, g.model_size) if f is not None else p
-                        for f, p in zip(framed, curves.split(curves.points))
-                    ]
-                )
-            out = np.empty((len(stage), g.n_points, 2))
-            parts = curves.split(flat)
-            for n in np.unique(curves.lengths):
-                rows = np.flatnonzero(curves.lengths == n)
-                out[rows] = resample_index(np.stack([parts[r] for r in rows]), g.n_points)
-        _check_float32(out, stage, index)
-        fractions = [None if n == g.n_points else np.linspace(0.0, 1.0, n) for n in curves.lengths]
-        return out.astype(np.float32), fractions
-
-    def _model_points_read(
-        self, inputs: list[np.ndarray], index: list[int], stage: list[Candidate]
-    ) -> tuple[np.ndarray, list[np.ndarray | None]]:
-        """`to_model_plane` with spacing "parameter" or "natural" for every candidate at once: each reading of a curve
-        taken to the model's count once, in the caller's plane (a frame maps interpolated points as it maps the
-        points), then every candidate through its frame (geometry.batch)."""
-        g = self.graphs
-        grid = np.linspace(0.0, 1.0, g.n_points)
-        # (curve, its reading's id, reversed): a curve's poses share its readings, each read in the model's order (so
-        # that a curve and its reversal are read alike to the last bit)
-        read: dict[tuple[int, int, bool], np.ndarray] = {}
-        rows: list[np.ndarray] = []
-        fractions: list[np.ndarray | None] = []
-        with np.errstate(all="ignore"):
-            for c in stage:
-                pts = inputs[c.curve]
-                back = c.frame is not None and c.frame.reverse
-                key = (c.curve, id(c.natural), back)
-                if c.natural is None:
-                    fractions.append(None if len(pts) == g.n_points else np.linspace(0.0, 1.0, len(pts)))
-                    if key not in read:
-                        read[key] = resample_index(pts[None], g.n_points)[0]
-                else:  # where the caller's points sit, in the model's order
-                    fractions.append((1.0 - c.natural)[::-1] if back else c.natural)
-                    if key not in read:
-                        at = fractions[-1] + np.arange(len(pts)) * 1e-12  # strictly increasing, for np.interp
-                        ordered = pts[::-1] if back else pts
-                        m = np.stack([np.interp(grid, at, ordered[:, 0]), np.interp(grid, at, ordered[:, 1])], axis=1)
-                        read[key] = m[::-1] if back else m  # in the caller's order: the frame turns it round
-                rows.append(read[key])
-            frames = FrameRows.of([c.frame for c in stage if c.frame is not None])
-            out = frames.to_model_rows(np.stack(rows), g.model_size)
-        _check_float32(out, stage, index)
-        return out.astype(np.float32), fractions
-
     # ----------------------------------------------------------------------------------- decoding, placement
 
     def _decoded(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], np.ndarray]:
@@ -419,22 +321,6 @@ def _distinct(ranked: np.ndarray, models: np.ndarray, count: int) -> np.ndarray:
         if all(np.abs(models[k] - models[j]).max() > SAME_POINTS for j in kept):
             kept.append(int(k))
     return np.array(kept)
-
-
-def _beyond(framed: bool) -> str:
-    return (
-        "its extent is too small or too large to map to the model's frame"
-        if framed
-        else 'coordinates beyond float32 range; use frame "auto"'
-    )
-
-
-def _check_float32(out: np.ndarray, stage: list[Candidate], index: list[int]) -> None:
-    """Names the first candidate's curve whose model-plane points (k, n, 2) are not all finite float32 numbers."""
-    bad = ~(np.abs(out) <= F32_MAX).reshape(len(out), -1).all(axis=1)  # also true for inf and nan
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise InputError(("curves", index[stage[k].curve]), _beyond(stage[k].frame is not None))
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:

@@ -49,7 +49,6 @@ from curve_vae.inference.placing import (
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
-from curve_vae.inference.spacer import Spacer
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import (
@@ -64,6 +63,7 @@ from curve_vae.inference.results import (
 )
 from curve_vae.inference.sampling import MAX_DRAWS, Sampler, fresh_seed
 from curve_vae.inference.sessions import SessionConfig
+from curve_vae.inference.spacer import Spacer
 
 DEFAULT = Reading()
 T = TypeVar("T")

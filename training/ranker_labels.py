@@ -20,6 +20,7 @@ import numpy as np
 
 from curve_vae.files import atomic_path
 from curve_vae.geometry.frame import resample, resample_index
+from curve_vae.inference.candidates import model_points
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.families import TRAIN_FAMILIES, draw_family
@@ -74,7 +75,8 @@ def label(runtime: CurveRuntime, curves: list[np.ndarray]) -> dict[str, np.ndarr
     inputs = [np.asarray(c, np.float64) for c in curves]
     index = list(range(len(inputs)))
     stage = reader._candidates(inputs, index, SEARCH)
-    models, fractions = reader._model_points(inputs, index, stage)
+    g = runtime.graphs
+    models, fractions = model_points(inputs, index, stage, n_points=g.n_points, model_size=g.model_size)
     mean, log_var = runtime.graphs.encode(models)
     from curve_vae.inference.prepared import ReadCurve
 

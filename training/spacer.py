@@ -2,7 +2,7 @@
 have on one of the paper's splines, so that the natural fit (geometry.natural) starts there and needs a few steps
 from one guess where it otherwise scouts nine starts (reading pose "learned"; inference.spacer runs it in numpy).
 
-    paper curve, drawn densely --by arc length--> (GRID, 2) --spacer_inputs--> the net --> (GRID,) parameters
+    paper curve as a caller's polyline --by arc length--> (GRID, 2) --spacer_inputs--> the net --> (GRID,) parameters
         loss: L1 against the generator's own parameters at those points (known exactly: nothing to label)
 
 The curves are drawn afresh for every step from `seed` and the step's number, mirrored and reversed at random, so
@@ -30,14 +30,16 @@ from curve_vae.geometry.frame import arc_fractions
 from curve_vae.inference.manifest import file_sha256
 from curve_vae.inference.spacer import GRID, SPACER_KIND, on_grid, spacer_inputs
 from curve_vae.training.checkpoint import atomic_save
+from curve_vae.training.families import warp
 
 #: Channels of the residual blocks; each block's dilation (two sweeps that together see the whole grid).
 CHANNELS = 32
 DILATIONS = (1, 2, 4, 8, 16, 32, 1, 2, 4, 8, 16, 32)
 #: The block after which the grid's mean is mixed back into every point (the curve as a whole).
 MIX_AFTER = len(DILATIONS) // 2 - 1
-#: Points each training curve is drawn at before it is read by arc length: the grid's points interpolate finely.
+#: Points each training curve is drawn at before it is sampled as a caller's polyline, and that polyline's points.
 DENSE = 2049
+POINTS = (40, 400)
 #: Held-out curves, and how often (steps) they are measured and the run saved.
 HELD_OUT = 1000
 EVAL_EVERY = 100
@@ -67,26 +69,41 @@ class SpacerNet(nn.Module):
     def weights(self) -> dict[str, np.ndarray]:
         """The weights as inference.spacer reads them."""
         out = {"dilations": np.array(DILATIONS), "mix_after": np.array(MIX_AFTER)}
-        named: dict[str, nn.Module] = {"inp": self.inp, "mix": self.mix, "out": self.out}
-        for i, (a, b) in enumerate(zip(self.a, self.b)):
-            named[f"block{i}_a"], named[f"block{i}_b"] = a, b
-        for name, m in named.items():
-            out[f"{name}_w"] = m.weight.detach().cpu().numpy().astype(np.float32)
-            out[f"{name}_b"] = m.bias.detach().cpu().numpy().astype(np.float32)
+        layers = {"inp": "inp", "mix": "mix", "out": "out"}
+        for i in range(len(DILATIONS)):
+            layers[f"a.{i}"], layers[f"b.{i}"] = f"block{i}_a", f"block{i}_b"
+        for key, t in self.state_dict().items():  # "a.3.weight" -> block3_a_w
+            layer, kind = key.rsplit(".", 1)
+            out[f"{layers[layer]}_{kind[0]}"] = t.detach().cpu().numpy().astype(np.float32)
         return out
 
 
 def paper_examples(rng: np.random.Generator, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """`count` of the paper's curves, each mirrored and reversed at random: their spacer inputs (count, 3, GRID)
-    and the generator's parameters at the grid's points (count, GRID)."""
+    """`count` of the paper's curves as callers post them — polylines of 40 to 400 points, spaced evenly in the
+    parameter, by arc length or at a random warp of it, mirrored and reversed at random: their spacer inputs
+    (count, 3, GRID) and the generator's parameters at the grid's points (count, GRID), the polyline's own
+    interpolated along its chords (as the guesser's guesses are read at a caller's points)."""
     dense = sample_bspline(random_control_points(rng, count), DENSE)
+    sizes = np.exp(rng.uniform(np.log(POINTS[0]), np.log(POINTS[1]), count)).astype(int)
+    kind = rng.integers(0, 3, count)  # 0: even in the parameter, 1: by arc length, 2: warped
     back = rng.random(count) < 0.5
-    dense[back] = dense[back, ::-1]  # a reversed spline is the spline of its reversed control points: u runs 0 to 1
-    dense[rng.random(count) < 0.5, :, 0] *= -1.0
+    mirror = np.where(rng.random(count) < 0.5, -1.0, 1.0)
     at = np.linspace(0.0, 1.0, GRID)
-    params = np.linspace(0.0, 1.0, DENSE)
-    u = np.stack([np.interp(at, arc_fractions(c), params) for c in dense])
-    return spacer_inputs(on_grid(dense)), u.astype(np.float32)
+    every = np.linspace(0.0, 1.0, DENSE)
+    polylines, u = [], np.empty((count, GRID), np.float32)
+    for i, (c, n) in enumerate(zip(dense, sizes)):
+        if kind[i] == 1:
+            q = np.interp(np.linspace(0.0, 1.0, n), arc_fractions(c), every)
+        elif kind[i] == 2:
+            q = warp(rng, 1, n)[0]
+        else:
+            q = np.linspace(0.0, 1.0, n)
+        pts = np.stack([np.interp(q, every, c[:, 0]) * mirror[i], np.interp(q, every, c[:, 1])], axis=1)
+        if back[i]:  # a reversed spline is the spline of its reversed control points: its parameter runs 0 to 1
+            pts, q = pts[::-1], (1.0 - q)[::-1]
+        polylines.append(pts)
+        u[i] = np.interp(at, arc_fractions(pts), q)
+    return spacer_inputs(on_grid(polylines)), u
 
 
 def held_out_error(net: SpacerNet, x: np.ndarray, u: np.ndarray) -> dict[str, float]:

@@ -24,7 +24,9 @@ def cmd_export(a: argparse.Namespace) -> int:
     from curve_vae.training.spacer import export_spacer
 
     refuse_overwrite(Path(a.model_dir) / "spacer.npz", a.force, flag="--model-dir")
-    path = export_spacer(a.checkpoint, a.model_dir, meta={"note": a.note} if a.note else None, version=a.version or None)
+    path = export_spacer(
+        a.checkpoint, a.model_dir, meta={"note": a.note} if a.note else None, version=a.version or None
+    )
     print(f'wrote {path}; pose "learned" starts its natural fit from its guesses (the manifest names it)')
     return 0
 

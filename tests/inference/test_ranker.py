@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from curve_vae.inference.candidates import model_points
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
 from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, Ranker, ranker_inputs
@@ -131,7 +132,8 @@ def test_a_symmetric_curve_is_read_two_different_ways(ranked: CurveRuntime):
     half_circle = np.c_[np.cos(t), np.sin(t)] * 30 + 64
     reader = ranked.reader
     stage = reader._candidates([half_circle], [0], Reading(pose="learned", spacing="parameter"))
-    models, _ = reader._model_points([half_circle], [0], stage)
+    g = ranked.graphs
+    models, _ = model_points([half_circle], [0], stage, n_points=g.n_points, model_size=g.model_size)
     keep = reader._ranked(stage, models, shared=False)
     assert len(keep) == 2 and np.abs(models[keep[0]] - models[keep[1]]).max() > 1e-3
     assert any(np.abs(models[i] - models[j]).max() < 1e-6 for i in range(6) for j in range(i))  # twins exist
