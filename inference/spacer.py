@@ -7,7 +7,8 @@ on the paper's curves, whose parameters are known; the service has no torch).
         --at the caller's points' arc-length fractions--> its guess (n,)
 
 The shape is read through its turning angles at even steps of its length, so the guess does not change when the
-curve is moved, turned or scaled; the network is trained on mirrored and reversed curves alike. Its parameters
+curve is moved, turned or scaled, and the way round it turns overall, so that a mirror image is guessed alike; the
+network is trained on mirrored and reversed curves alike. Its parameters
 rise from 0 to 1 by construction (a softmax's cumulative sum).
 """
 
@@ -19,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.errors import InvalidInput
-from curve_vae.geometry.frame import arc_fractions, resample
+from curve_vae.geometry.frame import arc_fractions, resample, turns_clockwise
 
 SPACER_KIND = "dilated-conv1d-cumsoftmax-v1"
 #: Points a curve is read at, evenly spaced along its length.
@@ -89,7 +90,10 @@ class Spacer:
         """Each polyline's (n, 2) guessed parameters at its own points (n,): 0 and 1 at its ends, never falling."""
         if not curves:
             return []
-        grid = self.grid_params(spacer_inputs(on_grid(curves)))
+        # the parameters of a mirror image are the curve's own: each curve is read the way round it turns
+        # counter-clockwise, so that a curve and its mirror image give the network the same numbers to the last bit
+        upright = [c * [-1.0, 1.0] if turns_clockwise(c) else c for c in (np.asarray(c, np.float64) for c in curves)]
+        grid = self.grid_params(spacer_inputs(on_grid(upright)))
         at = np.linspace(0.0, 1.0, GRID)
         return [np.interp(arc_fractions(np.asarray(c, np.float64)), at, u) for c, u in zip(curves, grid)]
 

@@ -60,6 +60,9 @@ def test_guesses_rise_from_0_to_1_at_each_curves_own_points_and_follow_the_shape
     for u, v in zip(guesses, again):
         np.testing.assert_allclose(v, u, atol=1e-5)
     assert spacer.guesses([]) == []
+    # a mirror image is read the way round its curve is: alike to the last bit (in a batch of the same curves)
+    for u, v in zip(guesses, spacer.guesses([c * [-1.0, 1.0] for c in curves])):
+        np.testing.assert_array_equal(v, u)
 
 
 def test_a_file_of_another_kind_or_without_its_weights_is_refused(tmp_path: Path):
