@@ -54,8 +54,10 @@ NATURAL_BATCH = 32
 #: against 29.5 (docs/BENCHMARKS.md, service 0.16.0). The search and spacing "natural" keep the full fit.
 LEARNED_NATURAL_STEPS = (8, 24)
 #: The same when the model ships a spacing guesser (inference.spacer): the fit starts from its guess and the
-#: arc-length fractions alone, and needs fewer steps (docs/RESULTS.md, "The spacing guesser").
-GUESSED_NATURAL_STEPS = (4, 8)
+#: arc-length fractions alone. On the family suite (200 a set) every set reads within 1.16× of the search (the
+#: paper's curves by arc length 1.05×, 1.15× from the nine starts), in 0.62× the time; 4/8 read a little farther, and
+#: the reading table's superellipse and cardioid need more than 8 (docs/RESULTS.md, "The spacing guesser").
+GUESSED_NATURAL_STEPS = (6, 12)
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'

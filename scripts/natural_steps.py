@@ -1,7 +1,7 @@
 """The learned reading with and without the spacing guesser and at several natural-fit steps: the family suite per
 set, beside the search.
 
-    .venv/bin/python scripts/natural_steps.py [--count 200] [--steps 8/24] [--guessed 4/8 2/4] [--json out.json]
+    .venv/bin/python scripts/natural_steps.py [--count 200] [--steps 8/24] [--guessed 6/12 4/8] [--json out.json]
 
 Each STEPS is SCOUT/TOTAL Levenberg–Marquardt steps of geometry.natural_readings_of (every start scouts SCOUT
 steps, the closest and the arc-length one go on to TOTAL): `--steps` from the fit's own nine starts (the reader's
@@ -35,7 +35,7 @@ def main() -> None:
     p.add_argument("--count", type=int, default=200, help="curves per suite set (default: 200)")
     p.add_argument("--steps", nargs="*", default=["8/24"], help="SCOUT/TOTAL without the guesser (default: 8/24)")
     p.add_argument(
-        "--guessed", nargs="*", default=["4/8", "2/4"], help="SCOUT/TOTAL from the guesser (default: 4/8 2/4)"
+        "--guessed", nargs="*", default=["6/12", "4/8"], help="SCOUT/TOTAL from the guesser (default: 6/12 4/8)"
     )
     p.add_argument("--json", default=None, help="also write the rows as JSON here")
     a = p.parse_args()
