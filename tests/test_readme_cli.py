@@ -29,6 +29,8 @@ TINY = {
     "ranker train": ["--time-budget", "3"],
     # the shipped model stays as it is: the ranker is exported into a copy (the last --model-dir wins)
     "ranker export": ["--model-dir", "model-copy"],
+    "spacer train": ["--time-budget", "3", "--batch", "8"],
+    "spacer export": ["--model-dir", "model-copy"],
 }
 ORDER = ["dataset", "train", "average", "export", "evaluate", "prior", "sample", "augment", "fit", "revolve"]
 
@@ -75,8 +77,8 @@ def _inputs(cwd: Path) -> None:
 
 
 def _tiny(argv: list[str]) -> list[str]:
-    """The flags that shrink a command to seconds (a `ranker` stage by its stage)."""
-    return TINY.get(" ".join(argv[:2]) if argv[0] == "ranker" else argv[0], [])
+    """The flags that shrink a command to seconds (a `ranker` or `spacer` stage by its stage)."""
+    return TINY.get(" ".join(argv[:2]) if argv[0] in ("ranker", "spacer") else argv[0], [])
 
 
 @pytest.mark.slow
@@ -103,6 +105,8 @@ def test_readme_cli_commands_run_as_written(tmp_path):
         "mine_samples.json",
         "runs/ranker/ranker-best.pt",
         "model-copy/ranker.npz",
+        "runs/spacer/spacer-best.pt",
+        "model-copy/spacer.npz",
     ]:
         assert (tmp_path / made).is_file(), made
     now = {f.name: hashlib.sha256(f.read_bytes()).hexdigest() for f in (ROOT / "models").glob("*") if f.is_file()}
