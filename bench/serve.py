@@ -51,6 +51,7 @@ RUNS = (
     "spinning",
     "access_log",
     "workers",
+    "one_thread",
     "one_session",
     "micro_batch",
     "C",
@@ -193,6 +194,7 @@ VARIANTS = {  # run as B (the default request), each against a server started wi
     "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
     "access_log": (["--access-log", "true"], "B with the access log on"),
     "workers": (["--workers", "2", "--inference-concurrency", "1"], "B over 2 worker processes"),
+    "one_thread": (["--inference-concurrency", "1"], "B with one inference thread"),
     "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
     "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),
 }

@@ -15,6 +15,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry.frame import MODEL_CENTER
+from curve_vae.inference.weights import read_weights
 
 RANKER_KIND = "conv1d-3x5s2-meanmax-v1"
 #: Readings pose "learned" encodes per curve: the ranker's first two.
@@ -52,11 +53,7 @@ class Ranker:
 
     @classmethod
     def load(cls, path: str | Path) -> Ranker:
-        with np.load(path) as d:
-            kind = str(d["kind"]) if "kind" in d else ""
-            if kind != RANKER_KIND:
-                raise InvalidInput(f"{path}: a ranker of kind {kind!r}; this runtime reads {RANKER_KIND!r}")
-            return cls({k: d[k] for k in d.files if k != "kind"})
+        return cls(read_weights(path, RANKER_KIND, "a ranker"))
 
     def scores(self, points: np.ndarray) -> np.ndarray:
         """(k, n, 2) model-plane points -> (k,) predicted natural log of each reading's relative RMSE."""

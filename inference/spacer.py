@@ -8,8 +8,8 @@ on the paper's curves, whose parameters are known; the service has no torch).
 
 The shape is read through its turning angles at even steps of its length, so the guess does not change when the
 curve is moved, turned or scaled, and the way round it turns overall, so that a mirror image is guessed alike; the
-network is trained on mirrored and reversed curves alike. Its parameters
-rise from 0 to 1 by construction (a softmax's cumulative sum).
+network is trained on mirrored and reversed curves alike. Its parameters rise from 0 to 1 by construction (a
+softmax's cumulative sum).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import numpy as np
 
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry.frame import arc_fractions, resample, turns_clockwise
+from curve_vae.inference.weights import read_weights
 
 SPACER_KIND = "dilated-conv1d-cumsoftmax-v1"
 #: Points a curve is read at, evenly spaced along its length.
@@ -63,11 +64,7 @@ class Spacer:
 
     @classmethod
     def load(cls, path: str | Path) -> Spacer:
-        with np.load(path) as d:
-            kind = str(d["kind"]) if "kind" in d else ""
-            if kind != SPACER_KIND:
-                raise InvalidInput(f"{path}: a spacing guesser of kind {kind!r}; this runtime reads {SPACER_KIND!r}")
-            return cls({k: d[k] for k in d.files if k != "kind"})
+        return cls(read_weights(path, SPACER_KIND, "a spacing guesser"))
 
     def grid_params(self, inputs: np.ndarray) -> np.ndarray:
         """(k, 3, GRID) spacer_inputs -> (k, GRID) parameters from 0 to 1 at the grid's points."""
@@ -90,12 +87,13 @@ class Spacer:
         """Each polyline's (n, 2) guessed parameters at its own points (n,): 0 and 1 at its ends, never falling."""
         if not curves:
             return []
+        pts = [np.asarray(c, np.float64) for c in curves]
         # the parameters of a mirror image are the curve's own: each curve is read the way round it turns
         # counter-clockwise, so that a curve and its mirror image give the network the same numbers to the last bit
-        upright = [c * [-1.0, 1.0] if turns_clockwise(c) else c for c in (np.asarray(c, np.float64) for c in curves)]
+        upright = [c * [-1.0, 1.0] if turns_clockwise(c) else c for c in pts]
         grid = self.grid_params(spacer_inputs(on_grid(upright)))
         at = np.linspace(0.0, 1.0, GRID)
-        return [np.interp(arc_fractions(np.asarray(c, np.float64)), at, u) for c, u in zip(curves, grid)]
+        return [np.interp(arc_fractions(c), at, u) for c, u in zip(pts, grid)]
 
 
 def _pair(weights: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, np.ndarray]:

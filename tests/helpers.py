@@ -16,3 +16,26 @@ FIXTURES = ROOT / "tests" / "fixtures"
 def bspline_curves(count: int, n_points: int = 161, *, seed: int = 0) -> np.ndarray:
     """(count, n_points, 2) curves of the paper's kind, in the 128×128 plane."""
     return sample_bspline(random_control_points(np.random.default_rng(seed), count), n_points)
+
+
+def natural_fits_asked(runtime, monkeypatch, readings: list) -> list[list[dict]]:
+    """For each reading, the options of every natural fit (geometry.natural_readings_of) the reader ran to read one
+    half-ellipse-like curve with it: what `Reader._natural_fit` chose."""
+    from curve_vae.inference import reader as reader_module
+
+    asked: list[dict] = []
+    real = reader_module.natural_readings_of
+
+    def recording(curves, **kw):
+        asked.append(kw)
+        return real(curves, **kw)
+
+    monkeypatch.setattr(reader_module, "natural_readings_of", recording)
+    t = np.linspace(0, np.pi, 80)
+    curve = np.c_[np.cos(t), 0.6 * np.sin(t) + 0.1 * np.sin(3 * t)] * 20
+    out = []
+    for reading in readings:
+        asked.clear()
+        runtime.reconstruct([curve], reading)
+        out.append(list(asked))
+    return out

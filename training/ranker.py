@@ -15,7 +15,6 @@ the weights as ranker.npz beside the model's graphs, which inference.ranker runs
 
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -25,10 +24,9 @@ import numpy as np
 import torch
 from torch import nn
 
-from curve_vae.files import atomic_path, atomic_write_text
-from curve_vae.inference.manifest import file_sha256
 from curve_vae.inference.ranker import RANKER_KIND, ranker_inputs
 from curve_vae.training.checkpoint import atomic_save
+from curve_vae.training.parts import write_part
 
 #: Channels of the three strided convolutions (kernel 5, stride 2) and the hidden layer of the head.
 CHANNELS = (32, 64, 96)
@@ -265,25 +263,8 @@ def export_ranker(
     ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
     net = RankerNet()
     net.load_state_dict(ck["model"])
-    root = Path(model_dir)
-    path = root / "ranker.npz"
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as fh:
-            # the ignore: numpy's stub, mypy checks **arrays against allow_pickle: bool too
-            np.savez(fh, kind=RANKER_KIND, **net.weights())  # type: ignore[arg-type]
-    manifest_path = root / "manifest.json"
-    manifest = json.loads(manifest_path.read_text())
-    manifest["files"]["ranker.npz"] = {"sha256": file_sha256(path), "bytes": path.stat().st_size}
-    manifest["ranker"] = {
-        "file": "ranker.npz",
-        "kind": RANKER_KIND,
-        **(meta or {}),
-        "held_out": ck.get("ratios"),
-        "trained": ck.get("trained"),
-    }
-    if default:
-        manifest["reading"] = {"pose": "learned", "spacing": "search"}
+    changes: dict[str, Any] = {"reading": {"pose": "learned", "spacing": "search"}} if default else {}
     if version is not None:
-        manifest["version"] = version
-    atomic_write_text(manifest_path, json.dumps(manifest, indent=2) + "\n")
-    return path
+        changes["version"] = version
+    entry = {**(meta or {}), "held_out": ck.get("ratios"), "trained": ck.get("trained")}
+    return write_part(model_dir, "ranker", RANKER_KIND, net.weights(), entry, changes=changes)

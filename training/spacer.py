@@ -14,7 +14,6 @@ spacer.npz beside the model's graphs and names them in the manifest.
 
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -24,13 +23,12 @@ import numpy as np
 import torch
 from torch import nn
 
-from curve_vae.files import atomic_path, atomic_write_text
 from curve_vae.geometry import random_control_points, sample_bspline
 from curve_vae.geometry.frame import arc_fractions
-from curve_vae.inference.manifest import file_sha256
 from curve_vae.inference.spacer import GRID, SPACER_KIND, on_grid, spacer_inputs
 from curve_vae.training.checkpoint import atomic_save
 from curve_vae.training.families import warp
+from curve_vae.training.parts import write_part
 
 #: Channels of the residual blocks; each block's dilation (two sweeps that together see the whole grid).
 CHANNELS = 32
@@ -175,22 +173,6 @@ def export_spacer(
     ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
     net = SpacerNet()
     net.load_state_dict(ck["model"])
-    root = Path(model_dir)
-    path = root / "spacer.npz"
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, kind=SPACER_KIND, **net.weights())  # type: ignore[arg-type]  # as export_ranker's
-    manifest_path = root / "manifest.json"
-    manifest = json.loads(manifest_path.read_text())
-    manifest["files"]["spacer.npz"] = {"sha256": file_sha256(path), "bytes": path.stat().st_size}
-    manifest["spacer"] = {
-        "file": "spacer.npz",
-        "kind": SPACER_KIND,
-        **(meta or {}),
-        "held_out": ck.get("held_out"),
-        "trained": ck.get("trained"),
-    }
-    if version is not None:
-        manifest["version"] = version
-    atomic_write_text(manifest_path, json.dumps(manifest, indent=2) + "\n")
-    return path
+    entry = {**(meta or {}), "held_out": ck.get("held_out"), "trained": ck.get("trained")}
+    changes = {"version": version} if version is not None else {}
+    return write_part(model_dir, "spacer", SPACER_KIND, net.weights(), entry, changes=changes)

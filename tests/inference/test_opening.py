@@ -69,27 +69,25 @@ def test_a_prior_of_another_latent_size_is_refused(model_dir, tmp_path):
         open_model(bad, **OPTIONS)
 
 
-def test_a_ranker_that_is_not_one_names_its_file(model_dir, tmp_path):
-    def ranker(path: Path) -> None:
-        np.savez(path, something=np.zeros(3))
-
-    bad = _replace_file(model_dir, tmp_path / "m", "ranker.npz", ranker)
+@pytest.mark.parametrize(
+    ("part", "kind", "saved", "message"),
+    [
+        pytest.param("ranker", "conv1d-ranker", {"something": np.zeros(3)}, "not a usable reading ranker", id="ranker"),
+        pytest.param(
+            "spacer",
+            "dilated-conv1d-cumsoftmax-v1",
+            {"kind": "dilated-conv1d-cumsoftmax-v1", "inp_w": np.zeros(3)},
+            r"not a usable spacing guesser \(not a spacing guesser: no",
+            id="spacer",
+        ),
+    ],
+)
+def test_a_learned_part_that_is_not_one_names_its_file(model_dir, tmp_path, part, kind, saved, message):
+    bad = _replace_file(model_dir, tmp_path / "m", f"{part}.npz", lambda path: np.savez(path, **saved))
     manifest = json.loads((bad / "manifest.json").read_text())
-    manifest["ranker"] = {"file": "ranker.npz", "kind": "conv1d-ranker"}
+    manifest[part] = {"file": f"{part}.npz", "kind": kind}
     (bad / "manifest.json").write_text(json.dumps(manifest))
-    with pytest.raises(ModelLoadError, match=r"ranker\.npz: not a usable reading ranker"):
-        open_model(bad, **OPTIONS)
-
-
-def test_a_spacing_guesser_that_is_not_one_names_its_file(model_dir, tmp_path):
-    def spacer(path: Path) -> None:
-        np.savez(path, kind="dilated-conv1d-cumsoftmax-v1", inp_w=np.zeros(3))
-
-    bad = _replace_file(model_dir, tmp_path / "m", "spacer.npz", spacer)
-    manifest = json.loads((bad / "manifest.json").read_text())
-    manifest["spacer"] = {"file": "spacer.npz", "kind": "dilated-conv1d-cumsoftmax-v1"}
-    (bad / "manifest.json").write_text(json.dumps(manifest))
-    with pytest.raises(ModelLoadError, match=r"spacer\.npz: not a usable spacing guesser \(not a spacing guesser: no"):
+    with pytest.raises(ModelLoadError, match=rf"{part}\.npz: {message}"):
         open_model(bad, **OPTIONS)
 
 

@@ -26,7 +26,7 @@ from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import Reconstruction
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.schemas import ReconstructRequest
-from tests.helpers import bspline_curves
+from tests.helpers import bspline_curves, natural_fits_asked
 
 # ------------------------------------------------------------------ spacing: natural readings and the search
 
@@ -315,24 +315,13 @@ def test_without_a_spacing_guesser_the_learned_reading_fits_in_fewer_steps_and_t
     """For a model with a ranker and no spacing guesser, pose "learned" with spacing "search" reads each curve's
     natural spacings with LEARNED_NATURAL_STEPS (its ranker keeps the closer of two candidates, and the suite reads as
     close); the search and spacing "natural" keep the fit's own steps (with a guesser: tests/inference/test_spacer)."""
-    asked: list[dict] = []
-    real = reader_module.natural_readings_of
     monkeypatch.setattr(shipped_runtime.reader, "spacer", None)
-
-    def recording(curves, **kw):
-        asked.append(kw)
-        return real(curves, **kw)
-
-    monkeypatch.setattr(reader_module, "natural_readings_of", recording)
-    t = np.linspace(0, np.pi, 80)
-    curve = np.c_[np.cos(t), 0.6 * np.sin(t) + 0.1 * np.sin(3 * t)] * 20
     scout, steps = reader_module.LEARNED_NATURAL_STEPS
-    for reading, expected in (
-        (Reading(pose="learned", spacing="search"), {"scout": scout, "steps": steps}),
-        (Reading(pose="search", spacing="search"), {}),
-        (Reading(pose="learned", spacing="natural"), {}),
-        (Reading(pose="canonical", spacing="natural"), {}),
-    ):
-        asked.clear()
-        shipped_runtime.reconstruct([curve], reading)
-        assert asked == [expected], reading
+    expected = {
+        Reading(pose="learned", spacing="search"): {"scout": scout, "steps": steps},
+        Reading(pose="search", spacing="search"): {},
+        Reading(pose="learned", spacing="natural"): {},
+        Reading(pose="canonical", spacing="natural"): {},
+    }
+    asked = natural_fits_asked(shipped_runtime, monkeypatch, list(expected))
+    assert asked == [[fit] for fit in expected.values()]

@@ -14,6 +14,7 @@ from curve_vae.geometry.bspline import evaluate_bspline
 from curve_vae.inference import reader as reader_module
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.spacer import GRID, SPACER_KIND, Spacer, on_grid, spacer_inputs
+from tests.helpers import natural_fits_asked
 
 
 def random_weights(seed: int = 0, channels: int = 8) -> dict[str, np.ndarray]:
@@ -93,23 +94,12 @@ def test_the_shipped_guesser_puts_the_papers_curves_drawn_by_arc_length_near_the
 def test_the_learned_reading_starts_its_natural_fit_from_the_guess(shipped_runtime, monkeypatch):
     """Pose "learned" with spacing "search" fits natural spacings from the guesser's guesses in GUESSED_NATURAL_STEPS;
     the search and spacing "natural" keep the fit's own starts and steps."""
-    asked: list[dict] = []
-    real = reader_module.natural_readings_of
-
-    def recording(curves, **kw):
-        asked.append(kw)
-        return real(curves, **kw)
-
-    monkeypatch.setattr(reader_module, "natural_readings_of", recording)
-    t = np.linspace(0, np.pi, 80)
-    curve = np.c_[np.cos(t), 0.6 * np.sin(t) + 0.1 * np.sin(3 * t)] * 20
     scout, steps = reader_module.GUESSED_NATURAL_STEPS
     spacer = shipped_runtime.reader.spacer
-    for reading, expected in (
-        (Reading(pose="learned", spacing="search"), {"scout": scout, "steps": steps, "guess": spacer.guesses}),
-        (Reading(pose="search", spacing="search"), {}),
-        (Reading(pose="learned", spacing="natural"), {}),
-    ):
-        asked.clear()
-        shipped_runtime.reconstruct([curve], reading)
-        assert asked == [expected], reading
+    expected = {
+        Reading(pose="learned", spacing="search"): {"scout": scout, "steps": steps, "guess": spacer.guesses},
+        Reading(pose="search", spacing="search"): {},
+        Reading(pose="learned", spacing="natural"): {},
+    }
+    asked = natural_fits_asked(shipped_runtime, monkeypatch, list(expected))
+    assert asked == [[fit] for fit in expected.values()]
