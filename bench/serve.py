@@ -67,8 +67,9 @@ class Server(LiveServer):
 
     def __init__(self, model_dir: Path, *flags: str, env: dict[str, str] | None = None) -> None:
         super().__init__("--model-dir", str(model_dir), "--providers", "cpu", *flags, env=env, cwd=ROOT, capture=False)
+        workers = int(flags[flags.index("--workers") + 1]) if "--workers" in flags else 1
         try:
-            self.wait_ready(timeout=90)
+            self.wait_ready(timeout=90, listeners=workers)  # wrk's connections are shared out as they open
         except BaseException:
             self.stop()
             raise

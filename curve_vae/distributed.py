@@ -38,9 +38,11 @@ class AugmentActor:
         reading: dict[str, Any],
         n_points: int | None,
     ) -> None:
+        from curve_vae.inference.cpus import limit_blas_threads
         from curve_vae.inference.runtime import CurveRuntime
 
         self.runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1, warm_up=False)
+        limit_blas_threads(1)  # one core an actor: numpy's BLAS too (inference/cpus.py)
         self.plan = self.runtime.plan_augment(
             [np.asarray(c, np.float64) for c in seeds],
             seed=seed,

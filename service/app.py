@@ -35,7 +35,7 @@ from starlette.exceptions import HTTPException
 
 from curve_vae.inference.batching import GraphBatcher
 from curve_vae.inference.batching import attach as attach_batcher
-from curve_vae.inference.cpus import available_cpus, inference_slots, session_config
+from curve_vae.inference.cpus import available_cpus, inference_slots, limit_blas_threads, session_config
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.runtime import CurveRuntime
@@ -104,7 +104,7 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
         "on" if config.spinning else "off",
     )
     try:
-        return await anyio.to_thread.run_sync(
+        runtime = await anyio.to_thread.run_sync(
             partial(
                 CurveRuntime.load,
                 settings.model_dir,
@@ -119,6 +119,9 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
     except ModelLoadError as e:
         log.error("cannot serve the model: %s", e)
         raise
+    # numpy's and scipy's BLAS get one inference's threads too (inference/cpus.py), now that both are loaded
+    log.info("BLAS: %d threads an inference", limit_blas_threads(config.intra_op_threads))
+    return runtime
 
 
 def _start_batcher(app: FastAPI, settings: Settings, runtime: CurveRuntime) -> GraphBatcher:

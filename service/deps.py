@@ -14,6 +14,7 @@ from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
 from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable
+from curve_vae.inference.cpus import blas_threads
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.metrics import Metrics
@@ -64,7 +65,12 @@ def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
         if getattr(request.app.state, "batcher", None) is not None
         else None
     )
-    return {**runtime.graphs.pool.applied(), "inference_threads": request.app.state.slots, "micro_batch": batching}
+    return {
+        **runtime.graphs.pool.applied(),
+        "blas_threads": blas_threads(),
+        "inference_threads": request.app.state.slots,
+        "micro_batch": batching,
+    }
 
 
 async def in_executor(request: Request, fn: Callable[..., T], *args: Any, token: CancelToken | None = None) -> T:

@@ -28,6 +28,20 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+def listening_sockets(port: int) -> int:
+    """TCP sockets listening on `port` on this machine, any address (Linux's /proc/net/tcp and tcp6; 0 elsewhere)."""
+    count = 0
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            rows = Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            local, state = row.split()[1], row.split()[3]
+            count += state == "0A" and int(local.rsplit(":", 1)[1], 16) == port  # 0A: LISTEN
+    return count
+
+
 class LiveServer:
     """The service in a subprocess on a free loopback port; `wait_ready` polls GET /ready until it answers 200."""
 
@@ -71,15 +85,17 @@ class LiveServer:
             return ""
         return self.proc.stdout.read()
 
-    def wait_ready(self, timeout: float = 60.0) -> None:
-        """Poll /ready until 200; RuntimeError (with the server's output) if it exits, TimeoutError if it is slow."""
+    def wait_ready(self, timeout: float = 60.0, *, listeners: int = 1) -> None:
+        """Poll /ready until 200 and until `listeners` sockets listen on the port (each worker its own: a client
+        that connects before a worker listens stays with the others); RuntimeError (with the server's output) if it
+        exits, TimeoutError if it is slow."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
                 raise RuntimeError(f"server exited with {self.proc.returncode}: {' '.join(self.cmd)}\n{self.output()}")
             try:
                 with urllib.request.urlopen(f"{self.url}/ready", timeout=1) as r:
-                    if r.status == 200:
+                    if r.status == 200 and listening_sockets(self.port) >= listeners:
                         return
             except OSError:
                 pass

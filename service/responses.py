@@ -195,5 +195,6 @@ class ModelInfo(BaseModel):
     limits: dict[str, int] = Field(description="Request limits of this server.")
     execution: dict[str, Any] = Field(
         description="How this worker runs inference, read back from the live onnxruntime sessions: session pairs, "
-        "intra- and inter-op threads, spinning; and the inference threads (slots) and micro-batching in use."
+        "intra- and inter-op threads, spinning; the threads of numpy's and scipy's BLAS (read back with "
+        "threadpoolctl); and the inference threads (slots) and micro-batching in use."
     )

@@ -140,6 +140,35 @@ class _ServerOptions(TypedDict):
     access_log: bool
 
 
+def _run_workers(settings: Settings, common: _ServerOptions) -> None:
+    """`settings.workers` processes under uvicorn's supervisor (restarts, SIGHUP, TTIN/TTOU), each with a listening
+    socket of its own where the platform shares connections out among them (service.listeners)."""
+    import uvicorn
+    from uvicorn.supervisors import Multiprocess
+
+    from curve_vae.service import listeners
+
+    # Workers are fresh processes: they rebuild the same settings from the environment.
+    os.environ.update(_as_env(settings))
+    app = "curve_vae.service.app:create_app_from_env"
+    if not listeners.balances_connections():
+        uvicorn.run(app, factory=True, workers=settings.workers, **common)
+        return
+    config = uvicorn.Config(app, factory=True, workers=settings.workers, **common)
+    try:
+        listener = listeners.PerWorkerListener(settings.host, settings.port)
+    except OSError as e:
+        listeners.log.error("cannot listen on %s:%d: %s", settings.host, settings.port, e)
+        raise SystemExit(3) from None
+    listeners.announce(settings.host, listener.port)
+    try:
+        Multiprocess(config, sockets=[listener]).run()  # type: ignore[list-item]  # a socket once in a worker
+    except KeyboardInterrupt:
+        pass
+    finally:
+        listener.close()
+
+
 def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
@@ -176,9 +205,7 @@ def run(args: argparse.Namespace) -> int:
             if not server.started:
                 return 3  # the app failed to start (uvicorn's own code for it)
         else:
-            # Workers are fresh processes: they rebuild the same settings from the environment.
-            os.environ.update(_as_env(settings))
-            uvicorn.run("curve_vae.service.app:create_app_from_env", factory=True, workers=settings.workers, **common)
+            _run_workers(settings, common)
     except SystemExit as e:  # uvicorn exits 3 when the app fails to start
         return e.code if isinstance(e.code, int) else 1
     return 0

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
+from threadpoolctl import threadpool_limits
 
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
@@ -27,6 +28,13 @@ from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves
 
 #: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
 SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}
+
+
+@pytest.fixture(autouse=True)
+def blas_threads_restored() -> Iterator[None]:
+    """A started app caps numpy's BLAS threads process-wide (inference/cpus.py); each test gets back what it had."""
+    with threadpool_limits(limits=None, user_api="blas"):
+        yield
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

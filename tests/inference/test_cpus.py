@@ -92,6 +92,7 @@ def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypa
         "intra_op_threads": 2,
         "inter_op_threads": 1,
         "spinning": False,
+        "blas_threads": 2,  # numpy's BLAS as many as onnxruntime
         "inference_threads": 3,
         "micro_batch": None,
     }
@@ -130,3 +131,14 @@ def test_each_inference_thread_keeps_its_own_session_pair(make_client, curves):
     assert answers == [200] * 8
     inference = {name: pair for name, pair in used.items() if name.startswith("inference")}
     assert 1 <= len(inference) <= 2 and len(set(inference.values())) == len(inference)
+
+
+def test_blas_threads_are_capped_and_read_back():
+    import numpy as np  # loads numpy's BLAS
+    from threadpoolctl import threadpool_info
+
+    assert cpus.limit_blas_threads(1) == 1 == cpus.blas_threads()
+    assert all(lib["num_threads"] == 1 for lib in threadpool_info() if lib["user_api"] == "blas")
+    a = np.random.default_rng(0).normal(size=(300, 300))
+    assert np.allclose(a @ np.linalg.inv(a), np.eye(300), atol=1e-8)  # still computes
+    assert cpus.blas_threads([]) == 0  # none loaded

@@ -44,6 +44,13 @@ def test_endpoints_over_a_socket(live_server, curves):
             assert after.get(key, 0) - before.get(key, 0) == 1, key
 
 
+def test_numpys_blas_runs_one_inferences_threads(live_server):
+    """The reading's small matrix products (ranker, spacing guesser, fit) run on numpy's BLAS, which starts a thread
+    per core of its own: the server holds it to the threads of one inference, read back from the live process."""
+    execution = httpx.get(f"{live_server.url}/model", timeout=30).json()["execution"]
+    assert execution["blas_threads"] == execution["intra_op_threads"] >= 1
+
+
 def _counts(metrics: str) -> dict[str, float]:
     """curve_vae_http_requests_total by its labels, from a Prometheus text page."""
     out = {}
@@ -71,6 +78,29 @@ def test_two_workers(server_factory, model_dir):
     server.wait_ready(timeout=60)
     r = httpx.post(f"{server.url}/encode", json={"curves": [C] * 4}, timeout=30)
     assert r.status_code == 422 and "at most 3 curves" in r.json()["detail"]
+    assert server.stop() == 0
+
+
+def test_two_workers_share_the_connections_out(server_factory, model_dir, curves):
+    """Each worker listens on a socket of its own (service.listeners): keep-alive clients that open their
+    connections at once land on both workers, not all on the first to accept (uvicorn's one shared socket)."""
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
+    server.wait_ready(timeout=90, listeners=2)
+    before = server.cpu_seconds()
+    body = {"curves": curves(32, 161).tolist()}
+    start = threading.Barrier(32)
+
+    def client(_: int) -> list[int]:
+        with httpx.Client(base_url=server.url, timeout=60) as http:
+            start.wait()  # 32 connections opened together, then kept alive
+            return [http.post("/reconstruct", json=body).status_code for _ in range(3)]
+
+    with cf.ThreadPoolExecutor(32) as pool:
+        assert all(code == 200 for codes in pool.map(client, range(32)) for code in codes)
+    used = sorted(t - before.get(pid, 0.0) for pid, t in server.cpu_seconds().items())
+    # the two workers are the two busiest processes (the supervisor and multiprocessing's tracker are idle); with
+    # 32 connections hashed to 2 sockets, one worker getting 85% of the work has odds under 1 in 10,000
+    assert used[-2] >= 0.15 * (used[-1] + used[-2]), used
     assert server.stop() == 0
 
 
