@@ -102,6 +102,7 @@ def wrk(server: Server, path: str, body: bytes, content_type: str, *, connection
     # CPU seconds of everything else on the machine during the run: other people's jobs show here
     result["other_cpu_s"] = max(0.0, busy - sum(cpu.values()) - wrk_cpu)
     result["cpu_s_by_process"] = {str(pid): round(s, 2) for pid, s in cpu.items()}
+    result["server_rss_mib"] = server.rss_mib()  # resident memory of all its processes, after the run
     if result["errors"] or result["non_2xx"]:
         print(f"  ! {path}: {result['errors']} socket errors, {result['non_2xx']} non-2xx answers", file=sys.stderr)
     return result
@@ -194,7 +195,7 @@ def machine() -> dict[str, Any]:
 VARIANTS = {  # run as B (the default request), each against a server started with these flags, no cache
     "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
     "access_log": (["--access-log", "true"], "B with the access log on"),
-    "workers": (["--workers", "2", "--inference-concurrency", "1"], "B over 2 worker processes"),
+    "workers": (["--workers", "2"], "B (and A, where asked) over 2 worker processes, each its own defaults"),
     "one_thread": (["--inference-concurrency", "1"], "B with one inference thread"),
     "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
     "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),
@@ -302,6 +303,9 @@ def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: se
         if name in runs:
             server = Server(model_dir, *flags, env=NO_CACHE)
             try:
+                if name == "workers" and "A" in runs:  # large requests on 2 connections: hashed to the workers
+                    r = load("A_workers", server, "/reconstruct", json_body(_callers(128, seed=2)), c=2, at_least=60.0)
+                    r["curves_per_s"] = r["rps"] * 128
                 load(name, server, "/reconstruct", single)
                 if name in ONE_PASS_VARIANTS and "one_pass" in runs:  # does sharing graph runs, or a second
                     # process (no GIL between the event loop and the inference threads), help a one-pass request?
@@ -321,7 +325,19 @@ def _ceiling_again(report: dict[str, Any], model_dir: Path, secs: float) -> None
         inproc[key] = max(inproc[key], again[key])
     inproc["ceiling"] = top = max(inproc["ceiling"], again["ceiling"])
     for name, x in report.items():
-        if name in ("A", "A_fast", "A_one", "B", "B_fast", "B_one", "B_npy", "B_cached", *VARIANTS, *ONE_PASS_NAMES):
+        if name in (
+            "A",
+            "A_fast",
+            "A_one",
+            "A_workers",
+            "B",
+            "B_fast",
+            "B_one",
+            "B_npy",
+            "B_cached",
+            *VARIANTS,
+            *ONE_PASS_NAMES,
+        ):
             x["ratio"] = x.get("curves_per_s", x["rps"]) / top
 
 

@@ -53,13 +53,21 @@ def available_cpus(root: Path = CGROUP) -> int:
     return max(1, cpus)
 
 
+#: The fewest inferences a worker runs at once by default. The default reading holds the GIL for most of a request
+#: but not in onnxruntime, so a second inference keeps the worker's core busy while the first runs its graphs, and a
+#: large request does not hold up a small one. With `--workers 2` on 2 cores, two each against one each: 156 against
+#: 83 curves/s for 128-curve default requests on 2 connections (both of which the kernel gave one worker), 101
+#: against 109 requests/s for single curves on 16 (docs/BENCHMARKS.md, service 0.18.0).
+MIN_SLOTS = 2
+
+
 def inference_slots(settings: Any, cpus: int | None = None) -> int:
     """Inferences one worker runs at once: `settings.inference_concurrency` where set; for 0, the CPUs shared
-    out among the workers (at least 1), so that 1-thread sessions fill the machine."""
+    out among the workers, at least MIN_SLOTS."""
     if settings.inference_concurrency:
         return int(settings.inference_concurrency)
     cpus = available_cpus() if cpus is None else cpus
-    return max(1, cpus // settings.workers)
+    return max(MIN_SLOTS, cpus // settings.workers)
 
 
 def threads_per_inference(settings: Any, cpus: int | None = None) -> int:

@@ -49,7 +49,7 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0: the CPU quota shared out"),
     ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),
     ("--spinning", "spinning", str, "true: onnxruntime threads spin-wait between runs"),
-    ("--inference-concurrency", "inference_concurrency", int, "inferences running at once; 0: one per CPU of a worker"),
+    ("--inference-concurrency", "inference_concurrency", int, "inferences running at once; 0: one per CPU of a worker, at least 2"),
     ("--sessions", "sessions", int, "onnxruntime session pairs per worker; 0: one per inference running at once"),
     ("--micro-batch", "micro_batch", str, "true: gather concurrent requests' graph runs into one run"),
     ("--micro-batch-rows", "micro_batch_rows", int, "most rows (curves, latents) of one micro-batched run"),

@@ -31,12 +31,12 @@ class Settings(BaseSettings):
     model_dir: Path = SHIPPED
     providers: Providers = "auto"  # "cuda" fails at startup where CUDA cannot load; "auto" falls back to CPU
     # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among
-    # workers × inference_concurrency (inference/cpus.py), so a container never runs more threads than its quota
+    # workers × inference_concurrency (inference/cpus.py): no run spreads over more cores than a container's quota
     intra_op_threads: int = Field(default=0, ge=0)
     # onnxruntime's inter-op pool; the graphs run sequentially; 0: its default
     inter_op_threads: int = Field(default=1, ge=0)
     spinning: bool = False  # onnxruntime threads spin-wait between runs: CPU stolen from the other inferences
-    # inferences running at once = threads of the inference executor; 0: one per CPU of this worker (cpus ÷ workers)
+    # inferences running at once = threads of the inference executor; 0: cpus ÷ workers, at least 2 (inference/cpus.py)
     inference_concurrency: int = Field(default=0, ge=0)
     # encoder/decoder session pairs per worker; 0: one per inference running at once
     sessions: int = Field(default=0, ge=0)

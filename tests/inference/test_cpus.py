@@ -66,9 +66,10 @@ def test_an_explicit_thread_count_wins():
 
 
 @pytest.mark.parametrize(
-    ("cpus_", "workers", "concurrency", "slots"), [(2, 1, 0, 2), (8, 2, 0, 4), (3, 4, 0, 1), (2, 1, 5, 5)]
+    ("cpus_", "workers", "concurrency", "slots"),
+    [(2, 1, 0, 2), (8, 2, 0, 4), (2, 2, 0, 2), (3, 4, 0, 2), (1, 1, 0, 2), (2, 1, 5, 5), (2, 2, 1, 1)],
 )
-def test_inference_slots_default_to_one_per_cpu_of_a_worker(cpus_, workers, concurrency, slots):
+def test_inference_slots_default_to_one_per_cpu_of_a_worker_and_at_least_two(cpus_, workers, concurrency, slots):
     settings = Settings.model_construct(workers=workers, inference_concurrency=concurrency)
     assert cpus.inference_slots(settings, cpus_) == slots
 
