@@ -89,6 +89,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
             batcher.close()
         if owned:
             app.state.runtime = None
+        app.state.metrics.worker_exit()
 
 
 async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:

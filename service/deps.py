@@ -17,7 +17,7 @@ from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable
 from curve_vae.inference.cpus import blas_threads
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.service.metrics import Metrics
+from curve_vae.service.metrics import Metrics, multiprocess_mode
 from curve_vae.service.settings import Settings
 
 T = TypeVar("T")
@@ -140,3 +140,5 @@ async def run_inference(request: Request, route: str, batch: int, work: Callable
         watcher.cancel()
         state.pending -= 1
         metrics.inference.labels(route).observe(time.perf_counter() - start)
+        if multiprocess_mode():  # a scrape may reach another worker: this one's gauges must be current
+            metrics.mirror(state.runtime)

@@ -1,16 +1,39 @@
 """Prometheus metrics of one app: request counts by route and status, latencies, batch sizes.
 
-Each app owns a CollectorRegistry, so several apps (tests, one per worker) never share or
-collide. With `--workers N` every worker answers /metrics with its own counts.
+Each app owns a CollectorRegistry, so several apps in one process (tests) never share or collide. With
+`--workers N` the server gives the workers one PROMETHEUS_MULTIPROC_DIR (service.server), prometheus-client keeps
+every worker's values in files there, and whichever worker a scrape reaches answers for all of them: counts and
+histograms summed, the gauges summed over the live workers (`curve_vae_ready`: their least, so 1 only when every
+worker is ready). The gauges that mirror the runtime (graph rows, the cache) are set after every inference, so a
+worker that is not scraped still reports its own.
 """
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Iterable
+from typing import Any
 
-from prometheus_client import CONTENT_TYPE_LATEST, CollectorRegistry, Counter, Gauge, Histogram, generate_latest
+from prometheus_client import (
+    CONTENT_TYPE_LATEST,
+    CollectorRegistry,
+    Counter,
+    Gauge,
+    Histogram,
+    generate_latest,
+    multiprocess,
+)
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+#: Where prometheus-client keeps the workers' values; set in the environment, it is on for the whole process.
+MULTIPROC_DIR = "PROMETHEUS_MULTIPROC_DIR"
+
+
+def multiprocess_mode() -> bool:
+    """Whether this process writes its metrics for a scrape of any worker to collect (`--workers` N > 1)."""
+    return bool(os.environ.get(MULTIPROC_DIR))
+
 
 LATENCY_BUCKETS = (0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0)
 BATCH_BUCKETS = (1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 4096)
@@ -55,19 +78,48 @@ class Metrics:
             ["route"],
             registry=self.registry,
         )
+        total: Any = {"registry": self.registry, "multiprocess_mode": "livesum"}  # over the live workers
         self.graph_rows = Gauge(
             "curve_vae_graph_rows",
             "Rows (curves or latents) each ONNX graph has run since the start: what the requests cost.",
             ["graph"],
-            registry=self.registry,
+            **total,
         )
-        self.cache_hits = Gauge("curve_vae_cache_hits", "Curves read from the encoding cache.", registry=self.registry)
-        self.cache_misses = Gauge("curve_vae_cache_misses", "Curves read afresh.", registry=self.registry)
-        self.cache_bytes = Gauge("curve_vae_cache_bytes", "Bytes the encoding cache holds.", registry=self.registry)
-        self.ready = Gauge("curve_vae_ready", "1 once the model is loaded and warmed up.", registry=self.registry)
+        self.cache_hits = Gauge("curve_vae_cache_hits", "Curves read from the encoding cache.", **total)
+        self.cache_misses = Gauge("curve_vae_cache_misses", "Curves read afresh.", **total)
+        self.cache_bytes = Gauge("curve_vae_cache_bytes", "Bytes the encoding cache holds.", **total)
+        self.ready = Gauge(
+            "curve_vae_ready",
+            "1 once the model is loaded and warmed up (every worker's).",
+            registry=self.registry,
+            multiprocess_mode="livemin",
+        )
+
+    def mirror(self, runtime: Any) -> None:
+        """Set the gauges that mirror the runtime: each graph's rows run, the encoding cache's hits, misses, bytes."""
+        if runtime is None:
+            return
+        for graph, rows in runtime.graphs.rows.items():
+            self.graph_rows.labels(graph).set(rows)
+        if runtime.cache is not None:
+            stats = runtime.cache.stats()
+            self.cache_hits.set(stats["hits"])
+            self.cache_misses.set(stats["misses"])
+            self.cache_bytes.set(stats["bytes"])
 
     def render(self) -> tuple[bytes, str]:
-        return generate_latest(self.registry), CONTENT_TYPE_LATEST
+        """The Prometheus text: this app's registry, or with workers, every worker's values."""
+        if not multiprocess_mode():
+            return generate_latest(self.registry), CONTENT_TYPE_LATEST
+        everyone = CollectorRegistry()
+        multiprocess.MultiProcessCollector(everyone)
+        return generate_latest(everyone), CONTENT_TYPE_LATEST
+
+    @staticmethod
+    def worker_exit() -> None:
+        """A worker stopping: its live gauges leave the sums (its counts stay in the totals)."""
+        if multiprocess_mode():
+            multiprocess.mark_process_dead(os.getpid())
 
 
 class MetricsMiddleware:

@@ -8,10 +8,14 @@ Every option falls back to its CURVE_VAE_* environment variable, then to the def
 from __future__ import annotations
 
 import argparse
+import contextlib
 import copy
 import json
 import os
+import shutil
 import sys
+import tempfile
+from collections.abc import Iterator
 from typing import Any, TypedDict
 
 from pydantic import ValidationError
@@ -49,7 +53,12 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0: the CPU quota shared out"),
     ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),
     ("--spinning", "spinning", str, "true: onnxruntime threads spin-wait between runs"),
-    ("--inference-concurrency", "inference_concurrency", int, "inferences running at once; 0: one per CPU of a worker, at least 2"),
+    (
+        "--inference-concurrency",
+        "inference_concurrency",
+        int,
+        "inferences at once; 0: one per CPU of a worker, at least 2",
+    ),
     ("--sessions", "sessions", int, "onnxruntime session pairs per worker; 0: one per inference running at once"),
     ("--micro-batch", "micro_batch", str, "true: gather concurrent requests' graph runs into one run"),
     ("--micro-batch-rows", "micro_batch_rows", int, "most rows (curves, latents) of one micro-batched run"),
@@ -112,8 +121,6 @@ def _log_config(level: str) -> dict[str, Any]:
 
 
 def _graceful_server_class() -> type:
-    import contextlib
-
     import uvicorn
 
     class GracefulServer(uvicorn.Server):
@@ -144,29 +151,53 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
     """`settings.workers` processes under uvicorn's supervisor (restarts, SIGHUP, TTIN/TTOU), each with a listening
     socket of its own where the platform shares connections out among them (service.listeners)."""
     import uvicorn
+    from uvicorn.config import STARTUP_FAILURE
     from uvicorn.supervisors import Multiprocess
 
     from curve_vae.service import listeners
 
     # Workers are fresh processes: they rebuild the same settings from the environment.
     os.environ.update(_as_env(settings))
-    app = "curve_vae.service.app:create_app_from_env"
-    if not listeners.balances_connections():
-        uvicorn.run(app, factory=True, workers=settings.workers, **common)
+    with _shared_metrics():
+        app = "curve_vae.service.app:create_app_from_env"
+        if not listeners.balances_connections():
+            uvicorn.run(app, factory=True, workers=settings.workers, **common)
+            return
+        config = uvicorn.Config(app, factory=True, workers=settings.workers, **common)
+        try:
+            listener = listeners.PerWorkerListener(settings.host, settings.port)
+        except OSError as e:
+            listeners.log.error("cannot listen on %s:%d: %s", settings.host, settings.port, e)
+            raise SystemExit(3) from None
+        listeners.announce(settings.host, listener.port)
+        supervisor = Multiprocess(config, sockets=[listener])  # type: ignore[list-item]  # a socket in a worker
+        try:
+            supervisor.run()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            listener.close()
+        if any(p.exitcode == STARTUP_FAILURE for p in supervisor.processes):
+            raise SystemExit(STARTUP_FAILURE)  # uvicorn's supervisor stops, but would exit 0
+
+
+@contextlib.contextmanager
+def _shared_metrics() -> Iterator[None]:
+    """A fresh directory where the workers keep their Prometheus values, so that a scrape of any one of them
+    answers for all (service.metrics); removed when the server stops. One set in the environment is used as it is
+    (the operator's, who then empties it between runs, as prometheus-client asks)."""
+    from curve_vae.service.metrics import MULTIPROC_DIR
+
+    if os.environ.get(MULTIPROC_DIR):
+        yield
         return
-    config = uvicorn.Config(app, factory=True, workers=settings.workers, **common)
+    path = tempfile.mkdtemp(prefix="curve-vae-metrics-")
+    os.environ[MULTIPROC_DIR] = path
     try:
-        listener = listeners.PerWorkerListener(settings.host, settings.port)
-    except OSError as e:
-        listeners.log.error("cannot listen on %s:%d: %s", settings.host, settings.port, e)
-        raise SystemExit(3) from None
-    listeners.announce(settings.host, listener.port)
-    try:
-        Multiprocess(config, sockets=[listener]).run()  # type: ignore[list-item]  # a socket once in a worker
-    except KeyboardInterrupt:
-        pass
+        yield
     finally:
-        listener.close()
+        os.environ.pop(MULTIPROC_DIR, None)
+        shutil.rmtree(path, ignore_errors=True)
 
 
 def run(args: argparse.Namespace) -> int:

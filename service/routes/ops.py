@@ -114,14 +114,6 @@ async def metrics(request: Request) -> Response:
     if not request.app.state.settings.metrics:
         raise HTTPException(404, "metrics are off on this server (CURVE_VAE_METRICS=false)")
     metrics = request.app.state.metrics
-    runtime = request.app.state.runtime
-    if runtime is not None:
-        for graph, rows in runtime.graphs.rows.items():
-            metrics.graph_rows.labels(graph).set(rows)
-    if runtime is not None and runtime.cache is not None:
-        stats = runtime.cache.stats()
-        metrics.cache_hits.set(stats["hits"])
-        metrics.cache_misses.set(stats["misses"])
-        metrics.cache_bytes.set(stats["bytes"])
+    metrics.mirror(request.app.state.runtime)
     body, content_type = metrics.render()
     return Response(body, media_type=content_type)

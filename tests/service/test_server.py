@@ -8,6 +8,7 @@ import json
 import shutil
 import signal
 import subprocess
+import tempfile
 import threading
 from pathlib import Path
 
@@ -104,6 +105,49 @@ def test_two_workers_share_the_connections_out(server_factory, model_dir, curves
     assert server.stop() == 0
 
 
+def test_with_workers_a_scrape_of_any_worker_counts_them_all(server_factory, model_dir):
+    """prometheus-client's multiprocess mode: requests answered by either worker show in /metrics wherever the
+    scrape lands, the gauges summed over the live workers; the shared directory goes when the server stops."""
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
+    server.wait_ready(timeout=90, listeners=2)
+    start = threading.Barrier(24)
+
+    def client(_: int) -> int:
+        with httpx.Client(base_url=server.url, timeout=60) as http:
+            start.wait()  # 24 connections at once: both workers answer some (see the test above)
+            return http.post("/encode", json={"curves": [C]}).status_code
+
+    with cf.ThreadPoolExecutor(24) as pool:
+        assert list(pool.map(client, range(24))) == [200] * 24
+    key = 'method="POST",route="/encode",status="200"'
+    for _ in range(4):  # fresh connections: scrapes that reach either worker read the same totals
+        page = httpx.get(f"{server.url}/metrics", timeout=30).text
+        assert _counts(page)[key] == 24
+        rows = _gauge(page, 'curve_vae_graph_rows{graph="encoder"}')
+        assert rows >= 24  # both workers' rows (each also ran its warm-up), summed
+        assert _gauge(page, "curve_vae_ready") == 1.0
+    pids = server.pids()
+    mine = [str(d) for d in Path(tempfile.gettempdir()).glob("curve-vae-metrics-*") if _used_by(str(d), pids)]
+    assert server.stop() == 0
+    assert mine and not any(Path(d).exists() for d in mine)  # removed at exit
+
+
+def _gauge(metrics: str, name: str) -> float:
+    line = next(ln for ln in metrics.splitlines() if ln.startswith(name + " "))
+    return float(line.rsplit(" ", 1)[1])
+
+
+def _used_by(directory: str, pids: list[int]) -> bool:
+    """Whether one of `pids` has a file of `directory` open or mapped (prometheus-client's .db files are mmapped)."""
+    for pid in pids:
+        try:
+            if directory in Path(f"/proc/{pid}/maps").read_text():
+                return True
+        except OSError:
+            continue
+    return False
+
+
 def test_sigterm_shuts_down_cleanly(server_factory, model_dir):
     server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--log-level", "info")
     server.wait_ready()
@@ -114,13 +158,14 @@ def test_sigterm_shuts_down_cleanly(server_factory, model_dir):
     assert "Application shutdown complete" in log and "Traceback" not in log
 
 
-def test_a_model_that_fails_at_startup_stops_the_server(server_factory, model_dir, tmp_path):
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_a_model_that_fails_at_startup_stops_the_server(server_factory, model_dir, tmp_path, workers):
     broken = tmp_path / "model"
     shutil.copytree(model_dir, broken)
     manifest = json.loads((broken / "manifest.json").read_text())
     manifest["latent_dim"] = 16  # checksums still match; the graphs do not
     (broken / "manifest.json").write_text(json.dumps(manifest))
-    server = server_factory("--model-dir", str(broken), "--providers", "cpu")
+    server = server_factory("--model-dir", str(broken), "--providers", "cpu", "--workers", workers)
     assert server.proc.wait(timeout=60) == 3
     assert "graphs do not match the manifest" in server.proc.stdout.read()  # type: ignore[union-attr]
 
