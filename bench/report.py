@@ -25,13 +25,13 @@ ROW_LABELS = {
     "interpolate": "/interpolate, pair, 5 steps, the default request, 16 connections",
     "spinning": "B, spinning on (`--spinning true`)",
     "access_log": "B, access log on (`--access-log true`)",
-    "A_workers": "A, `--workers 2` (2 inferences each)",
-    "workers": "B, `--workers 2` (2 inferences each)",
+    "A_one_worker": "A, one worker (`--workers 1`)",
+    "one_worker": "B, one worker (`--workers 1`)",
     "one_thread": "B, one inference thread (`--inference-concurrency 1`)",
     "one_session": "B, one session pair for both threads (`--sessions 1`)",
     "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
     "micro_batch_one": "B, one pass, micro-batching on",
-    "workers_one": "B, one pass, `--workers 2` (2 inferences each)",
+    "one_worker_one": "B, one pass, one worker (`--workers 1`)",
 }
 
 
@@ -70,12 +70,12 @@ def _table(r: dict[str, Any]) -> list[str]:
         "B_cached",
         "spinning",
         "access_log",
-        "workers",
+        "one_worker",
         "one_thread",
         "one_session",
         "micro_batch",
         "micro_batch_one",
-        "workers_one",
+        "one_worker_one",
     )
     for key, label in ROW_LABELS.items():
         if key not in r:
@@ -93,20 +93,16 @@ def _table(r: dict[str, Any]) -> list[str]:
 def _notes(r: dict[str, Any]) -> list[str]:
     """The workers' CPU spread and /augment's times, where those runs were made."""
     lines: list[str] = []
-    for key in ("A_workers", "workers"):
+    for key in ("A", "B", "A_one_worker", "one_worker"):
         if key in r:
-            spread = ", ".join(f"{s:.1f}" for s in sorted(r[key]["cpu_s_by_process"].values(), reverse=True))
-            run = "A" if key == "A_workers" else "B"
-            lines += [
-                "",
-                f"`--workers 2`, {run}: CPU seconds per server process during the run (supervisor included): {spread}.",
-            ]
-    for key, name in (("B", "one worker"), ("workers", "`--workers 2`")):
-        if "server_rss_mib" in r.get(key, {}):
-            lines += [
-                "",
-                f"Resident memory, {name}, all its processes after the run: {r[key]['server_rss_mib']:.0f} MiB.",
-            ]
+            x = r[key]
+            spread = ", ".join(f"{s:.1f}" for s in sorted(x["cpu_s_by_process"].values(), reverse=True))
+            memory = (
+                f"; resident memory after it, all of them: {x['server_rss_mib']:.0f} MiB"
+                if "server_rss_mib" in x
+                else ""
+            )
+            lines += ["", f"Run {key}: CPU seconds per server process (supervisor included): {spread}{memory}."]
     if "augment" in r:
         g = r["augment"]
         lines += [

@@ -36,6 +36,7 @@ import numpy as np
 
 from bench import ceiling
 from bench.report import markdown
+from curve_vae.inference.cpus import available_cpus
 from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -50,7 +51,7 @@ RUNS = (
     "augment",
     "spinning",
     "access_log",
-    "workers",
+    "one_worker",
     "one_thread",
     "one_session",
     "micro_batch",
@@ -67,7 +68,8 @@ class Server(LiveServer):
 
     def __init__(self, model_dir: Path, *flags: str, env: dict[str, str] | None = None) -> None:
         super().__init__("--model-dir", str(model_dir), "--providers", "cpu", *flags, env=env, cwd=ROOT, capture=False)
-        workers = int(flags[flags.index("--workers") + 1]) if "--workers" in flags else 1
+        workers = int(flags[flags.index("--workers") + 1]) if "--workers" in flags else 0
+        workers = workers or available_cpus()  # the service's default: one per CPU
         try:
             self.wait_ready(timeout=90, listeners=workers)  # wrk's connections are shared out as they open
         except BaseException:
@@ -195,7 +197,7 @@ def machine() -> dict[str, Any]:
 VARIANTS = {  # run as B (the default request), each against a server started with these flags, no cache
     "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
     "access_log": (["--access-log", "true"], "B with the access log on"),
-    "workers": (["--workers", "2"], "B (and A, where asked) over 2 worker processes, each its own defaults"),
+    "one_worker": (["--workers", "1"], "B (and A, where asked) in one worker process, as before service 0.18.0"),
     "one_thread": (["--inference-concurrency", "1"], "B with one inference thread"),
     "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
     "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),
@@ -292,7 +294,7 @@ def _default_server_runs(
             cached.stop()
 
 
-ONE_PASS_VARIANTS = ("micro_batch", "workers")  # variants also run with one-pass bodies when one_pass is asked for
+ONE_PASS_VARIANTS = ("micro_batch", "one_worker")  # variants also run with one-pass bodies when one_pass is asked for
 ONE_PASS_NAMES = tuple(f"{v}_one" for v in ONE_PASS_VARIANTS)
 
 
@@ -303,12 +305,14 @@ def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: se
         if name in runs:
             server = Server(model_dir, *flags, env=NO_CACHE)
             try:
-                if name == "workers" and "A" in runs:  # large requests on 2 connections: hashed to the workers
-                    r = load("A_workers", server, "/reconstruct", json_body(_callers(128, seed=2)), c=2, at_least=60.0)
+                if name == "one_worker" and "A" in runs:
+                    r = load(
+                        "A_one_worker", server, "/reconstruct", json_body(_callers(128, seed=2)), c=2, at_least=60.0
+                    )
                     r["curves_per_s"] = r["rps"] * 128
                 load(name, server, "/reconstruct", single)
-                if name in ONE_PASS_VARIANTS and "one_pass" in runs:  # does sharing graph runs, or a second
-                    # process (no GIL between the event loop and the inference threads), help a one-pass request?
+                if name in ONE_PASS_VARIANTS and "one_pass" in runs:  # does sharing graph runs, or one process
+                    # (one GIL for the event loop and the inference threads), help or hinder a one-pass request?
                     load(f"{name}_one", server, "/reconstruct", json_body(_callers(1, seed=1), **ONE_PASS))
             finally:
                 server.stop()
@@ -329,7 +333,7 @@ def _ceiling_again(report: dict[str, Any], model_dir: Path, secs: float) -> None
             "A",
             "A_fast",
             "A_one",
-            "A_workers",
+            "A_one_worker",
             "B",
             "B_fast",
             "B_one",

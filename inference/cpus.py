@@ -61,13 +61,21 @@ def available_cpus(root: Path = CGROUP) -> int:
 MIN_SLOTS = 2
 
 
+def worker_count(settings: Any, cpus: int | None = None) -> int:
+    """Worker processes: `settings.workers` where set; for 0, one per CPU this process may use. The default reading
+    holds the GIL for most of a request, so one process uses little more than one core (docs/DEPLOYMENT.md)."""
+    if settings.workers:
+        return int(settings.workers)
+    return available_cpus() if cpus is None else cpus
+
+
 def inference_slots(settings: Any, cpus: int | None = None) -> int:
     """Inferences one worker runs at once: `settings.inference_concurrency` where set; for 0, the CPUs shared
     out among the workers, at least MIN_SLOTS."""
     if settings.inference_concurrency:
         return int(settings.inference_concurrency)
     cpus = available_cpus() if cpus is None else cpus
-    return max(MIN_SLOTS, cpus // settings.workers)
+    return max(MIN_SLOTS, cpus // worker_count(settings, cpus))
 
 
 def threads_per_inference(settings: Any, cpus: int | None = None) -> int:
@@ -76,7 +84,7 @@ def threads_per_inference(settings: Any, cpus: int | None = None) -> int:
     if settings.intra_op_threads:
         return int(settings.intra_op_threads)
     cpus = available_cpus() if cpus is None else cpus
-    return max(1, cpus // (settings.workers * inference_slots(settings, cpus)))
+    return max(1, cpus // (worker_count(settings, cpus) * inference_slots(settings, cpus)))
 
 
 def limit_blas_threads(threads: int) -> int:

@@ -35,7 +35,13 @@ from starlette.exceptions import HTTPException
 
 from curve_vae.inference.batching import GraphBatcher
 from curve_vae.inference.batching import attach as attach_batcher
-from curve_vae.inference.cpus import available_cpus, inference_slots, limit_blas_threads, session_config
+from curve_vae.inference.cpus import (
+    available_cpus,
+    inference_slots,
+    limit_blas_threads,
+    session_config,
+    worker_count,
+)
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.runtime import CurveRuntime
@@ -101,7 +107,7 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
         config.intra_op_threads,
         "CURVE_VAE_INTRA_OP_THREADS" if settings.intra_op_threads else f"{available_cpus()} CPUs shared out",
         slots,
-        "CURVE_VAE_INFERENCE_CONCURRENCY" if settings.inference_concurrency else f"{settings.workers} workers",
+        "CURVE_VAE_INFERENCE_CONCURRENCY" if settings.inference_concurrency else f"{worker_count(settings)} workers",
         "on" if config.spinning else "off",
     )
     try:

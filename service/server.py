@@ -34,7 +34,7 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
         "directory with encoder.onnx, decoder.onnx and manifest.json, or a shipped model's name: default, paper",
     ),
     ("--providers", "providers", str, "onnxruntime providers: cpu, cuda (an error where CUDA cannot load) or auto"),
-    ("--workers", "workers", int, "worker processes, each loading its own ONNX sessions"),
+    ("--workers", "workers", int, "worker processes, each loading its own ONNX sessions; 0: one per CPU"),
     ("--log-level", "log_level", str, "uvicorn and service log level"),
     ("--cors-origins", "cors_origins", str, "comma-separated origins allowed to call from a browser; empty: CORS off"),
     ("--max-curves", "max_curves", int, "most curves, latents or interpolants per request"),
@@ -204,6 +204,7 @@ def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
 
+    from curve_vae.inference.cpus import worker_count
     from curve_vae.inference.manifest import Manifest, ModelLoadError
     from curve_vae.inference.sessions import resolve_providers
 
@@ -227,7 +228,8 @@ def run(args: argparse.Namespace) -> int:
         access_log=settings.access_log,
     )
     try:
-        if settings.workers == 1:
+        workers = worker_count(settings)
+        if workers == 1:
             from curve_vae.service.app import create_app
 
             config = uvicorn.Config(create_app(settings), **common)
@@ -235,8 +237,8 @@ def run(args: argparse.Namespace) -> int:
             server.run()
             if not server.started:
                 return 3  # the app failed to start (uvicorn's own code for it)
-        else:
-            _run_workers(settings, common)
+        else:  # the workers rebuild the settings from the environment: the count they are, not 0
+            _run_workers(settings.model_copy(update={"workers": workers}), common)
     except SystemExit as e:  # uvicorn exits 3 when the app fails to start
         return e.code if isinstance(e.code, int) else 1
     return 0

@@ -25,7 +25,8 @@ class Settings(BaseSettings):
 
     host: str = "127.0.0.1"  # loopback by default; "0.0.0.0" to listen on every interface
     port: int = Field(default=8000, ge=0, le=65535)  # 0 picks a free port
-    workers: int = Field(default=1, ge=1)  # uvicorn worker processes, each with its own ONNX sessions
+    # uvicorn worker processes, each with its own ONNX sessions; 0: one per CPU this process may use (inference/cpus.py)
+    workers: int = Field(default=0, ge=0)
     log_level: Literal["critical", "error", "warning", "info", "debug", "trace"] = "info"
     # encoder.onnx, decoder.onnx and manifest.json; or a shipped model's name: "default", "paper" (inference/shipped.py)
     model_dir: Path = SHIPPED

@@ -60,6 +60,13 @@ def test_threads_per_inference_share_the_cpus_out(cpus_, workers, concurrency, t
     assert workers * concurrency * threads <= max(cpus_, workers * concurrency)  # never more threads than CPUs
 
 
+@pytest.mark.parametrize(("cpus_", "workers", "count"), [(2, 0, 2), (8, 0, 8), (1, 0, 1), (8, 3, 3)])
+def test_workers_default_to_one_per_cpu(cpus_, workers, count):
+    settings = Settings.model_construct(workers=workers, inference_concurrency=0, intra_op_threads=0)
+    assert cpus.worker_count(settings, cpus_) == count
+    assert cpus.threads_per_inference(settings, cpus_) == max(1, cpus_ // (count * max(2, cpus_ // count)))
+
+
 def test_an_explicit_thread_count_wins():
     settings = Settings.model_construct(intra_op_threads=3, workers=4, inference_concurrency=2)
     assert cpus.threads_per_inference(settings, 2) == 3
@@ -76,7 +83,7 @@ def test_inference_slots_default_to_one_per_cpu_of_a_worker_and_at_least_two(cpu
 
 def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypatch):
     monkeypatch.setattr("curve_vae.inference.cpus.available_cpus", lambda root=None: 6)
-    client = make_client(share_runtime=False, providers="cpu", inference_concurrency=3)
+    client = make_client(share_runtime=False, providers="cpu", workers=1, inference_concurrency=3)
     assert client.get("/ready").status_code == 200
     runtime = client.app.state.runtime
     assert len(runtime.graphs.pool.pairs) == 3  # one session pair per inference at once

@@ -63,7 +63,7 @@ def test_a_shipped_models_name_is_its_directory(name):
     [
         pytest.param("port", 65536, id="port-over-65535"),
         pytest.param("port", -1, id="port-negative"),
-        pytest.param("workers", 0, id="no-workers"),
+        pytest.param("workers", -1, id="workers-negative"),
         pytest.param("max_points", 3, id="max-points-under-4"),
         pytest.param("max_body_bytes", 1023, id="body-limit-under-1k"),
         pytest.param("micro_batch_wait_ms", 1000.5, id="wait-over-1s"),
