@@ -7,6 +7,7 @@ with default fields gets (the shipped model's learned reading).
     .venv/bin/python -m bench.profile_one                 # 300 requests
     .venv/bin/python -m bench.profile_one --markdown      # the table docs/BENCHMARKS.md shows
     .venv/bin/python -m bench.profile_one --reading default --markdown
+    .venv/bin/python -m bench.profile_one --reading default --blas-threads 1   # numpy's BLAS as the service runs it
 
 Stages are named by the functions they run (cumulative time), so the same script measures an older checkout too.
 """
@@ -22,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from bench import ceiling
+from curve_vae.inference.cpus import limit_blas_threads
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.inference.sessions import SessionConfig
@@ -50,13 +52,17 @@ DEFAULT_STAGES = {
 READINGS = {"one-pass": (ONE_PASS, STAGES), "default": (Reading(), DEFAULT_STAGES)}
 
 
-def measure(model_dir: Path, requests: int, reading: str = "one-pass") -> dict[str, float]:
+def measure(
+    model_dir: Path, requests: int, reading: str = "one-pass", blas_threads: int | None = None
+) -> dict[str, float]:
     asked, stages = READINGS[reading]
     rt = CurveRuntime.load(model_dir, sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
+    if blas_threads is not None:
+        limit_blas_threads(blas_threads)  # as the service does (inference/cpus.py)
     plane = ceiling.curves(1, seed=1)
     one = list(ceiling.callers_curves(plane, seed=1))
     rt.reconstruct(one, asked)
-    wall, graphs = _interleaved(rt, one, asked, np.asarray(plane, np.float32), requests)
+    wall, cpu, graphs = _interleaved(rt, one, asked, np.asarray(plane, np.float32), requests)
     prof = cProfile.Profile()
     prof.enable()
     for _ in range(requests):
@@ -64,7 +70,7 @@ def measure(model_dir: Path, requests: int, reading: str = "one-pass") -> dict[s
     prof.disable()
     stats = pstats.Stats(prof).stats  # type: ignore[attr-defined]
     total = max(ct for (_, _, name), (_, _, _, ct, _) in stats.items() if name == "reconstruct")
-    out = {"wall_ms_per_request": wall, "graphs_ms_per_request": graphs}
+    out = {"wall_ms_per_request": wall, "cpu_ms_per_request": cpu, "graphs_ms_per_request": graphs}
     for stage, functions in stages.items():
         out[stage] = (
             sum(
@@ -80,21 +86,25 @@ def measure(model_dir: Path, requests: int, reading: str = "one-pass") -> dict[s
     return out
 
 
-def _interleaved(rt: CurveRuntime, one: list, asked: Reading, plane: np.ndarray, requests: int) -> tuple[float, float]:
-    """Milliseconds per request of the request and of its two graphs alone (the same curve, already in the model
-    plane), in alternating blocks of 50 so that both see the same machine."""
-    spent = {"request": 0.0, "graphs": 0.0}
+def _interleaved(
+    rt: CurveRuntime, one: list, asked: Reading, plane: np.ndarray, requests: int
+) -> tuple[float, float, float]:
+    """Milliseconds per request of the request (wall and this process's CPU, every thread's: a BLAS library's own
+    threads count) and of its two graphs alone (the same curve, already in the model plane, wall), in alternating
+    blocks of 50 so that both see the same machine."""
+    spent = {"request": 0.0, "cpu": 0.0, "graphs": 0.0}
     for done in range(0, requests, 50):
         n = min(50, requests - done)
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         for _ in range(n):
             rt.reconstruct(one, asked)
         spent["request"] += time.perf_counter() - start
+        spent["cpu"] += time.process_time() - cpu
         start = time.perf_counter()
         for _ in range(n):
             rt.graphs.decode(rt.graphs.encode(plane)[0])
         spent["graphs"] += time.perf_counter() - start
-    return spent["request"] / requests * 1e3, spent["graphs"] / requests * 1e3
+    return tuple(spent[k] / requests * 1e3 for k in ("request", "cpu", "graphs"))  # type: ignore[return-value]
 
 
 def main() -> None:
@@ -102,9 +112,12 @@ def main() -> None:
     p.add_argument("--model-dir", default=str(ROOT / "models"), help="the model (default: the shipped one)")
     p.add_argument("--requests", type=int, default=300, help="single-curve requests (default: 300)")
     p.add_argument("--reading", choices=list(READINGS), default="one-pass", help="the request's reading")
+    p.add_argument(
+        "--blas-threads", type=int, default=None, help="cap numpy's BLAS threads as the service does (default: its own)"
+    )
     p.add_argument("--markdown", action="store_true", help="print a Markdown table")
     a = p.parse_args()
-    r = measure(Path(a.model_dir), a.requests, a.reading)
+    r = measure(Path(a.model_dir), a.requests, a.reading, a.blas_threads)
     if a.markdown:
         print("| stage | share of the request |\n|---|---|")
         for k, v in r.items():
@@ -112,6 +125,7 @@ def main() -> None:
                 print(f"| {k} | {100 * v:.0f}% |")
         wall, graphs = r["wall_ms_per_request"], r["graphs_ms_per_request"]
         print(f"| wall time per request, without the profiler | {wall:.2f} ms |")
+        print(f"| CPU time per request, all threads | {r['cpu_ms_per_request']:.2f} ms |")
         print(f"| its two graphs alone, the same curve in the model plane | {graphs:.2f} ms ({wall / graphs:.2f}×) |")
     else:
         print({k: round(float(np.round(v, 4)), 4) for k, v in r.items()})
