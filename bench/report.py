@@ -27,7 +27,8 @@ ROW_LABELS = {
     "access_log": "B, access log on (`--access-log true`)",
     "A_one_worker": "A, one worker (`--workers 1`)",
     "one_worker": "B, one worker (`--workers 1`)",
-    "one_thread": "B, one inference thread (`--inference-concurrency 1`)",
+    "A_one_thread": "A, one inference thread a worker (`--inference-concurrency 1`)",
+    "one_thread": "B, one inference thread a worker (`--inference-concurrency 1`)",
     "one_session": "B, one session pair for both threads (`--sessions 1`)",
     "micro_batch": "B, micro-batching on (`--micro-batch true`: 32 rows, 2 ms)",
     "micro_batch_one": "B, one pass, micro-batching on",
@@ -93,7 +94,7 @@ def _table(r: dict[str, Any]) -> list[str]:
 def _notes(r: dict[str, Any]) -> list[str]:
     """The workers' CPU spread and /augment's times, where those runs were made."""
     lines: list[str] = []
-    for key in ("A", "B", "A_one_worker", "one_worker"):
+    for key in ("A", "B", "A_one_worker", "one_worker", "A_one_thread", "one_thread"):
         if key in r:
             x = r[key]
             spread = ", ".join(f"{s:.1f}" for s in sorted(x["cpu_s_by_process"].values(), reverse=True))

@@ -198,7 +198,7 @@ VARIANTS = {  # run as B (the default request), each against a server started wi
     "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
     "access_log": (["--access-log", "true"], "B with the access log on"),
     "one_worker": (["--workers", "1"], "B (and A, where asked) in one worker process, as before service 0.18.0"),
-    "one_thread": (["--inference-concurrency", "1"], "B with one inference thread"),
+    "one_thread": (["--inference-concurrency", "1"], "B (and A, where asked) with one inference thread a worker"),
     "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
     "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),
 }
@@ -294,6 +294,7 @@ def _default_server_runs(
             cached.stop()
 
 
+WITH_A = ("one_worker", "one_thread")  # variants also run as A when A is asked for
 ONE_PASS_VARIANTS = ("micro_batch", "one_worker")  # variants also run with one-pass bodies when one_pass is asked for
 ONE_PASS_NAMES = tuple(f"{v}_one" for v in ONE_PASS_VARIANTS)
 
@@ -305,10 +306,8 @@ def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: se
         if name in runs:
             server = Server(model_dir, *flags, env=NO_CACHE)
             try:
-                if name == "one_worker" and "A" in runs:
-                    r = load(
-                        "A_one_worker", server, "/reconstruct", json_body(_callers(128, seed=2)), c=2, at_least=60.0
-                    )
+                if name in WITH_A and "A" in runs:  # large requests on 2 connections, hashed to the workers
+                    r = load(f"A_{name}", server, "/reconstruct", json_body(_callers(128, seed=2)), c=2, at_least=60.0)
                     r["curves_per_s"] = r["rps"] * 128
                 load(name, server, "/reconstruct", single)
                 if name in ONE_PASS_VARIANTS and "one_pass" in runs:  # does sharing graph runs, or one process
@@ -333,7 +332,7 @@ def _ceiling_again(report: dict[str, Any], model_dir: Path, secs: float) -> None
             "A",
             "A_fast",
             "A_one",
-            "A_one_worker",
+            *(f"A_{v}" for v in WITH_A),
             "B",
             "B_fast",
             "B_one",

@@ -118,8 +118,17 @@ def test_the_augment_iterator_survives_a_dropped_connection(live_server):
 
 
 def test_a_full_queue_is_retried_until_it_answers(server_factory, model_dir):
-    server = server_factory(
-        "--model-dir", str(model_dir), "--providers", "cpu", "--inference-concurrency", "1", "--max-queue", "0"
+    server = server_factory(  # one worker with one slot and no queue: a second worker would answer at once
+        "--model-dir",
+        str(model_dir),
+        "--providers",
+        "cpu",
+        "--workers",
+        "1",
+        "--inference-concurrency",
+        "1",
+        "--max-queue",
+        "0",
     )
     server.wait_ready()
     heavy = {"curves": bspline_curves(256, 161, seed=1).tolist(), "pose": "search", "spacing": "search"}
