@@ -55,9 +55,10 @@ def available_cpus(root: Path = CGROUP) -> int:
 
 #: The fewest inferences a worker runs at once by default. The default reading holds the GIL for most of a request
 #: but not in onnxruntime, so a second inference keeps the worker's core busy while the first runs its graphs, and a
-#: large request does not hold up a small one. With `--workers 2` on 2 cores, two each against one each: 156 against
-#: 83 curves/s for 128-curve default requests on 2 connections (both of which the kernel gave one worker), 101
-#: against 109 requests/s for single curves on 16 (docs/BENCHMARKS.md, service 0.18.0).
+#: large request does not hold up a small one, nor do two connections the kernel hashed to one worker: on 2 cores,
+#: 128-curve default requests on 2 connections ran at 81 curves/s with one inference a worker (both connections on
+#: one worker, the other idle) against 164 with two; single curves 105 against 112 requests/s (docs/BENCHMARKS.md,
+#: service 0.18.0).
 MIN_SLOTS = 2
 
 
