@@ -52,6 +52,10 @@ class PerWorkerListener:
 
     def __init__(self, host: str, port: int) -> None:
         self.family = _family(host)
+        if port:  # SO_REUSEPORT would join another server's group on this port (same user): refuse, as one socket does
+            with socket.socket(self.family, socket.SOCK_STREAM, socket.IPPROTO_TCP) as probe:
+                probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+                probe.bind((host, port))
         self.reservation = _bound(self.family, (host, port))  # bound, never listening: it takes no connections
         self.address = self.reservation.getsockname()
 

@@ -105,6 +105,18 @@ def test_two_workers_share_the_connections_out(server_factory, model_dir, curves
     assert server.stop() == 0
 
 
+def test_workers_refuse_a_port_another_server_listens_on(server_factory, model_dir):
+    """Each worker's socket is SO_REUSEPORT, which would quietly join another server's workers on the same port and
+    split its connections with it: a second server on a port in use exits 3 instead, naming the address."""
+    first = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
+    first.wait_ready(timeout=90, listeners=2)
+    second = _serve("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2", "--port", str(first.port))
+    assert second.returncode == 3
+    assert f"cannot listen on 127.0.0.1:{first.port}" in second.stdout + second.stderr
+    assert "in use" in second.stdout + second.stderr
+    assert httpx.get(f"{first.url}/ready", timeout=10).status_code == 200  # the first server is untouched
+
+
 def test_with_workers_a_scrape_of_any_worker_counts_them_all(server_factory, model_dir):
     """prometheus-client's multiprocess mode: requests answered by either worker show in /metrics wherever the
     scrape lands, the gauges summed over the live workers; the shared directory goes when the server stops."""
