@@ -8,8 +8,9 @@ among the worker processes and the inferences each runs at once. Torch-free; rea
 
 The same holds for the BLAS library under numpy and scipy (OpenBLAS in their wheels): it starts a thread per core
 for each small matrix product of the reading (the ranker's and the spacing guesser's convolutions, the fit's
-solves), and on 2 cores it doubled the CPU time of a default single-curve request (30.5 ms against 15.1 ms, the
-same wall time) while the other inference waited. `limit_blas_threads` gives it the threads of one inference.
+solves), and on 2 cores it doubled the CPU time of a default single-curve request (36.2 ms against 17.6 ms, about
+the same wall time: `python -m bench.profile_one --reading default` without and with `--blas-threads 1`) while the
+other inference waited. `limit_blas_threads` gives it the threads of one inference.
 """
 
 from __future__ import annotations
@@ -57,8 +58,8 @@ def available_cpus(root: Path = CGROUP) -> int:
 #: but not in onnxruntime, so a second inference keeps the worker's core busy while the first runs its graphs, and a
 #: large request does not hold up a small one, nor do two connections the kernel hashed to one worker: on 2 cores,
 #: 128-curve default requests on 2 connections ran at 81 curves/s with one inference a worker (both connections on
-#: one worker, the other idle) against 164 with two; single curves 105 against 112 requests/s (docs/BENCHMARKS.md,
-#: service 0.18.0).
+#: one worker, the other idle) against 164 with two; single curves about alike, 105 requests/s with one a worker and
+#: 112 with two in an earlier run (docs/BENCHMARKS.md, service 0.18.0).
 MIN_SLOTS = 2
 
 

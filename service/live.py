@@ -28,17 +28,17 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def listening_sockets(port: int) -> int:
-    """TCP sockets listening on `port` on this machine, any address (Linux's /proc/net/tcp and tcp6; 0 elsewhere)."""
+def listening_sockets(port: int) -> int | None:
+    """TCP sockets listening on `port` on this machine, any address (Linux's /proc/net/tcp and tcp6); None where
+    there are no such tables to read."""
+    tables = [Path(t) for t in ("/proc/net/tcp", "/proc/net/tcp6") if Path(t).is_file()]
+    if not tables:
+        return None
     count = 0
-    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
-        try:
-            rows = Path(table).read_text().splitlines()[1:]
-        except OSError:
-            continue
-        for row in rows:
-            local, state = row.split()[1], row.split()[3]
-            count += state == "0A" and int(local.rsplit(":", 1)[1], 16) == port  # 0A: LISTEN
+    for table in tables:
+        for row in table.read_text().splitlines()[1:]:
+            fields = row.split()
+            count += fields[3] == "0A" and int(fields[1].rsplit(":", 1)[1], 16) == port  # 0A: LISTEN
     return count
 
 
@@ -95,7 +95,8 @@ class LiveServer:
                 raise RuntimeError(f"server exited with {self.proc.returncode}: {' '.join(self.cmd)}\n{self.output()}")
             try:
                 with urllib.request.urlopen(f"{self.url}/ready", timeout=1) as r:
-                    if r.status == 200 and listening_sockets(self.port) >= listeners:
+                    listening = listening_sockets(self.port)
+                    if r.status == 200 and (listening is None or listening >= listeners):
                         return
             except OSError:
                 pass

@@ -24,7 +24,7 @@ from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.live import LiveServer
 from curve_vae.service.settings import Settings
-from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves
+from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves, shipped_live_server
 
 #: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
 SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}
@@ -150,11 +150,8 @@ def server_factory() -> Iterator[Callable[..., LiveServer]]:
 
 @pytest.fixture(scope="module")
 def shipped_server() -> Iterator[LiveServer]:
-    """`curve-vae serve` on the shipped model, for tests of what users see (the page, the README's answers)."""
-    if not (SHIPPED / "manifest.json").is_file():
-        pytest.skip("no shipped model: models/manifest.json is absent")
-    with LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu", cwd=ROOT) as server:
-        yield server
+    """`curve-vae serve` on the shipped model, for tests of what users see (the README's answers)."""
+    yield from shipped_live_server()
 
 
 @pytest.fixture(scope="session")

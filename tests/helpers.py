@@ -1,16 +1,32 @@
-"""What several test modules share that is not a fixture: the repository's paths and curves of the paper's kind."""
+"""What several test modules share that is not a fixture: the repository's paths, curves of the paper's kind, and
+servers' flags."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from curve_vae.geometry import random_control_points, sample_bspline
+from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = ROOT / "models"
 FIXTURES = ROOT / "tests" / "fixtures"
+#: `curve-vae serve` flags for tests of one worker's inference slot and queue (with a worker per CPU, another worker
+#: would answer at once)
+ONE_SLOT = ("--providers", "cpu", "--workers", "1", "--inference-concurrency", "1")
+
+
+def shipped_live_server(*flags: str) -> Iterator[LiveServer]:
+    """`curve-vae serve` on the shipped model with `flags`, ready, stopped when done (a fixture's body); skips where
+    the shipped model is absent."""
+    if not (SHIPPED / "manifest.json").is_file():
+        pytest.skip("no shipped model: models/manifest.json is absent")
+    with LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu", *flags, cwd=ROOT) as server:
+        yield server
 
 
 def bspline_curves(count: int, n_points: int = 161, *, seed: int = 0) -> np.ndarray:

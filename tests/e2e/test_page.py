@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from curve_vae.service.live import LiveServer
-from tests.helpers import ROOT, SHIPPED
+from tests.helpers import ROOT, SHIPPED, shipped_live_server
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 ARTIFACTS = ROOT / "test-artifacts"
@@ -50,10 +50,7 @@ def server() -> Iterator[LiveServer]:
     """The shipped model, so that the page draws real reconstructions and interpolants; one worker, because these
     tests watch the encoding cache answer a slider's moves, and each worker keeps its own (the browser's requests
     may reach either of two: docs/DEPLOYMENT.md)."""
-    if not (SHIPPED / "manifest.json").is_file():
-        pytest.skip("no shipped model: models/manifest.json is absent")
-    with LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu", "--workers", "1", cwd=ROOT) as live:
-        yield live
+    yield from shipped_live_server("--workers", "1")
 
 
 @pytest.fixture(scope="module")

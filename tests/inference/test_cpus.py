@@ -60,11 +60,13 @@ def test_threads_per_inference_share_the_cpus_out(cpus_, workers, concurrency, t
     assert workers * concurrency * threads <= max(cpus_, workers * concurrency)  # never more threads than CPUs
 
 
-@pytest.mark.parametrize(("cpus_", "workers", "count"), [(2, 0, 2), (8, 0, 8), (1, 0, 1), (8, 3, 3)])
-def test_workers_default_to_one_per_cpu(cpus_, workers, count):
+@pytest.mark.parametrize(
+    ("cpus_", "workers", "count", "threads"), [(2, 0, 2, 1), (8, 0, 8, 1), (1, 0, 1, 1), (8, 3, 3, 1), (16, 2, 2, 1)]
+)
+def test_workers_default_to_one_per_cpu(cpus_, workers, count, threads):
     settings = Settings.model_construct(workers=workers, inference_concurrency=0, intra_op_threads=0)
     assert cpus.worker_count(settings, cpus_) == count
-    assert cpus.threads_per_inference(settings, cpus_) == max(1, cpus_ // (count * max(2, cpus_ // count)))
+    assert cpus.threads_per_inference(settings, cpus_) == threads
 
 
 def test_an_explicit_thread_count_wins():

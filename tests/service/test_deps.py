@@ -14,6 +14,7 @@ from fastapi.testclient import TestClient
 
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
+from tests.helpers import ONE_SLOT
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 
@@ -34,18 +35,7 @@ def test_a_request_over_the_time_limit_is_a_504(server_factory, model_dir, curve
 
 
 def test_more_work_than_the_queue_takes_is_a_503_with_retry_after(server_factory, model_dir, curves):
-    server = server_factory(  # one worker's slot and queue
-        "--model-dir",
-        str(model_dir),
-        "--providers",
-        "cpu",
-        "--workers",
-        "1",
-        "--inference-concurrency",
-        "1",
-        "--max-queue",
-        "1",
-    )
+    server = server_factory("--model-dir", str(model_dir), *ONE_SLOT, "--max-queue", "1")
     server.wait_ready()
     body = heavy(curves)
     with httpx.Client(timeout=120) as http, cf.ThreadPoolExecutor(8) as pool:
@@ -64,18 +54,8 @@ def _cpu(server) -> float:
 def test_a_request_whose_client_disconnects_stops_and_frees_its_slot(server_factory, model_dir, curves):
     """The client gives up mid-request: the server stops at its next graph run or curve, its one inference slot is
     free for the next request at once, and it goes idle instead of computing the abandoned answer to the end."""
-    server = server_factory(  # one worker, one slot: the next request finds it free only if the first stopped
-        "--model-dir",
-        str(model_dir),
-        "--providers",
-        "cpu",
-        "--workers",
-        "1",
-        "--inference-concurrency",
-        "1",
-        "--batch-size",
-        "8",
-    )
+    # one slot: the next request finds it free only if the first stopped
+    server = server_factory("--model-dir", str(model_dir), *ONE_SLOT, "--batch-size", "8")
     server.wait_ready()
     body = {**heavy(curves), "pose": "search", "spacing": "search"}  # seconds of work on one slot
     start = _cpu(server)

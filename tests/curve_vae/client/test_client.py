@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from curve_vae.client import ApiError, AsyncClient, Client, RetriesExhausted, fresh_seed
-from tests.helpers import bspline_curves
+from tests.helpers import ONE_SLOT, bspline_curves
 
 C1 = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 C2 = [[0, 0], [1.5, 0.5], [3, 2], [4, 4], [5, 6.5], [6.5, 8], [8, 8.5]]
@@ -118,18 +118,7 @@ def test_the_augment_iterator_survives_a_dropped_connection(live_server):
 
 
 def test_a_full_queue_is_retried_until_it_answers(server_factory, model_dir):
-    server = server_factory(  # one worker with one slot and no queue: a second worker would answer at once
-        "--model-dir",
-        str(model_dir),
-        "--providers",
-        "cpu",
-        "--workers",
-        "1",
-        "--inference-concurrency",
-        "1",
-        "--max-queue",
-        "0",
-    )
+    server = server_factory("--model-dir", str(model_dir), *ONE_SLOT, "--max-queue", "0")  # nothing may queue
     server.wait_ready()
     heavy = {"curves": bspline_curves(256, 161, seed=1).tolist(), "pose": "search", "spacing": "search"}
     busy = threading.Thread(target=lambda: httpx.post(server.url + "/reconstruct", json=heavy, timeout=120))
