@@ -111,6 +111,20 @@ def naca(rng: np.random.Generator, count: int) -> np.ndarray:
     return out
 
 
+def closed(rng: np.random.Generator, count: int) -> np.ndarray:
+    """Closed outlines: ellipses (a third of them) and blobs r(θ) = 1 + Σ a_k·cos(kθ + φ_k), k = 2–4, stretched to an
+    axis ratio of 0.3–1, once round from a random start either way — the loops designers draw, which the open
+    families never close. Not in the VAE's mix; the reading ranker learns from them (training/ranker_labels.py)."""
+    k = np.arange(2, 5)[None, None, :]
+    blob = rng.random((count, 1, 1)) >= 1 / 3
+    amp = rng.uniform(0.0, 0.3, (count, 1, 3)) / (k - 1) * blob * (rng.random((count, 1, 3)) < 0.7)
+    way = np.where(rng.random((count, 1)) < 0.5, 1.0, -1.0)
+    t = rng.uniform(0, 2 * np.pi, (count, 1)) + way * 2 * np.pi * _u(count)
+    r = 1.0 + (amp * np.cos(k * t[:, :, None] + rng.uniform(0, 2 * np.pi, (count, 1, 3)))).sum(axis=2)
+    ratio = rng.uniform(0.3, 1.0, (count, 1))
+    return np.stack([r * np.cos(t), ratio * r * np.sin(t)], axis=2)
+
+
 # ------------------------------------------------------------------------------------------ held out
 
 
@@ -152,6 +166,9 @@ TRAIN_FAMILIES: dict[str, Family] = {
     "naca": naca,
 }
 HELD_OUT: dict[str, Family] = {"superellipse": superellipse, "stroke": stroke, "lissajous": lissajous}
+#: Families the reading ranker may be labelled on (`curve-vae ranker label --families`): the training families and
+#: closed outlines, which the VAE's mix leaves out but users post.
+RANKER_FAMILIES: dict[str, Family] = {**TRAIN_FAMILIES, "closed": closed}
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ loses at most the chunk it was on, and `label_curves` skips the chunks already w
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +23,7 @@ from curve_vae.geometry.frame import resample, resample_index
 from curve_vae.inference.candidates import model_points
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.training.families import TRAIN_FAMILIES, draw_family
+from curve_vae.training.families import RANKER_FAMILIES, TRAIN_FAMILIES, draw_family
 from curve_vae.training.suite import AIRFOIL_WHEEL, random_moves
 
 #: Point counts the labelled curves come at (users send anything from a few dozen points to a few hundred).
@@ -34,12 +34,13 @@ HELD_AIRFOILS = ((200, 2024), (20, 5))
 SEARCH = Reading(pose="search", spacing="search")
 
 
-def user_curves(count: int, seed: int) -> list[np.ndarray]:
-    """`count` curves of the training families (the paper's among them) and real airfoils, at random point counts
-    and spacings (as drawn, by arc length, warped), turned, mirrored and reversed at random."""
+def user_curves(count: int, seed: int, families: Sequence[str] = tuple(TRAIN_FAMILIES)) -> list[np.ndarray]:
+    """`count` curves of `families` (RANKER_FAMILIES' names; by default the training families, the paper's among
+    them) and real airfoils, at random point counts and spacings (as drawn, by arc length, warped), turned, mirrored
+    and reversed at random."""
     rng = np.random.default_rng(seed)
     airfoils = _TRAINING_AIRFOILS or _training_airfoils()
-    families = list(TRAIN_FAMILIES.values())
+    chosen = [RANKER_FAMILIES[name] for name in families]
     out: list[np.ndarray] = []
     while len(out) < count:
         n = int(rng.choice(POINT_COUNTS))
@@ -47,7 +48,7 @@ def user_curves(count: int, seed: int) -> list[np.ndarray]:
             c = airfoils[int(rng.integers(len(airfoils)))]
             c = resample(c, n) if rng.random() < 0.5 else c
         else:
-            family = families[int(rng.integers(len(families)))]
+            family = chosen[int(rng.integers(len(chosen)))]
             c = draw_family(family, 1, rng, n_points=n, model_size=None, chunk=8)[0].astype(np.float64)
             if rng.random() < 0.2:  # also the model's own count at the paper's spacing, read by index
                 c = resample_index(c[None], 161)[0]
@@ -103,10 +104,12 @@ def label_curves(
     seed: int,
     chunk: int = 500,
     time_budget: float = 0.0,
+    families: Sequence[str] = tuple(TRAIN_FAMILIES),
     say: Callable[[str], None] = print,
 ) -> list[Path]:
-    """Label `curves` user curves (seed `seed`) against the model in `model_dir`, `chunk` curves a file, skipping
-    chunks already written; stop after `time_budget` seconds (0: no limit) at a chunk's end. Returns the files."""
+    """Label `curves` user curves of `families` (seed `seed`: give each set of families its own) against the model
+    in `model_dir`, `chunk` curves a file, skipping chunks already written; stop after `time_budget` seconds (0: no
+    limit) at a chunk's end. Returns the files."""
     out = Path(out_dir)
     runtime = CurveRuntime.load(model_dir, intra_op_threads=1, cache_bytes=0)
     files, start, total = [], time.monotonic(), (curves + chunk - 1) // chunk
@@ -119,7 +122,7 @@ def label_curves(
             say(f"time budget spent: {k} of {total} chunks; run again to carry on")
             return [f for f in files if f.exists()]
         t0 = time.monotonic()
-        drawn = user_curves(min(chunk, curves - k * chunk), seed * 100_003 + k)
+        drawn = user_curves(min(chunk, curves - k * chunk), seed * 100_003 + k, families)
         labels = label(runtime, drawn)
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as fh:

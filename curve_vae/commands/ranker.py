@@ -10,7 +10,15 @@ from pathlib import Path
 def cmd_label(a: argparse.Namespace) -> int:
     from curve_vae.training.ranker_labels import label_curves
 
-    files = label_curves(a.model_dir, a.out, curves=a.curves, seed=a.seed, chunk=a.chunk, time_budget=a.time_budget)
+    files = label_curves(
+        a.model_dir,
+        a.out,
+        curves=a.curves,
+        seed=a.seed,
+        chunk=a.chunk,
+        time_budget=a.time_budget,
+        **({"families": a.families} if a.families else {}),
+    )
     print(f"{len(files)} label files in {a.out} (train on them with curve-vae ranker train)")
     return 0
 
@@ -44,6 +52,15 @@ def cmd_export(a: argparse.Namespace) -> int:
     return 0
 
 
+def _families(text: str) -> list[str]:
+    from curve_vae.training.families import RANKER_FAMILIES
+
+    unknown = [name for name in text.split(",") if name not in RANKER_FAMILIES]
+    if unknown:
+        raise argparse.ArgumentTypeError(f"unknown families {unknown}: choose from {', '.join(RANKER_FAMILIES)}")
+    return text.split(",")
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     r = sub.add_parser("ranker", help="the reading ranker: label curves, train it, export it into a model")
     stages = r.add_subparsers(dest="stage", required=True)
@@ -55,6 +72,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--seed", type=int, default=1, help="seed of the curves; each seed its own files (default: 1)")
     s.add_argument("--chunk", type=int, default=250, help="curves per file (default: 250)")
     s.add_argument("--time-budget", type=float, default=0.0, help="seconds, then stop at a chunk's end (0: none)")
+    s.add_argument(
+        "--families",
+        type=_families,
+        default=None,
+        help="comma-separated family names (default: the VAE's training families; closed: closed outlines)",
+    )
     s.set_defaults(func=cmd_label)
 
     s = stages.add_parser("train", help="train the ranker on the label chunks (time-budgeted, resumable)")

@@ -10,9 +10,9 @@ from curve_vae.geometry.frame import MODEL_CENTER, chord_heading
 from curve_vae.training import families as F
 
 
-@pytest.mark.parametrize("name", [*F.TRAIN_FAMILIES, *F.HELD_OUT])
+@pytest.mark.parametrize("name", [*F.RANKER_FAMILIES, *F.HELD_OUT])
 def test_every_family_draws_simple_finite_curves_in_the_models_pose_and_frame(name):
-    fam = {**F.TRAIN_FAMILIES, **F.HELD_OUT}[name]
+    fam = {**F.RANKER_FAMILIES, **F.HELD_OUT}[name]
     curves = F.draw_family(fam, 64, np.random.default_rng(0), model_size=92.6)
     assert curves.shape == (64, 161, 2) and curves.dtype == np.float32 and np.isfinite(curves).all()
     assert not self_intersects(curves).any()
@@ -22,6 +22,14 @@ def test_every_family_draws_simple_finite_curves_in_the_models_pose_and_frame(na
         assert f.size == pytest.approx(92.6, rel=1e-5)
         assert signed_turning(c) >= -1e-4  # counter-clockwise, as the paper's curves turn (a straight line: 0)
         assert -0.75 * np.pi - 1e-6 <= chord_heading(c) <= -0.25 * np.pi + 1e-6
+
+
+def test_closed_outlines_close_either_way_round_and_stay_out_of_the_vaes_mix():
+    curves = F.closed(np.random.default_rng(3), 200)
+    np.testing.assert_allclose(curves[:, 0], curves[:, -1], atol=1e-12)  # once round: the loop closes
+    ways = {bool(signed_turning(c) > 0) for c in curves}
+    assert ways == {True, False}  # listed counter-clockwise and clockwise
+    assert "closed" not in F.TRAIN_FAMILIES and F.RANKER_FAMILIES["closed"] is F.closed
 
 
 def test_spacings_put_points_where_they_say():

@@ -43,6 +43,15 @@ def test_user_curves_are_seeded_and_moved():
     assert all(np.array_equal(x, y) for x, y in zip(a, b)) and len({len(c) for c in a}) > 1
 
 
+def test_user_curves_are_drawn_from_the_families_asked_for():
+    def closed_share(curves: list[np.ndarray]) -> float:
+        return float(np.mean([np.hypot(*(c[-1] - c[0])) < 1e-6 * np.ptp(c, axis=0).max() for c in curves]))
+
+    # airfoils (when their wheel is there) are drawn beside any family, some of them closed at the trailing edge
+    assert closed_share(user_curves(40, seed=4, families=["closed"])) >= 0.7
+    assert closed_share(user_curves(40, seed=4)) <= 0.3
+
+
 def test_a_spent_time_budget_stops_at_a_chunks_start_and_returns_the_chunks_written(
     labels: Path, tmp_path: Path, closest_model_dir: Path
 ):

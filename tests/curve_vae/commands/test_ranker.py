@@ -77,3 +77,12 @@ def test_export_makes_learned_the_models_reading_unless_told_not_to(
     assert manifest.reading.pose == (pose or was) and manifest.ranker is not None
     assert "two chunks" in (model / "manifest.json").read_text()
     assert capsys.readouterr().out.startswith(f"wrote {model / 'ranker.npz'}; ")
+
+
+def test_label_refuses_a_family_it_does_not_know(closest_model_dir: Path, tmp_path: Path, capsys):
+    argv = ["ranker", "label", "--model-dir", str(closest_model_dir), "--out", str(tmp_path)]
+    with pytest.raises(SystemExit) as e:
+        main([*argv, "--families", "closed,blob"])
+    assert e.value.code == 2 and not any(tmp_path.iterdir())
+    said = capsys.readouterr().err
+    assert "unknown families ['blob']: choose from paper, polygon, arc, spiral, wave, naca, closed" in said
