@@ -44,7 +44,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     On any error the temporary file is removed and `path` keeps its previous content.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    _folder_for(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.close(fd)
     try:
@@ -54,6 +54,16 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _folder_for(path: Path) -> None:
+    """Make `path`'s folder; where a file stands in its way, say so (not "[Errno 17] File exists")."""
+    for above in [path.parent, *path.parent.parents]:
+        if above.exists():
+            if not above.is_dir():
+                raise NotADirectoryError(f"cannot write {path}: {above} is a file, not a folder")
+            break
+    path.parent.mkdir(parents=True, exist_ok=True)
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:

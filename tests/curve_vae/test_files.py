@@ -82,6 +82,16 @@ def test_an_atomic_path_appears_whole_readable_and_in_new_folders(tmp_path):
     assert sorted(p.name for p in target.parent.iterdir()) == ["out.bin"]
 
 
+@pytest.mark.parametrize("under", ["out.npy", "sub/out.npy"])
+def test_a_file_where_a_folder_should_be_is_named_and_left_alone(tmp_path, capsys, under):
+    blocker = tmp_path / "results"
+    blocker.write_text("a user's notes")
+    assert main(["sample", "--count", "2", "-o", str(blocker / under)]) == 2
+    err = capsys.readouterr().err
+    assert f"cannot write {blocker / under}: {blocker} is a file, not a folder" in err and "Errno" not in err
+    assert blocker.read_text() == "a user's notes" and [p.name for p in tmp_path.iterdir()] == ["results"]
+
+
 def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
     target = tmp_path / "out.json"
     target.write_text("before")
