@@ -64,6 +64,8 @@ def read_curves(path: str | Path) -> list[np.ndarray]:
     if name == "-":
         return parse_json(sys.stdin.read(), "<stdin>")
     p = Path(path)
+    if p.is_dir():
+        raise CurveFileError(f"{name}: a folder; this command reads one curve file (give a file, or - for stdin)")
     if not p.is_file():
         raise CurveFileError(f"{name}: no such file")
     suffix = p.suffix.lower()
