@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from numpy.lib.stride_tricks import as_strided
+from numpy.lib.stride_tricks import sliding_window_view
 
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry.frame import MODEL_CENTER
@@ -41,10 +41,7 @@ class Ranker:
         self.convs = []
         i = 0
         while f"conv{i}_w" in weights:
-            w = weights[f"conv{i}_w"].astype(np.float32)  # (out, in, taps)
-            # as (taps·in, out), tap by tap: a window of the input's rows, flattened, times it is the convolution
-            self.convs.append((np.ascontiguousarray(w.transpose(2, 1, 0).reshape(-1, len(w))),
-                               weights[f"conv{i}_b"].astype(np.float32)))  # fmt: skip
+            self.convs.append((weights[f"conv{i}_w"].astype(np.float32), weights[f"conv{i}_b"].astype(np.float32)))
             i += 1
         self.dense = []
         i = 0
@@ -64,17 +61,11 @@ class Ranker:
             return np.zeros(0)
         h = ranker_inputs(points).transpose(0, 2, 1)  # (k, n, c): each step one matrix product
         for w, b in self.convs:
-            k, n, c = h.shape
-            taps = len(w) // c
-            pad = taps // 2
-            n_out = (n - 1) // 2 + 1
-            padded = np.zeros((k, n + 2 * pad + 1, c), np.float32)  # one more: the last window of an even n
-            padded[:, pad : pad + n] = h
-            # (k, n_out, taps, c): each window's taps in order, each tap's channels contiguous, as w's rows run
-            s0, s1, s2 = padded.strides
-            windows = as_strided(padded, (k, n_out, taps, c), (s0, 2 * s1, s1, s2), writeable=False)
-            h = (windows.reshape(k * n_out, taps * c) @ w + b).reshape(k, n_out, -1)
-            np.maximum(h, 0.0, out=h)
+            padded = np.pad(h, ((0, 0), (2, 2), (0, 0)))
+            windows = sliding_window_view(padded, w.shape[2], axis=1)[:, ::2]  # (k, n_out, c, 5)
+            k, n_out = windows.shape[:2]
+            flat = windows.reshape(k * n_out, -1)  # (k·n_out, c·5), as w (o, c, 5) flattens: one matrix product
+            h = np.maximum(flat @ w.reshape(len(w), -1).T + b, 0.0).reshape(k, n_out, len(w))
         z = np.concatenate([h.mean(1), h.max(1)], axis=1)
         (w0, b0), (w1, b1) = self.dense
         z = np.maximum(z @ w0.T + b0, 0.0)
