@@ -28,12 +28,12 @@ class DataConfig:
     radius: float = 64.0  # control points lie in this circle ...
     center: tuple[float, float] = (64.0, 64.0)  # ... centred in the 128×128 plane
     # "paper": every split is the paper's curves. "broad": training and validation curves come from the broad
-    # mix of training/families.py (any spacing, shapes beyond the paper's, in the service's pose and frame);
+    # mix of training/mixes.py (any spacing, shapes beyond the paper's, in the service's pose and frame);
     # the test split stays the paper's, the one eq. 4's MSE is reported on. "files": a user's own curves, read
-    # from `source` (training/families.own_curves): split by curve, the training curves posed n_train times.
+    # from `source` (training/mixes.own_curves): split by curve, the training curves posed n_train times.
     mix: str = "paper"
     source: str = ""  # mix "files": a curve file, or a directory of .npy/.csv/.json/.dat files
-    # mix "broad": the version of its definition (training.families.MIX_VERSION), set by default; 0 otherwise
+    # mix "broad": the version of its definition (training.mixes.MIX_VERSION), set by default; 0 otherwise
     mix_version: int = 0
     # mix "broad": also keep each training and validation curve evenly in its own parameter, in the same pose
     # (its "twin", training.families.draw_family), for training with match "twin"
@@ -43,7 +43,7 @@ class DataConfig:
         if self.mix not in MIXES:
             raise InvalidInput(f"mix must be one of {', '.join(MIXES)}, got {self.mix!r}")
         if self.mix == "broad" and not self.mix_version:
-            from curve_vae.training.families import MIX_VERSION
+            from curve_vae.training.mixes import MIX_VERSION
 
             object.__setattr__(self, "mix_version", MIX_VERSION)
         elif self.mix != "broad" and self.mix_version:
@@ -112,13 +112,13 @@ class CurveDataset:
     def generate(cls, config: DataConfig, *, workers: int = 1) -> CurveDataset:
         """The data set of `config`; the broad mix is drawn by `workers` processes (the same data however many)."""
         if config.mix == "files":
-            from curve_vae.training.families import own_curves
+            from curve_vae.training.mixes import own_curves
 
             train, val, test = own_curves(config.source, config.n_train, config.seed, n_points=config.n_points)
             return cls(config, train, val, test, np.zeros((len(test), 0, 2), np.float32))
         a, b = config.n_train, config.n_train + config.n_val
         if config.mix == "broad":
-            from curve_vae.training.families import broad_mix
+            from curve_vae.training.mixes import broad_mix
 
             curves, ctrl = paper_test_curves(config)
             mixed = broad_mix(

@@ -308,7 +308,7 @@ def export_checkpoint(
 def reading_of(data_cfg: Any) -> tuple[str, str]:
     """The reading a model trained on `data_cfg` expects: one canonical pose and the points as given for the broad mix
     in geometry.canonical_frame's pose (training.families MixSpec.pose), the search for every other."""
-    from curve_vae.training.families import MIXES
+    from curve_vae.training.mixes import MIXES
 
     if data_cfg.mix == "broad" and MIXES[data_cfg.mix_version].pose == "canonical":
         return ("canonical", "parameter")

@@ -11,7 +11,7 @@ from curve_vae.errors import InvalidInput
 from curve_vae.inference.choices import Providers, choices
 from curve_vae.inference.cpus import available_cpus
 from curve_vae.inference.reading import Reading, reading_options
-from curve_vae.training.families import MIX_VERSION, MIXES
+from curve_vae.training.mixes import MIX_VERSION, MIXES
 
 DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
 DEFAULT_MODELS = "models"

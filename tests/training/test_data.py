@@ -78,7 +78,7 @@ def test_cache_round_trip_and_mismatch(tmp_path, small):
 
 
 def test_broad_mix_is_versioned_and_its_test_split_is_the_papers(tmp_path):
-    from curve_vae.training.families import MIX_VERSION
+    from curve_vae.training.mixes import MIX_VERSION
 
     cfg = DataConfig(n_train=300, n_val=20, n_test=10, mix="broad")
     assert cfg.mix_version == MIX_VERSION and DataConfig().mix_version == 0
@@ -108,7 +108,7 @@ def test_broad_mix_is_versioned_and_its_test_split_is_the_papers(tmp_path):
 
 def test_each_mix_version_draws_its_own_shares():
     """Version 2 (model 0.9.0's) is still drawn as it was; the present version differs from it."""
-    from curve_vae.training.families import MIX_VERSION, MIXES, broad_mix
+    from curve_vae.training.mixes import MIX_VERSION, MIXES, broad_mix
 
     assert MIX_VERSION in MIXES and 2 in MIXES
     for spec in MIXES.values():
