@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
+from numpy.lib.stride_tricks import as_strided
 
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry.frame import MODEL_CENTER
@@ -38,10 +38,13 @@ class Ranker:
     """The ranker's weights (ranker.npz) and its forward pass."""
 
     def __init__(self, weights: dict[str, np.ndarray]) -> None:
-        self.convs = []
+        self.convs: list[tuple[np.ndarray, np.ndarray, int]] = []  # (taps·in, out) weights, bias, taps
         i = 0
         while f"conv{i}_w" in weights:
-            self.convs.append((weights[f"conv{i}_w"].astype(np.float32), weights[f"conv{i}_b"].astype(np.float32)))
+            w = weights[f"conv{i}_w"].astype(np.float32)  # (out, in, taps)
+            # as (taps·in, out): a window of the input's rows (channels last), flattened, times it is the convolution
+            flat = np.ascontiguousarray(w.transpose(2, 1, 0).reshape(-1, len(w)))
+            self.convs.append((flat, weights[f"conv{i}_b"].astype(np.float32), w.shape[2]))
             i += 1
         self.dense = []
         i = 0
@@ -60,12 +63,17 @@ class Ranker:
         if len(points) == 0:
             return np.zeros(0)
         h = ranker_inputs(points).transpose(0, 2, 1)  # (k, n, c): each step one matrix product
-        for w, b in self.convs:
-            padded = np.pad(h, ((0, 0), (2, 2), (0, 0)))
-            windows = sliding_window_view(padded, w.shape[2], axis=1)[:, ::2]  # (k, n_out, c, 5)
-            k, n_out = windows.shape[:2]
-            flat = windows.reshape(k * n_out, -1)  # (k·n_out, c·5), as w (o, c, 5) flattens: one matrix product
-            h = np.maximum(flat @ w.reshape(len(w), -1).T + b, 0.0).reshape(k, n_out, len(w))
+        for w, b, taps in self.convs:
+            k, n, c = h.shape
+            pad = taps // 2
+            padded = np.zeros((k, n + 2 * pad, c), np.float32)
+            padded[:, pad : pad + n] = h
+            n_out = (n + 2 * pad - taps) // 2 + 1
+            # stride 2: window j is rows 2j … 2j + taps - 1 of the padded input, taps·c floats in a row in memory, so
+            # the windows' copy into one matrix is a copy of contiguous runs (a 5-element gather per channel is not)
+            s0, s1, s2 = padded.strides
+            windows = as_strided(padded, (k, n_out, taps * c), (s0, 2 * s1, s2), writeable=False)
+            h = np.maximum(windows.reshape(k * n_out, taps * c) @ w + b, 0.0).reshape(k, n_out, len(b))
         z = np.concatenate([h.mean(1), h.max(1)], axis=1)
         (w0, b0), (w1, b1) = self.dense
         z = np.maximum(z @ w0.T + b0, 0.0)

@@ -63,10 +63,12 @@ def test_inputs_are_the_points_about_the_centre_and_their_steps():
     assert np.all(x[0, 3] == 0)
 
 
-def test_the_forward_pass_is_a_convolution_stack():
-    """Against a direct loop: conv (kernel 5, stride 2, padding 2) + ReLU three times, mean and max, two layers."""
+@pytest.mark.parametrize("n_points", [161, 50])
+def test_the_forward_pass_is_a_convolution_stack(n_points):
+    """Against a direct loop: conv (kernel 5, stride 2, padding 2) + ReLU three times, mean and max, two layers; at
+    an odd and an even number of points (the last window of an even row ends in the padding)."""
     w = random_weights(3)
-    pts = np.random.default_rng(1).uniform(20, 108, (3, 161, 2)).astype(np.float32)
+    pts = np.random.default_rng(1).uniform(20, 108, (3, n_points, 2)).astype(np.float32)
     h = ranker_inputs(pts).astype(np.float64)
     for i in range(3):
         k, b = w[f"conv{i}_w"], w[f"conv{i}_b"]
