@@ -164,6 +164,45 @@ def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
     return frames
 
 
+def pose_frames_of(curves: Sequence[np.ndarray], *, chords: int = 3, flips: bool = True) -> list[list[Frame]]:
+    """`frame.pose_frames` of every curve, computed for the curves of each length together. Raises ValueError naming
+    the first curve whose points all coincide."""
+    out: dict[int, list[Frame]] = {}
+    lengths = np.array([len(c) for c in curves])
+    for n in np.unique(lengths):
+        idx: list[int] = np.flatnonzero(lengths == n).tolist()
+        pts = np.stack([np.asarray(curves[i], np.float64) for i in idx])
+        out.update(zip(idx, _poses_same_length(pts, chords, flips)))
+    return [out[i] for i in range(len(curves))]
+
+
+def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[Frame]]:
+    """Pose frames of curves of one length (k, n, 2); see frame.pose_frames and frame.pose_candidates."""
+    if not (np.ptp(pts, axis=1).max(axis=1) > 0).all():
+        raise ValueError("all points coincide: a curve needs at least 2 distinct points")
+    mirror = _turns_clockwise(pts)
+    flip = np.stack([np.where(mirror, -1.0, 1.0), np.ones(len(pts))], axis=-1)  # (k, 2)
+    heading = _chord_heading(pts * flip[:, None, :], _arc_centroid(pts) * flip)
+    poses: list[tuple[np.ndarray, np.ndarray, bool]] = []  # (rotation (k,), mirror (k,), reverse), in pose order
+    for target in POSE_CHORDS[:chords]:
+        turn = np.angle(np.exp(1j * (target - heading)))
+        poses.append((turn, mirror, False))
+        if flips:
+            normal = np.array([np.cos(target), np.sin(target)])
+            c, s = np.cos(turn), np.sin(turn)
+            rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (k, 2, 2) column-vector rotations
+            a = (np.eye(2) - 2 * np.outer(normal, normal)) @ rot @ np.diag([-1.0, 1.0])
+            poses.append((np.arctan2(a[:, 1, 0], a[:, 0, 0]), ~mirror, True))
+    boxes = [_box(pts, _linear(turn, mir)) for turn, mir, _ in poses]
+    return [
+        [
+            Frame((float(center[i, 0]), float(center[i, 1])), float(size[i]), float(turn[i]), bool(mir[i]), rev)
+            for (turn, mir, rev), (center, size) in zip(poses, boxes)
+        ]
+        for i in range(len(pts))
+    ]
+
+
 def _linear(rotation: np.ndarray, mirror: np.ndarray) -> np.ndarray:
     """(k, 2, 2) `Frame._linear` of each pose (row vectors, mirror first)."""
     c, s = np.cos(rotation), np.sin(rotation)

@@ -29,6 +29,7 @@ from curve_vae.geometry.batch import (
     FrameRows,
     Ragged,
     canonical_frames,
+    pose_frames_of,
     shared_canonical_frames,
     shared_pose_frames,
 )
@@ -196,7 +197,7 @@ class Reader:
     ) -> list[Candidate]:
         """Every curve in every pose, read as the reading says; spacing "search": its points as given and each of
         its natural readings that does not put them where they are (a curve at the paper's own spacing is read so).
-        The canonical pose is found for all curves at once (geometry.batch); shared: the set's poses, the same for
+        The candidate poses are found for all curves at once (geometry.batch); shared: the set's poses, the same for
         every curve (geometry.batch.shared_pose_frames)."""
         posed: list[list[Frame]] | None = None
         try:
@@ -206,6 +207,8 @@ class Reader:
                 posed = shared_pose_frames(inputs, chords=POSE_CHORD_COUNT)
             elif reading.frame != "model" and reading.pose == "canonical":
                 posed = [[f] for f in canonical_frames(inputs)]
+            elif reading.frame != "model" and reading.pose in ("search", "learned"):
+                posed = pose_frames_of(inputs, chords=POSE_CHORD_COUNT)
         except ValueError:
             pass  # the curve whose points coincide is named below
         natural = (

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from curve_vae.geometry import canonical_frame, pose_frames, random_control_points, sample_bspline
-from curve_vae.geometry.batch import FrameRows, Ragged, canonical_frames
+from curve_vae.geometry.batch import FrameRows, Ragged, canonical_frames, pose_frames_of
 
 
 def _drawn(count: int, seed: int = 0) -> list[np.ndarray]:
@@ -27,6 +27,22 @@ def test_canonical_frames_of_a_batch_are_each_curves_own():
     curves = _drawn(60)
     together = canonical_frames(curves)
     assert together == [canonical_frame(c) for c in curves]
+
+
+@pytest.mark.parametrize(("chords", "flips"), [(3, True), (2, False), (1, True)])
+def test_pose_frames_of_a_batch_are_each_curves_own(chords, flips):
+    """Every candidate pose of every curve as frame.pose_frames gives it alone, in order (loops, repeated points,
+    curves of many lengths; rotations to rounding)."""
+    curves = _drawn(60, seed=3) + [np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])]  # a straight line: by its area
+    for c, together in zip(curves, pose_frames_of(curves, chords=chords, flips=flips)):
+        alone = pose_frames(c, chords=chords, flips=flips)
+        assert [(f.mirror, f.reverse) for f in together] == [(f.mirror, f.reverse) for f in alone]
+        for f, g in zip(together, alone):
+            np.testing.assert_allclose([*f.center, f.size], [*g.center, g.size], rtol=1e-12, atol=1e-12 * g.size)
+            assert np.isclose(np.cos(f.rotation - g.rotation), 1.0, rtol=0, atol=1e-15)
+            assert np.isclose(np.sin(f.rotation - g.rotation), 0.0, rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="coincide"):
+        pose_frames_of([curves[0], np.ones((5, 2))])
 
 
 def test_the_canonical_frame_is_one_of_the_two_pose_candidates():
