@@ -101,16 +101,18 @@ def _pair(weights: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, np.nda
 
 
 def _conv(h: np.ndarray, w: np.ndarray, b: np.ndarray, *, dilation: int) -> np.ndarray:
-    """A 1-D convolution of (k, n, c) with weights (o, c, taps), zero-padded to keep n: each tap one (k·n, c) @ (c, o)
-    matrix product."""
-    k, n, c = h.shape
-    taps = w.shape[2]
-    pad = dilation * (taps - 1) // 2
-    padded = h
-    if pad:
-        padded = np.zeros((k, n + 2 * pad, c), h.dtype)
-        padded[:, pad : pad + n] = h
-    out = padded[:, :n].reshape(k * n, c) @ w[:, :, 0].T + b
-    for t in range(1, taps):
-        out += padded[:, t * dilation : t * dilation + n].reshape(k * n, c) @ w[:, :, t].T
-    return out.reshape(k, n, len(w))
+    """A 1-D convolution of (k, n, c) with weights (o, c, taps), zero-padded to keep n: the middle tap's (k, n, c) @
+    (c, o) product, then each other tap's product added into the rows it reaches (the zero padding contributes
+    nothing, so it is never built: 32 curves' guesses 27.5 -> 18 ms against a padded copy per convolution)."""
+    n = h.shape[1]
+    mid = w.shape[2] // 2
+    out = h @ w[:, :, mid].T + b
+    for t in range(w.shape[2]):
+        shift = (t - mid) * dilation  # out[j] += h[j + shift] @ w[:, :, t].T where j + shift is a row of h
+        if t == mid or abs(shift) >= n:
+            continue
+        if shift > 0:
+            out[:, : n - shift] += h[:, shift:] @ w[:, :, t].T
+        else:
+            out[:, -shift:] += h[:, : n + shift] @ w[:, :, t].T
+    return out

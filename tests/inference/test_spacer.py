@@ -13,7 +13,7 @@ from curve_vae.geometry import arc_length_params, random_control_points, sample_
 from curve_vae.geometry.bspline import evaluate_bspline
 from curve_vae.inference import reader as reader_module
 from curve_vae.inference.reading import Reading
-from curve_vae.inference.spacer import GRID, SPACER_KIND, Spacer, on_grid, spacer_inputs
+from curve_vae.inference.spacer import GRID, SPACER_KIND, Spacer, _conv, on_grid, spacer_inputs
 from tests.helpers import natural_fits_asked
 
 
@@ -34,6 +34,21 @@ def random_weights(seed: int = 0, channels: int = 8) -> dict[str, np.ndarray]:
 def _turned(c: np.ndarray, angle: float, scale: float, shift: tuple[float, float]) -> np.ndarray:
     rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
     return c @ rot.T * scale + np.asarray(shift)
+
+
+@pytest.mark.parametrize(("taps", "dilation"), [(3, 1), (3, 4), (5, 1), (3, 40), (5, 9)])
+def test_a_convolution_is_the_zero_padded_one(taps, dilation):
+    """Against a direct loop over a zero-padded input (torch's Conv1d with padding dilation·(taps - 1) / 2),
+    including dilations whose outer taps reach past the whole row."""
+    rng = np.random.default_rng(taps * 100 + dilation)
+    h = rng.normal(size=(3, 17, 4)).astype(np.float32)
+    w, b = rng.normal(size=(6, 4, taps)).astype(np.float32), rng.normal(size=6).astype(np.float32)
+    pad = dilation * (taps - 1) // 2
+    padded = np.pad(h.astype(np.float64), ((0, 0), (pad, pad), (0, 0)))
+    expected = np.stack(
+        [sum(padded[:, j + t * dilation] @ w[:, :, t].T for t in range(taps)) + b for j in range(17)], axis=1
+    )
+    np.testing.assert_allclose(_conv(h, w, b, dilation=dilation), expected, rtol=1e-5, atol=1e-5)
 
 
 def test_the_inputs_are_the_shapes_turning_along_its_length_whatever_its_pose():
