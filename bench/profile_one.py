@@ -43,7 +43,7 @@ DEFAULT_STAGES = {
     "the two graphs (onnxruntime)": STAGES["the two graphs (onnxruntime)"],
     "natural-spacing fit": [("natural.py", "natural_readings_of")],
     "of which the spacing guesser": [("spacer.py", "guesses")],  # inside the fit: not counted twice
-    "candidate poses": [("frame.py", "pose_frames")],
+    "candidate poses": [("frame.py", "pose_frames"), ("batch.py", "pose_frames_of")],
     "reading ranker": [("ranker.py", "scores")],
     "to the model plane": STAGES["to the model plane"],
     "placement on the spline": STAGES["placement on the spline"],

@@ -183,21 +183,24 @@ def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[F
     mirror = _turns_clockwise(pts)
     flip = np.stack([np.where(mirror, -1.0, 1.0), np.ones(len(pts))], axis=-1)  # (k, 2)
     heading = _chord_heading(pts * flip[:, None, :], _arc_centroid(pts) * flip)
-    poses: list[tuple[np.ndarray, np.ndarray, bool]] = []  # (rotation (k,), mirror (k,), reverse), in pose order
+    turns, mirrors, reverses = [], [], []  # per pose (k,), (k,) and one flag, in pose_frames' order
     for target in POSE_CHORDS[:chords]:
         turn = np.angle(np.exp(1j * (target - heading)))
-        poses.append((turn, mirror, False))
+        turns.append(turn), mirrors.append(mirror), reverses.append(False)
         if flips:
-            normal = np.array([np.cos(target), np.sin(target)])
-            c, s = np.cos(turn), np.sin(turn)
-            rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (k, 2, 2) column-vector rotations
-            a = (np.eye(2) - 2 * np.outer(normal, normal)) @ rot @ np.diag([-1.0, 1.0])
-            poses.append((np.arctan2(a[:, 1, 0], a[:, 0, 0]), ~mirror, True))
-    boxes = [_box(pts, _linear(turn, mir)) for turn, mir, _ in poses]
+            # reflected across the chord's normal after the turn and the mirror (frame.pose_candidates' S·R(turn)·M):
+            # two reflections, whose axes lie at target + π/2 and (turn + π) / 2, make the turn 2·target − turn
+            turns.append(np.angle(np.exp(1j * (2 * target - turn)))), mirrors.append(~mirror), reverses.append(True)
+    turn, mir = np.stack(turns, axis=1), np.stack(mirrors, axis=1)  # (k, poses)
+    linear = _linear(turn.ravel(), mir.ravel()).reshape(*turn.shape, 2, 2)
+    q = np.einsum("knd,kpde->kpne", pts, linear)  # every pose's bounding box at once (frame.posed_frame)
+    lo, hi = q.min(axis=2), q.max(axis=2)
+    center, size = np.einsum("kpe,kpde->kpd", (lo + hi) / 2, linear).tolist(), (hi - lo).max(axis=2).tolist()
+    turn_, mir_ = turn.tolist(), mir.tolist()
     return [
         [
-            Frame((float(center[i, 0]), float(center[i, 1])), float(size[i]), float(turn[i]), bool(mir[i]), rev)
-            for (turn, mir, rev), (center, size) in zip(poses, boxes)
+            Frame((center[i][p][0], center[i][p][1]), size[i][p], turn_[i][p], mir_[i][p], reverses[p])
+            for p in range(len(reverses))
         ]
         for i in range(len(pts))
     ]
