@@ -1,5 +1,5 @@
-"""Where a single-curve request's time goes in-process: `CurveRuntime.reconstruct` of one caller curve, no cache,
-one 1-thread session pair, under cProfile; each stage's share of the time, and the wall time per request without
+"""Where a single-curve request's time goes in-process: `CurveRuntime.reconstruct` of one caller curve (`--curves N`:
+of N, as one request), no cache, one 1-thread session pair, under cProfile; each stage's share of the time, and the wall time per request without
 the profiler beside that of its two graphs alone (issue 39's "≤ 2× its graphs"). `--reading one-pass` (the
 default): pose "canonical", spacing "parameter" (one encoding, one decoding); `--reading default`: what a request
 with default fields gets (the shipped model's learned reading).
@@ -8,6 +8,7 @@ with default fields gets (the shipped model's learned reading).
     .venv/bin/python -m bench.profile_one --markdown      # the table docs/BENCHMARKS.md shows
     .venv/bin/python -m bench.profile_one --reading default --markdown
     .venv/bin/python -m bench.profile_one --reading default --blas-threads 1   # numpy's BLAS as the service runs it
+    .venv/bin/python -m bench.profile_one --reading default --blas-threads 1 --curves 128 --requests 6 --markdown
 
 Stages are named by the functions they run (cumulative time), so the same script measures an older checkout too.
 """
@@ -53,13 +54,13 @@ READINGS = {"one-pass": (ONE_PASS, STAGES), "default": (Reading(), DEFAULT_STAGE
 
 
 def measure(
-    model_dir: Path, requests: int, reading: str = "one-pass", blas_threads: int | None = None
+    model_dir: Path, requests: int, reading: str = "one-pass", blas_threads: int | None = None, curves: int = 1
 ) -> dict[str, float]:
     asked, stages = READINGS[reading]
     rt = CurveRuntime.load(model_dir, sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
     if blas_threads is not None:
         limit_blas_threads(blas_threads)  # as the service does (inference/cpus.py)
-    plane = ceiling.curves(1, seed=1)
+    plane = ceiling.curves(curves, seed=1)
     one = list(ceiling.callers_curves(plane, seed=1))
     rt.reconstruct(one, asked)
     wall, cpu, graphs = _interleaved(rt, one, asked, np.asarray(plane, np.float32), requests)
@@ -110,14 +111,15 @@ def _interleaved(
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--model-dir", default=str(ROOT / "models"), help="the model (default: the shipped one)")
-    p.add_argument("--requests", type=int, default=300, help="single-curve requests (default: 300)")
+    p.add_argument("--requests", type=int, default=300, help="requests (default: 300)")
+    p.add_argument("--curves", type=int, default=1, help="curves a request (default: 1)")
     p.add_argument("--reading", choices=list(READINGS), default="one-pass", help="the request's reading")
     p.add_argument(
         "--blas-threads", type=int, default=None, help="cap numpy's BLAS threads as the service does (default: its own)"
     )
     p.add_argument("--markdown", action="store_true", help="print a Markdown table")
     a = p.parse_args()
-    r = measure(Path(a.model_dir), a.requests, a.reading, a.blas_threads)
+    r = measure(Path(a.model_dir), a.requests, a.reading, a.blas_threads, a.curves)
     if a.markdown:
         print("| stage | share of the request |\n|---|---|")
         for k, v in r.items():
