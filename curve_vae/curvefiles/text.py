@@ -75,7 +75,8 @@ def _columns(header: list[str], number_line: int, name: str) -> tuple[int, int, 
 
 def parse_csv(text: str, name: str) -> list[np.ndarray]:
     """Curves from CSV or TSV: one point a row. Without a header, a row is `x,y` and a blank line starts the next
-    curve; with one, the columns named x and y are read and a `curve` (or `name`) column groups the rows."""
+    curve; with one, the columns named x and y are read and a `curve` (or `name`) column groups the rows, each
+    curve's rows one after another."""
     lines = text.splitlines()
     first = next((i for i, line in enumerate(lines) if line.strip()), None)
     if first is None:
@@ -86,6 +87,7 @@ def parse_csv(text: str, name: str) -> list[np.ndarray]:
     x, y, key = _columns(cells, first + 1, name) if header else (0, 1, None)
     curves: list[list[tuple[float, float]]] = [[]]
     last = None
+    began: dict[str, int] = {}  # each curve name's first row (1-based)
     for i in range(first + header, len(lines)):
         if not lines[i].strip():
             curves.append([])
@@ -95,8 +97,17 @@ def parse_csv(text: str, name: str) -> list[np.ndarray]:
         if values[0] is None or values[1] is None or (not header and len(row) != 2):
             what = "two numbers x,y" if not header or len(cells) == 2 else "numbers in the columns named x and y"
             raise CurveFileError(f"{name}:{i + 1}: expected {what}, got {lines[i].strip()!r}")
-        if key is not None and row[key] != last:
-            curves.append([])
-            last = row[key]
+        if key is not None:
+            if key >= len(row):
+                raise CurveFileError(f"{name}:{i + 1}: no column {cells[key]!r} in {lines[i].strip()!r}")
+            if row[key] != last:
+                if row[key] in began:  # joined or kept apart, either guess could be wrong: the file says which
+                    raise CurveFileError(
+                        f"{name}:{i + 1}: curve {row[key]!r} again after other curves (its rows begin at row "
+                        f"{began[row[key]]}): list each curve's rows one after another, or name the pieces apart"
+                    )
+                began[row[key]] = i + 1
+                curves.append([])
+                last = row[key]
         curves[-1].append((values[0], values[1]))
     return as_curves([c for c in curves if c], name)

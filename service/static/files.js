@@ -73,6 +73,7 @@
     }
     const curves = [[]];
     let last = null;
+    const began = new Map();  // each curve name's first row (1-based)
     for (let i = first + (header ? 1 : 0); i < lines.length; i++) {
       if (!lines[i].trim()) { curves.push([]); continue; }
       const row = cells(lines[i], delimiter);
@@ -81,7 +82,18 @@
         const what = !header || head.length === 2 ? "two numbers x,y" : "numbers in the columns named x and y";
         throw new CurveFileError(`${name}:${i + 1}: expected ${what}, got "${lines[i].trim()}"`);
       }
-      if (key >= 0 && row[key] !== last) { curves.push([]); last = row[key]; }
+      if (key >= 0) {
+        if (row[key] === undefined) throw new CurveFileError(`${name}:${i + 1}: no column '${head[key]}' in '${lines[i].trim()}'`);
+        if (row[key] !== last) {
+          if (began.has(row[key])) {  // joined or kept apart, either guess could be wrong: the file says which
+            throw new CurveFileError(`${name}:${i + 1}: curve '${row[key]}' again after other curves (its rows begin at row ` +
+              `${began.get(row[key])}): list each curve's rows one after another, or name the pieces apart`);
+          }
+          began.set(row[key], i + 1);
+          curves.push([]);
+          last = row[key];
+        }
+      }
       curves[curves.length - 1].push([px, py]);
     }
     return checked(curves, name);

@@ -182,3 +182,24 @@ def test_the_page_reads_a_file_as_the_command_line_does(browser, server, name): 
     for g, w in zip(got, want):
         np.testing.assert_allclose(g, w, rtol=1e-15, atol=0)
     assert errors == []
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        pytest.param("curve,x,y\nA,0,0\nA,1,1\nA,2,0\nA,3,1\nB,0,0\nB,1,1\nB,2,0\nB,3,1\nA,4,0\n", id="curve-again"),
+        pytest.param("x,y,curve\n0,0,A\n1,1\n2,0,A\n3,1,A\n", id="no-name-cell"),
+    ],
+)
+def test_the_page_refuses_a_csv_as_the_command_line_does(browser, server, text):  # noqa: F811
+    """A curve's rows apart, or a row without the curve column: the same message from files.js and curvefiles."""
+    from curve_vae.curvefiles import CurveFileError
+    from curve_vae.curvefiles.text import parse_csv
+
+    page, errors = open_page(browser, server.url + "/")
+    got = page.evaluate(
+        "(text) => { try { window.curveFiles.parse('c.csv', text); return null } catch (e) { return e.message } }", text
+    )
+    with pytest.raises(CurveFileError) as want:
+        parse_csv(text, "c.csv")
+    assert got == str(want.value) and errors == []

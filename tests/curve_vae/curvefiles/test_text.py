@@ -60,6 +60,15 @@ def test_text_files_in_every_shape(tmp_path, name, text, curves):
             id="cols",
         ),
         pytest.param("three.csv", "0,0,1\n", r"three\.csv:1: expected two numbers x,y", id="csv-columns"),
+        pytest.param(
+            "again.csv",
+            "curve,x,y\nA,0,0\nA,1,1\nA,2,0\nA,3,1\nB,0,0\nB,1,1\nB,2,0\nB,3,1\nA,4,0\n",
+            r"again\.csv:10: curve 'A' again after other curves \(its rows begin at row 2\): list each curve's rows",
+            id="curve-again",
+        ),
+        pytest.param(
+            "short.csv", "x,y,curve\n0,0,A\n1,1\n", r"short\.csv:3: no column 'curve' in '1,1'", id="no-name-cell"
+        ),
         pytest.param("empty.json", "[]", r"empty\.json: no curve in this file", id="json-empty"),
         pytest.param("other.json", '{"latents": []}', r"other\.json: a JSON object needs a 'curves' list", id="obj"),
         pytest.param("nopts.json", '{"curves": [{"name": "A"}]}', r"curves\[0\] \(A\) is an object without 'points'"),
