@@ -159,7 +159,7 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
     # Workers are fresh processes: they rebuild the same settings from the environment.
     os.environ.update(_as_env(settings))
     with _shared_metrics():
-        app = "curve_vae.service.app:create_app_from_env"
+        app = "curve_vae.service.server:supervised_app"
         if not listeners.balances_connections():
             uvicorn.run(app, factory=True, workers=settings.workers, **common)
             return
@@ -179,6 +179,34 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
             listener.close()
         if any(p.exitcode == STARTUP_FAILURE for p in supervisor.processes):
             raise SystemExit(STARTUP_FAILURE)  # uvicorn's supervisor stops, but would exit 0
+
+
+#: How often a worker looks for its supervisor, seconds.
+SUPERVISOR_CHECK_S = 1.0
+
+
+def supervised_app() -> Any:
+    """The app of one of `_run_workers`' worker processes (uvicorn's factory, in the worker), which also stops the
+    worker when its supervisor is gone: a supervisor killed outright (SIGKILL, the OOM killer) cannot stop its
+    workers, and they would go on holding the port, the model's memory and a share of the connections that no one
+    restarts. The worker asks itself to stop (SIGTERM: requests in flight finish) once its parent is another."""
+    import logging
+    import signal
+    import threading
+    import time
+
+    from curve_vae.service.app import create_app_from_env
+
+    supervisor = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == supervisor:
+            time.sleep(SUPERVISOR_CHECK_S)
+        logging.getLogger("uvicorn.error").warning("the supervisor (pid %d) is gone: this worker stops", supervisor)
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    threading.Thread(target=watch, name="supervisor-watch", daemon=True).start()
+    return create_app_from_env()
 
 
 @contextlib.contextmanager

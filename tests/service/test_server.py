@@ -10,12 +10,15 @@ import signal
 import subprocess
 import tempfile
 import threading
+import time
 from pathlib import Path
 
 import httpx
 import numpy as np
 import onnxruntime as ort
 import pytest
+
+from curve_vae.service.live import listening_sockets
 
 ROOT = Path(__file__).resolve().parents[2]
 C = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
@@ -103,6 +106,30 @@ def test_two_workers_share_the_connections_out(server_factory, model_dir, curves
     # 32 connections hashed to 2 sockets, one worker getting 85% of the work has odds under 1 in 10,000
     assert used[-2] >= 0.15 * (used[-1] + used[-2]), used
     assert server.stop() == 0
+
+
+def test_workers_stop_when_their_supervisor_is_killed(server_factory, model_dir):
+    """SIGKILL to the supervisor: it cannot stop its workers, so each stops itself within seconds (the port is free
+    again for a restarted server), rather than serve on as orphans."""
+    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
+    server.wait_ready(timeout=90, listeners=2)
+    workers = [pid for pid in server.pids() if pid != server.proc.pid]
+    assert len(workers) >= 2  # the two workers (and multiprocessing's resource tracker)
+    server.proc.kill()
+    server.proc.wait(timeout=10)
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and not all(_gone(pid) for pid in workers):
+        time.sleep(0.2)
+    assert all(_gone(pid) for pid in workers), "workers outlived their supervisor"
+    assert listening_sockets(server.port) in (0, None)
+
+
+def _gone(pid: int) -> bool:
+    """Whether a process has exited (a zombie not yet reaped by whoever adopted it counts as exited)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
 
 
 def test_workers_refuse_a_port_another_server_listens_on(server_factory, model_dir):
