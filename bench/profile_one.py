@@ -1,8 +1,8 @@
 """Where a single-curve request's time goes in-process: `CurveRuntime.reconstruct` of one caller curve (`--curves N`:
-of N, as one request), no cache, one 1-thread session pair, under cProfile; each stage's share of the time, and the wall time per request without
-the profiler beside that of its two graphs alone (issue 39's "≤ 2× its graphs"). `--reading one-pass` (the
-default): pose "canonical", spacing "parameter" (one encoding, one decoding); `--reading default`: what a request
-with default fields gets (the shipped model's learned reading).
+of N, as one request), no cache, one 1-thread session pair, under cProfile; each stage's share of the time, and the
+wall time per request without the profiler beside that of its two graphs alone (issue 39's "≤ 2× its graphs").
+`--reading one-pass` (the default): pose "canonical", spacing "parameter" (one encoding, one decoding); `--reading
+default`: what a request with default fields gets (the shipped model's learned reading).
 
     .venv/bin/python -m bench.profile_one                 # 300 requests
     .venv/bin/python -m bench.profile_one --markdown      # the table docs/BENCHMARKS.md shows

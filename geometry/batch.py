@@ -183,14 +183,15 @@ def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[F
     mirror = _turns_clockwise(pts)
     flip = np.stack([np.where(mirror, -1.0, 1.0), np.ones(len(pts))], axis=-1)  # (k, 2)
     heading = _chord_heading(pts * flip[:, None, :], _arc_centroid(pts) * flip)
-    turns, mirrors, reverses = [], [], []  # per pose (k,), (k,) and one flag, in pose_frames' order
+    poses: list[tuple[np.ndarray, np.ndarray, bool]] = []  # (rotation (k,), mirror (k,), reverse), in pose order
     for target in POSE_CHORDS[:chords]:
         turn = np.angle(np.exp(1j * (target - heading)))
-        turns.append(turn), mirrors.append(mirror), reverses.append(False)
+        poses.append((turn, mirror, False))
         if flips:
             # reflected across the chord's normal after the turn and the mirror (frame.pose_candidates' S·R(turn)·M):
             # two reflections, whose axes lie at target + π/2 and (turn + π) / 2, make the turn 2·target − turn
-            turns.append(np.angle(np.exp(1j * (2 * target - turn)))), mirrors.append(~mirror), reverses.append(True)
+            poses.append((np.angle(np.exp(1j * (2 * target - turn))), ~mirror, True))
+    turns, mirrors, reverses = zip(*poses)
     turn, mir = np.stack(turns, axis=1), np.stack(mirrors, axis=1)  # (k, poses)
     linear = _linear(turn.ravel(), mir.ravel()).reshape(*turn.shape, 2, 2)
     q = np.einsum("knd,kpde->kpne", pts, linear)  # every pose's bounding box at once (frame.posed_frame)
