@@ -12,6 +12,7 @@ with the same reading come from the encoding cache. `refine` fits each latent cl
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Sequence
 from typing import Any
 
@@ -200,7 +201,7 @@ class Reader:
         The candidate poses are found for all curves at once (geometry.batch); shared: the set's poses, the same for
         every curve (geometry.batch.shared_pose_frames)."""
         posed: list[list[Frame]] | None = None
-        try:
+        with contextlib.suppress(ValueError), np.errstate(all="ignore"):  # the curve whose points coincide: below
             if shared and reading.pose == "canonical":
                 posed = [[f] for f in shared_canonical_frames(inputs)]
             elif shared:
@@ -209,8 +210,6 @@ class Reader:
                 posed = [[f] for f in canonical_frames(inputs)]
             elif reading.frame != "model" and reading.pose in ("search", "learned"):
                 posed = pose_frames_of(inputs, chords=POSE_CHORD_COUNT)
-        except ValueError:
-            pass  # the curve whose points coincide is named below
         natural = (
             self._natural_readings(inputs, index, self._natural_fit(reading))
             if reading.spacing in ("search", "natural")

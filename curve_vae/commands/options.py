@@ -164,15 +164,21 @@ def reading_fields(a: argparse.Namespace) -> dict[str, Any]:
 
 
 def model_runtime(a: argparse.Namespace, priors_dir: Path | None = None):
+    from curve_vae.inference.cpus import limit_blas_threads
     from curve_vae.inference.runtime import CurveRuntime
     from curve_vae.inference.shipped import model_directory
 
     model_dir = model_directory(a.model_dir)
     flag: str | None = getattr(a, "priors_dir", "") or None  # --priors-dir, where the command has it
     priors = priors_dir or flag
-    return CurveRuntime.load(
+    runtime = CurveRuntime.load(
         model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False, priors_dir=priors
     )
+    # numpy's BLAS on one thread, as a Ray job's actors run it: more threads only cost CPU on the reading's small
+    # products (inference/cpus.py), and their float32 rounding differs, which can tip a near-tie between two readings
+    # of a curve, so that a command and a Ray job of the same curves would not write the same answer
+    limit_blas_threads(1)
+    return runtime
 
 
 def add_server_option(p: argparse.ArgumentParser) -> None:
