@@ -76,7 +76,7 @@ def _columns(header: list[str], number_line: int, name: str) -> tuple[int, int, 
 def parse_csv(text: str, name: str) -> list[np.ndarray]:
     """Curves from CSV or TSV: one point a row. Without a header, a row is `x,y` and a blank line starts the next
     curve; with one, the columns named x and y are read and a `curve` (or `name`) column groups the rows, each
-    curve's rows one after another."""
+    curve's rows one after another (blank lines between them change nothing)."""
     lines = text.splitlines()
     first = next((i for i, line in enumerate(lines) if line.strip()), None)
     if first is None:
@@ -90,7 +90,8 @@ def parse_csv(text: str, name: str) -> list[np.ndarray]:
     began: dict[str, int] = {}  # each curve name's first row (1-based)
     for i in range(first + header, len(lines)):
         if not lines[i].strip():
-            curves.append([])
+            if key is None:  # a blank line starts the next curve; where a column names the curves, the names do
+                curves.append([])
             continue
         row = _cells(lines[i], delimiter)
         values = [number(row[j]) if j < len(row) else None for j in (x, y)]

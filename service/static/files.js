@@ -75,7 +75,10 @@
     let last = null;
     const began = new Map();  // each curve name's first row (1-based)
     for (let i = first + (header ? 1 : 0); i < lines.length; i++) {
-      if (!lines[i].trim()) { curves.push([]); continue; }
+      if (!lines[i].trim()) {  // a blank line starts the next curve; where a column names the curves, the names do
+        if (key < 0) curves.push([]);
+        continue;
+      }
       const row = cells(lines[i], delimiter);
       const [px, py] = [number(row[x] ?? ""), number(row[y] ?? "")];
       if (px === null || py === null || (!header && row.length !== 2)) {

@@ -203,3 +203,15 @@ def test_the_page_refuses_a_csv_as_the_command_line_does(browser, server, text):
     with pytest.raises(CurveFileError) as want:
         parse_csv(text, "c.csv")
     assert got == str(want.value) and errors == []
+
+
+def test_the_page_reads_named_rows_across_blank_lines_as_the_command_line_does(browser, server):  # noqa: F811
+    from curve_vae.curvefiles.text import parse_csv
+
+    text = "curve,x,y\nA,0,0\nA,1,1\n\nA,2,0\nA,3,1\n\nB,5,5\nB,6,6\nB,7,5\nB,8,6\n"
+    page, errors = open_page(browser, server.url + "/")
+    got = page.evaluate("(text) => window.curveFiles.parse('c.csv', text).curves", text)
+    want = parse_csv(text, "c.csv")
+    assert [len(c) for c in got] == [len(c) for c in want] == [4, 4] and errors == []
+    for g, w in zip(got, want):
+        np.testing.assert_array_equal(g, w)

@@ -97,6 +97,13 @@ def test_csv_rows_in_any_layout_give_the_points(text):
     assert curve.dtype == np.float64
 
 
+def test_where_a_column_names_the_curves_blank_lines_change_nothing():
+    text = "curve,x,y\nA,0,0\nA,1,1\n\nA,2,0\nA,3,1\n\n\nB,5,5\nB,6,6\nB,7,5\nB,8,6\n"
+    a, b = parse_csv(text, "gaps.csv")
+    np.testing.assert_array_equal(a, SQUARE_WAVE)
+    np.testing.assert_array_equal(b, np.asarray(SQUARE_WAVE) + 5)
+
+
 def test_a_curve_column_starts_a_curve_where_its_value_changes():
     text = "curve,role,index,x,y\nA,input,0,0,0\nA,input,1,1,1\nA,input,2,2,0\nA,input,3,3,1\n"
     text += "B,input,0,5,5\nB,input,1,6,6\nB,input,2,7,5\nB,input,3,8,6\n"
