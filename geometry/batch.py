@@ -13,8 +13,9 @@ Python).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -30,6 +31,8 @@ from curve_vae.geometry.frame import (
     signed_turning,
     turns_clockwise,
 )
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -115,11 +118,16 @@ class FrameRows:
 def canonical_frames(curves: Sequence[np.ndarray]) -> list[Frame]:
     """`frame.canonical_frame` of every curve, computed for the curves of each length together. Raises ValueError
     naming the first curve whose points all coincide."""
-    out: dict[int, Frame] = {}
+    return _by_length(curves, _canonical_same_length)
+
+
+def _by_length(curves: Sequence[np.ndarray], per_length: Callable[[np.ndarray], list[T]]) -> list[T]:
+    """`per_length` of the curves of each length stacked (k, n, 2), its answers back in the curves' order."""
+    out: dict[int, T] = {}
     lengths = np.array([len(c) for c in curves])
     for n in np.unique(lengths):
         idx: list[int] = np.flatnonzero(lengths == n).tolist()
-        out.update(zip(idx, _canonical_same_length(np.stack([np.asarray(curves[i], np.float64) for i in idx]))))
+        out.update(zip(idx, per_length(np.stack([np.asarray(curves[i], np.float64) for i in idx]))))
     return [out[i] for i in range(len(curves))]
 
 
@@ -167,13 +175,7 @@ def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
 def pose_frames_of(curves: Sequence[np.ndarray], *, chords: int = 3, flips: bool = True) -> list[list[Frame]]:
     """`frame.pose_frames` of every curve, computed for the curves of each length together. Raises ValueError naming
     the first curve whose points all coincide."""
-    out: dict[int, list[Frame]] = {}
-    lengths = np.array([len(c) for c in curves])
-    for n in np.unique(lengths):
-        idx: list[int] = np.flatnonzero(lengths == n).tolist()
-        pts = np.stack([np.asarray(curves[i], np.float64) for i in idx])
-        out.update(zip(idx, _poses_same_length(pts, chords, flips)))
-    return [out[i] for i in range(len(curves))]
+    return _by_length(curves, lambda pts: _poses_same_length(pts, chords, flips))
 
 
 def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[Frame]]:
