@@ -42,6 +42,16 @@ class Encoding:
     frames: list[Frame | None]
 
 
+def _cuts(sizes: Sequence[int]) -> list[slice]:
+    ends = np.cumsum(sizes)
+    return [slice(int(e - n), int(e)) for n, e in zip(sizes, ends)]
+
+
+def split_encoding(enc: Encoding, sizes: Sequence[int]) -> list[Encoding]:
+    """`enc` cut into consecutive parts of `sizes` curves (inference.coalescing: each request's own)."""
+    return [Encoding(enc.mean[c], enc.log_var[c], enc.frames[c]) for c in _cuts(sizes)]
+
+
 def head_splines(splines: Sequence[Spline | None], has_splines: bool) -> list[Spline] | None:
     """A result's splines: each curve's from a model with a B-spline head (which returns one for every curve), None
     from a model without one."""
@@ -68,6 +78,16 @@ class Reconstruction:
     latents: np.ndarray  # (B, latent_dim)
     frames: list[Frame | None]
     splines: list[Spline] | None = None
+
+
+def split_reconstruction(rec: Reconstruction, sizes: Sequence[int]) -> list[Reconstruction]:
+    """`rec` cut into consecutive parts of `sizes` curves (inference.coalescing: each request's own)."""
+    return [
+        Reconstruction(
+            rec.curves[c], rec.mse[c], rec.latents[c], rec.frames[c], None if rec.splines is None else rec.splines[c]
+        )
+        for c in _cuts(sizes)
+    ]
 
 
 @dataclass(frozen=True)

@@ -35,6 +35,7 @@ from starlette.exceptions import HTTPException
 
 from curve_vae.inference.batching import GraphBatcher
 from curve_vae.inference.batching import attach as attach_batcher
+from curve_vae.inference.coalescing import runtime_coalescer
 from curve_vae.inference.cpus import (
     available_cpus,
     inference_slots,
@@ -75,6 +76,15 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     runtime: CurveRuntime = app.state.runtime
     batcher = _start_batcher(app, settings, runtime) if settings.micro_batch else None
     app.state.batcher = batcher
+    app.state.coalescer = (
+        runtime_coalescer(
+            runtime,
+            max_curves=settings.coalesce_curves,
+            observe=lambda jobs, _curves: app.state.metrics.coalesced.observe(jobs),
+        )
+        if settings.coalesce_curves
+        else None
+    )
     app.state.ready = True
     app.state.metrics.ready.set(1)
     log.info(
@@ -201,6 +211,7 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
     )
     app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
     app.state.metrics = Metrics()
+    app.state.coalescer = None  # the lifespan's, over the runtime
     app.state.pending = 0  # requests in deps.run_inference: running or waiting for an inference slot
     app.state.slots = inference_slots(settings)
     app.state.executor = inference_executor(app.state.slots)

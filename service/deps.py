@@ -5,15 +5,17 @@ from __future__ import annotations
 
 import asyncio
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from typing import Annotated, Any, TypeVar
 
 import anyio
+import numpy as np
 from fastapi import Depends, Request
 from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
 from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable
+from curve_vae.inference.coalescing import Coalescer, Read, read_alone
 from curve_vae.inference.cpus import blas_threads
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.runtime import CurveRuntime
@@ -100,14 +102,39 @@ async def _watch_disconnect(request: Request, token: CancelToken) -> None:
         await asyncio.sleep(DISCONNECT_POLL_S)
 
 
-async def run_inference(request: Request, route: str, batch: int, work: Callable[[], Response]) -> Response:
+def coalescer_of(request: Request) -> Coalescer[Read] | None:
+    """The app's coalescer of concurrent /encode and /reconstruct requests, None where CURVE_VAE_COALESCE_CURVES=0."""
+    return getattr(request.app.state, "coalescer", None)
+
+
+async def coalesced(
+    request: Request, route: str, key: Hashable, curves: list[np.ndarray], render: Callable[[Any], Response]
+) -> Response:
+    """`run_inference` of a job the app's coalescer may read together with other requests' (inference.coalescing):
+    registered before it queues, so requests that queue together are read together; `render` builds the response
+    from this request's own part. Without a coalescer, the job is read alone."""
+    coalescer = coalescer_of(request)
+    if coalescer is None:
+        runtime = runtime_of(request)
+        return await run_inference(request, route, len(curves), lambda: render(read_alone(runtime, key, curves)))
+    job = coalescer.submit(key, curves)
+    try:
+        return await run_inference(request, route, len(curves), lambda: render(coalescer.result(job)), token=job.token)
+    finally:
+        coalescer.forget(job)
+
+
+async def run_inference(
+    request: Request, route: str, batch: int, work: Callable[[], Response], *, token: CancelToken | None = None
+) -> Response:
     """Run `work` (inference and JSON rendering) on an inference thread, never on the event loop; timed, and at
     most one per inference slot (CURVE_VAE_INFERENCE_CONCURRENCY) at once.
 
     Bounded both ways: with `slots + max_queue` requests already in here, a new one is answered 503 with
     Retry-After at once instead of joining an ever longer queue; one that takes longer than `request_timeout`
     seconds (queueing included) is answered 504. Either way, and when the client disconnects, the work is cancelled:
-    its thread stops at the next chunk boundary and the slot is free for the next request.
+    its thread stops at the next chunk boundary and the slot is free for the next request. `token`: the request's
+    own, where its work was registered under it before (a coalesced job's).
     """
     settings: Settings = request.app.state.settings
     state = request.app.state
@@ -122,7 +149,7 @@ async def run_inference(request: Request, route: str, batch: int, work: Callable
     metrics.batch_size.labels(route).observe(batch)
     state.pending += 1
     start = time.perf_counter()
-    token = CancelToken()
+    token = token or CancelToken()
     watcher = asyncio.ensure_future(_watch_disconnect(request, token))
     try:
         with anyio.fail_after(settings.request_timeout or None):

@@ -37,6 +37,7 @@ def multiprocess_mode() -> bool:
 
 LATENCY_BUCKETS = (0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0)
 BATCH_BUCKETS = (1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 4096)
+COALESCED_BUCKETS = (1, 2, 3, 4, 6, 8, 12, 16, 24, 32)
 UNMATCHED = "unmatched"  # route label of paths no route serves, so scanners cannot blow up the label set
 
 
@@ -70,6 +71,12 @@ class Metrics:
             "Time in the worker thread: pre-processing, ONNX runs, post-processing and JSON rendering.",
             ["route"],
             buckets=LATENCY_BUCKETS,
+            registry=self.registry,
+        )
+        self.coalesced = Histogram(
+            "curve_vae_coalesced_requests",
+            "Requests (/encode, /reconstruct) read together in each batch (CURVE_VAE_COALESCE_CURVES).",
+            buckets=COALESCED_BUCKETS,
             registry=self.registry,
         )
         self.cancelled = Counter(

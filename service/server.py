@@ -63,6 +63,12 @@ _OPTIONS: list[tuple[str, str, Any, str]] = [
     ("--micro-batch", "micro_batch", str, "true: gather concurrent requests' graph runs into one run"),
     ("--micro-batch-rows", "micro_batch_rows", int, "most rows (curves, latents) of one micro-batched run"),
     ("--micro-batch-wait-ms", "micro_batch_wait_ms", float, "most milliseconds a run waits for others to join it"),
+    (
+        "--coalesce-curves",
+        "coalesce_curves",
+        int,
+        "most curves of concurrent /encode and /reconstruct requests read as one batch; 0: each alone",
+    ),
     ("--access-log", "access_log", str, "true: log a line per request (uvicorn's access log)"),
     ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
     ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),

@@ -47,6 +47,9 @@ class Settings(BaseSettings):
     micro_batch: bool = False
     micro_batch_rows: int = Field(default=32, ge=1)
     micro_batch_wait_ms: float = Field(default=2.0, ge=0, le=1000)
+    # Requests that queue for an inference thread at once read as one batch of at most this many curves, each
+    # answered its own part (inference/coalescing.py: /encode and /reconstruct of equal options); 0: each alone
+    coalesce_curves: int = Field(default=32, ge=0)
     access_log: bool = False  # uvicorn's line per request: log volume (its CPU cost is within noise, BENCHMARKS)
     # requests waiting for an inference slot; beyond them: 503 with Retry-After
     max_queue: int = Field(default=64, ge=0)

@@ -10,11 +10,13 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
 from curve_vae.inference.bodies import decode_body, encode_body, interpolate_body, reconstruct_body
+from curve_vae.inference.coalescing import encode_key, reconstruct_key
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.results import Reconstruction
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
-from curve_vae.service.deps import check_output, run_inference, runtime_of, settings_of
+from curve_vae.service.deps import check_output, coalesced, run_inference, runtime_of, settings_of
 from curve_vae.service.fastjson import JSON, FastJSONRoute
 from curve_vae.service.limits import check_weights
 from curve_vae.service.routing import model_route
@@ -36,12 +38,8 @@ curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 async def encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray]) -> Response:
     """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance).
     The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
-    runtime = runtime_of(request)
-
-    def work() -> Response:
-        return JSON(encode_body(runtime.encode(curves, req.reading())))
-
-    return await run_inference(request, "/encode", len(curves), work)
+    runtime_of(request)  # 503 until the model is loaded
+    return await coalesced(request, "/encode", encode_key(req.reading()), curves, lambda enc: JSON(encode_body(enc)))
 
 
 @model_route(
@@ -90,14 +88,12 @@ async def decode(request: Request, req: s.DecodeRequest, _curves: list[np.ndarra
 async def reconstruct(request: Request, req: s.ReconstructRequest, curves: list[np.ndarray]) -> Response:
     """Encode each curve's latent mean and decode it: the reconstruction in the caller's frame, and its MSE there.
     The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
-    runtime = runtime_of(request)
-    check_output(req.output, runtime)
+    check_output(req.output, runtime_of(request))
 
-    def work() -> Response:
-        rec = runtime.reconstruct(curves, req.reading(), n_points=req.n_points)
+    def render(rec: Reconstruction) -> Response:
         return JSON(reconstruct_body(rec, metrics=req.metrics, output=req.output))
 
-    return await run_inference(request, "/reconstruct", len(curves), work)
+    return await coalesced(request, "/reconstruct", reconstruct_key(req.reading(), req.n_points), curves, render)
 
 
 @model_route(
