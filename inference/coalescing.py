@@ -10,6 +10,10 @@ waits its thread runs the next batch of untaken jobs, if any. A lone request run
 its latency — and under load the batches grow with the queue.
 
 - Only jobs with equal options (the reading, `n_points`) share a batch; a job larger than `max_curves` runs alone.
+- At most `readers` batches are read at once (the service: the CPUs of a worker, so one on 2 cores with 2 workers):
+  a thread that would start another waits, and the jobs queueing meanwhile make the next batch larger. Two batches
+  sharing one core cost more than one of both (measured: single-curve requests on 16 connections, 132 requests/s
+  with a batch per inference thread, 156 with one per worker; docs/BENCHMARKS.md).
 - A failing batch (a bad curve in one job) is run again job by job, so an error names its own request's curve.
 - A batch is cancelled only when every job in it is (each job's token, inference.cancel); a job abandoned before it
   was taken is never read.
@@ -79,9 +83,12 @@ class Coalescer(Generic[R]):
         split: Callable[[R, list[int]], list[R]],
         *,
         max_curves: int = 32,
+        readers: int | None = None,
         observe: Callable[[int, int], None] | None = None,
     ) -> None:
         self._read, self._split, self.max_curves = read, split, max_curves
+        self.readers = readers  # batches read at once (None: one per thread that asks)
+        self._reading = 0
         self._observe = observe  # (jobs, curves) of each batch run: the service's histogram
         self._changed = threading.Condition()  # a job registered or a batch finished
         self._pending: list[Job[R]] = []
@@ -111,6 +118,8 @@ class Coalescer(Generic[R]):
             try:
                 self._run(batch)
             finally:
+                with self._changed:
+                    self._reading -= 1
                 for j in batch:  # an error past Exception (KeyboardInterrupt) still ends every job of the batch
                     if not j.done.is_set():
                         j.finish(error=Cancelled("the batch reading this request stopped"))
@@ -131,11 +140,12 @@ class Coalescer(Generic[R]):
         while not job.done.is_set():
             if not job.taken and job.token.cancelled:  # abandoned: read alone, which stops at once
                 return self._take(job, alone=True)
-            if not job.taken:
-                return self._take(job)
-            live = self._live()
-            if live:
-                return self._take(live[0])
+            if self.readers is None or self._reading < self.readers:
+                if not job.taken:
+                    return self._take(job)
+                live = self._live()
+                if live:
+                    return self._take(live[0])
             self._changed.wait()
         return None
 
@@ -146,6 +156,7 @@ class Coalescer(Generic[R]):
             if j is not first and j.key == first.key and count + len(j.curves) <= self.max_curves:
                 batch.append(j)
                 count += len(j.curves)
+        self._reading += 1
         for j in batch:
             j.taken = True
             if j in self._pending:  # `first` may have been forgotten (its request ended): it is read alone
@@ -184,7 +195,11 @@ Read: TypeAlias = Encoding | Reconstruction
 
 
 def runtime_coalescer(
-    runtime: CurveRuntime, *, max_curves: int = 32, observe: Callable[[int, int], None] | None = None
+    runtime: CurveRuntime,
+    *,
+    max_curves: int = 32,
+    readers: int | None = None,
+    observe: Callable[[int, int], None] | None = None,
 ) -> Coalescer[Read]:
     """A coalescer of `runtime.encode` and `runtime.reconstruct` calls: jobs keyed `(kind, reading, n_points)`,
     kind "encode" or "reconstruct" (`encode_key`, `reconstruct_key`)."""
@@ -197,7 +212,7 @@ def runtime_coalescer(
             return list(split_encoding(result, sizes))
         return list(split_reconstruction(result, sizes))
 
-    return Coalescer(read, split, max_curves=max_curves, observe=observe)
+    return Coalescer(read, split, max_curves=max_curves, readers=readers, observe=observe)
 
 
 def read_alone(runtime: CurveRuntime, key: Hashable, curves: Sequence[np.ndarray]) -> Read:

@@ -80,6 +80,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
         runtime_coalescer(
             runtime,
             max_curves=settings.coalesce_curves,
+            readers=max(1, available_cpus() // worker_count(settings)),
             observe=lambda jobs, _curves: app.state.metrics.coalesced.observe(jobs),
         )
         if settings.coalesce_curves

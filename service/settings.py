@@ -48,7 +48,8 @@ class Settings(BaseSettings):
     micro_batch_rows: int = Field(default=32, ge=1)
     micro_batch_wait_ms: float = Field(default=2.0, ge=0, le=1000)
     # Requests that queue for an inference thread at once read as one batch of at most this many curves, each
-    # answered its own part (inference/coalescing.py: /encode and /reconstruct of equal options); 0: each alone
+    # answered its own part (inference/coalescing.py: /encode and /reconstruct of equal options, requests of at most
+    # half as many curves; one batch at a time a CPU of the worker); 0: each alone
     coalesce_curves: int = Field(default=32, ge=0)
     access_log: bool = False  # uvicorn's line per request: log volume (its CPU cost is within noise, BENCHMARKS)
     # requests waiting for an inference slot; beyond them: 503 with Retry-After

@@ -163,3 +163,32 @@ def test_threads_at_once_each_get_their_own(coalescer, batches, runtime, curves)
     assert batches == [(8, 8)]
     for k, c in enumerate(asked):
         _same(results[k], runtime.reconstruct(c))
+
+
+def test_at_most_readers_batches_at_once():
+    # one reader: a thread whose own job was registered after the first batch was taken waits for that batch
+    # instead of reading beside it, and its job and those that came meanwhile are read as one batch after it
+    gate, reads = threading.Event(), []
+
+    def read(key, items):
+        reads.append(list(items))
+        if len(reads) == 1:
+            assert gate.wait(30)
+        return list(items)
+
+    coalescer = Coalescer(read, lambda got, sizes: [got[i - n : i] for n, i in zip(sizes, np.cumsum(sizes))], readers=1)
+    first = coalescer.submit("k", ["a"])
+    one = threading.Thread(target=coalescer.result, args=(first,))
+    one.start()
+    while not reads:
+        time.sleep(0.001)
+    second = coalescer.submit("k", ["b"])
+    two = threading.Thread(target=coalescer.result, args=(second,))
+    two.start()
+    time.sleep(0.05)
+    third = coalescer.submit("k", ["c"])
+    time.sleep(0.05)
+    assert reads == [["a"]] and not second.done.is_set()  # thread two waits for the reader
+    gate.set()
+    one.join(30), two.join(30)
+    assert reads == [["a"], ["b", "c"]] and coalescer.result(third) == ["c"]

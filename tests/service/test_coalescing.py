@@ -45,6 +45,8 @@ def test_concurrent_requests_each_get_their_own_answer(make_client, curves):
     batches, requests = _coalesced(together.get("/metrics").text)
     assert requests == 16 and batches < 16  # sixteen at once on two inference threads: some read together
     assert _coalesced(alone.get("/metrics").text) == (0, 0)  # off: nothing coalesced
+    large = together.post("/reconstruct", json={"curves": curves(17, 40).tolist()})  # over half a batch: alone
+    assert large.status_code == 200 and _coalesced(together.get("/metrics").text)[1] == 16
 
 
 def test_concurrent_encodings_too(make_client, curves):
