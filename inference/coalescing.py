@@ -10,6 +10,9 @@ waits its thread runs the next batch of untaken jobs, if any. A lone request run
 its latency — and under load the batches grow with the queue.
 
 - Only jobs with equal options (the reading, `n_points`) share a batch; a job larger than `max_curves` runs alone.
+- Right after a batch ends its clients are answered and ask again within a few milliseconds: the next batch waits
+  up to `hold` (5 ms) for as many jobs as the last had, instead of starting with the first to come back while the
+  rest queue behind it (under load, single-curve batches gave way to batches of the connections' number).
 - At most `readers` batches are read at once (the service: the CPUs of a worker, so one on 2 cores with 2 workers):
   a thread that would start another waits, and the jobs queueing meanwhile make the next batch larger. Two batches
   sharing one core cost more than one of both (measured: single-curve requests on 16 connections, 132 requests/s
@@ -24,6 +27,7 @@ its latency — and under load the batches grow with the queue.
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Generic, TypeAlias, TypeVar, cast
@@ -84,11 +88,14 @@ class Coalescer(Generic[R]):
         *,
         max_curves: int = 32,
         readers: int | None = None,
+        hold: float = 0.005,
         observe: Callable[[int, int], None] | None = None,
     ) -> None:
         self._read, self._split, self.max_curves = read, split, max_curves
         self.readers = readers  # batches read at once (None: one per thread that asks)
+        self.hold = hold  # seconds a batch may wait, right after one ended, for as many jobs as it had
         self._reading = 0
+        self._ended, self._last = -1e9, 0  # when the last batch ended (time.monotonic), and its jobs
         self._observe = observe  # (jobs, curves) of each batch run: the service's histogram
         self._changed = threading.Condition()  # a job registered or a batch finished
         self._pending: list[Job[R]] = []
@@ -120,6 +127,7 @@ class Coalescer(Generic[R]):
             finally:
                 with self._changed:
                     self._reading -= 1
+                    self._ended, self._last = time.monotonic(), len(batch)
                 for j in batch:  # an error past Exception (KeyboardInterrupt) still ends every job of the batch
                     if not j.done.is_set():
                         j.finish(error=Cancelled("the batch reading this request stopped"))
@@ -141,6 +149,10 @@ class Coalescer(Generic[R]):
             if not job.taken and job.token.cancelled:  # abandoned: read alone, which stops at once
                 return self._take(job, alone=True)
             if self.readers is None or self._reading < self.readers:
+                held = self._held()
+                if held > 0:
+                    self._changed.wait(held)
+                    continue
                 if not job.taken:
                     return self._take(job)
                 live = self._live()
@@ -148,6 +160,13 @@ class Coalescer(Generic[R]):
                     return self._take(live[0])
             self._changed.wait()
         return None
+
+    def _held(self) -> float:
+        """Seconds a new batch should still wait (under the lock): right after a batch ended, its requests' clients
+        are being answered and will ask again, so a batch started at once would be one of the first to come back and
+        the rest would wait for it. Up to `hold` after a batch ended, until as many jobs wait as it had."""
+        left = self._ended + self.hold - time.monotonic()
+        return left if left > 0 and len(self._live()) < self._last else 0.0
 
     def _take(self, first: Job[R], *, alone: bool = False) -> list[Job[R]]:
         """`first` and (unless alone) the untaken jobs of its key, up to max_curves curves, taken off the register."""

@@ -72,6 +72,9 @@ def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
         "blas_threads": blas_threads(),
         "inference_threads": request.app.state.slots,
         "micro_batch": batching,
+        "coalesce": None
+        if (coalescer := coalescer_of(request)) is None
+        else {"curves": coalescer.max_curves, "readers": coalescer.readers, "hold_ms": coalescer.hold * 1e3},
     }
 
 

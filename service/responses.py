@@ -196,5 +196,6 @@ class ModelInfo(BaseModel):
     execution: dict[str, Any] = Field(
         description="How this worker runs inference, read back from the live onnxruntime sessions: session pairs, "
         "intra- and inter-op threads, spinning; the threads of numpy's and scipy's BLAS (read back with "
-        "threadpoolctl); and the inference threads (slots) and micro-batching in use."
+        "threadpoolctl); and the inference threads (slots), micro-batching and coalescing (concurrent requests read "
+        "as one batch: most curves, batches read at once, milliseconds a batch waits for company after one) in use."
     )

@@ -192,3 +192,42 @@ def test_at_most_readers_batches_at_once():
     gate.set()
     one.join(30), two.join(30)
     assert reads == [["a"], ["b", "c"]] and coalescer.result(third) == ["c"]
+
+
+def _recording(reads):
+    def read(key, items):
+        reads.append(list(items))
+        return list(items)
+
+    return read
+
+
+def _cut(got, sizes):
+    return [got[i - n : i] for n, i in zip(sizes, np.cumsum(sizes))]
+
+
+def test_after_a_batch_the_next_waits_for_as_many_requests():
+    # right after a batch of three, its clients ask again one by one: the first to come back waits for the other
+    # two instead of being read alone while they queue behind it
+    reads: list = []
+    coalescer = Coalescer(_recording(reads), _cut, hold=30.0)
+    jobs = [coalescer.submit("k", [c]) for c in "abc"]
+    coalescer.result(jobs[0])
+    x = coalescer.submit("k", ["x"])
+    waiter = threading.Thread(target=coalescer.result, args=(x,))
+    waiter.start()
+    time.sleep(0.05)
+    assert reads == [["a", "b", "c"]]  # x waits for company
+    later = [coalescer.submit("k", [c]) for c in "yz"]
+    waiter.join(30)
+    assert reads == [["a", "b", "c"], ["x", "y", "z"]] and all(j.done.is_set() for j in later)
+
+
+def test_a_lone_request_after_a_batch_waits_at_most_hold():
+    reads: list = []
+    coalescer = Coalescer(_recording(reads), _cut, hold=0.05)
+    jobs = [coalescer.submit("k", [c]) for c in "abc"]
+    coalescer.result(jobs[0])
+    started = time.monotonic()
+    assert coalescer.result(coalescer.submit("k", ["x"])) == ["x"]
+    assert time.monotonic() - started < 1.0 and reads == [["a", "b", "c"], ["x"]]

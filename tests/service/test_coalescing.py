@@ -49,6 +49,15 @@ def test_concurrent_requests_each_get_their_own_answer(make_client, curves):
     assert large.status_code == 200 and _coalesced(together.get("/metrics").text)[1] == 16
 
 
+def test_model_reports_coalescing(make_client):
+    assert make_client(coalesce_curves=16).get("/model").json()["execution"]["coalesce"] == {
+        "curves": 16,
+        "readers": 1,  # the tests' app: one worker a CPU
+        "hold_ms": 5.0,
+    }
+    assert make_client(coalesce_curves=0).get("/model").json()["execution"]["coalesce"] is None
+
+
 def test_concurrent_encodings_too(make_client, curves):
     together, alone = make_client(), make_client(coalesce_curves=0)
     bodies = [{"curves": curves(2, 50, seed=i).tolist()} for i in range(8)]
