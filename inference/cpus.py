@@ -80,6 +80,13 @@ def inference_slots(settings: Any, cpus: int | None = None) -> int:
     return max(MIN_SLOTS, cpus // worker_count(settings, cpus))
 
 
+def coalescing_readers(settings: Any, cpus: int | None = None) -> int:
+    """Batches of coalesced requests one worker reads at once (inference.coalescing): one a CPU of the worker, at
+    most its inference slots. Fewer than the slots: two batches sharing a core cost more than one of both."""
+    cpus = available_cpus() if cpus is None else cpus
+    return max(1, min(inference_slots(settings, cpus), cpus // worker_count(settings, cpus)))
+
+
 def threads_per_inference(settings: Any, cpus: int | None = None) -> int:
     """`settings.intra_op_threads` where set; for 0, the CPUs shared out: workers × inference slots
     inferences run at once, each on this many threads (at least 1)."""

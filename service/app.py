@@ -38,6 +38,7 @@ from curve_vae.inference.batching import attach as attach_batcher
 from curve_vae.inference.coalescing import runtime_coalescer
 from curve_vae.inference.cpus import (
     available_cpus,
+    coalescing_readers,
     inference_slots,
     limit_blas_threads,
     session_config,
@@ -80,7 +81,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
         runtime_coalescer(
             runtime,
             max_curves=settings.coalesce_curves,
-            readers=max(1, available_cpus() // worker_count(settings)),
+            readers=coalescing_readers(settings),
             observe=lambda jobs, _curves: app.state.metrics.coalesced.observe(jobs),
         )
         if settings.coalesce_curves
