@@ -6,8 +6,8 @@ at the same moment are read together and each gets its own part back.
 Flat combining, without waiting for company: every request registers its job, then queues for an inference thread
 as before. The thread that picks a job up runs it together with every other registered job of the same options not
 yet taken (up to `max_curves` curves); a job already taken by another thread's batch waits for it, and while it
-waits its thread runs the next batch of untaken jobs, if any. A lone request runs alone at once — nothing is added to
-its latency — and under load the batches grow with the queue.
+waits its thread runs the next batch of untaken jobs, if any. A request to an idle server runs alone at once —
+nothing is added to its latency — and under load the batches grow with the queue.
 
 - Only jobs with equal options (the reading, `n_points`) share a batch; a job larger than `max_curves` runs alone.
 - Right after a batch ends its clients are answered and ask again within a few milliseconds: the next batch waits
