@@ -26,6 +26,7 @@ nothing is added to its latency — and under load the batches grow with the que
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
 from collections.abc import Callable, Hashable, Sequence
@@ -125,13 +126,12 @@ class Coalescer(Generic[R]):
             try:
                 self._run(batch)
             finally:
-                with self._changed:
-                    self._reading -= 1
-                    self._ended, self._last = time.monotonic(), len(batch)
                 for j in batch:  # an error past Exception (KeyboardInterrupt) still ends every job of the batch
                     if not j.done.is_set():
                         j.finish(error=Cancelled("the batch reading this request stopped"))
                 with self._changed:
+                    self._reading -= 1
+                    self._ended, self._last = time.monotonic(), len(batch)
                     self._changed.notify_all()
         if job.error is not None:
             raise job.error
@@ -223,14 +223,11 @@ def runtime_coalescer(
     """A coalescer of `runtime.encode` and `runtime.reconstruct` calls: jobs keyed `(kind, reading, n_points)`,
     kind "encode" or "reconstruct" (`encode_key`, `reconstruct_key`)."""
 
-    def read(key: Hashable, curves: list[np.ndarray]) -> Read:
-        return read_alone(runtime, key, curves)
-
     def split(result: Read, sizes: list[int]) -> list[Read]:
-        if isinstance(result, Encoding):
-            return list(split_encoding(result, sizes))
-        return list(split_reconstruction(result, sizes))
+        parts = split_encoding(result, sizes) if isinstance(result, Encoding) else split_reconstruction(result, sizes)
+        return list[Read](parts)  # a list of one kind, typed as either
 
+    read = functools.partial(read_alone, runtime)
     return Coalescer(read, split, max_curves=max_curves, readers=readers, observe=observe)
 
 

@@ -117,9 +117,9 @@ async def coalesced(
     registered before it queues, so requests that queue together are read together; `render` builds the response
     from this request's own part. Without a coalescer, or with more than half a batch of curves (it gains little
     from company, and would hold the coalescer's readers from the small requests), the job is read alone."""
+    runtime = runtime_of(request)  # 503 until the model is loaded
     coalescer = coalescer_of(request)
     if coalescer is None or len(curves) > coalescer.max_curves // 2:
-        runtime = runtime_of(request)
         return await run_inference(request, route, len(curves), lambda: render(read_alone(runtime, key, curves)))
     job = coalescer.submit(key, curves)
     try:

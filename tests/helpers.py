@@ -3,6 +3,8 @@ servers' flags."""
 
 from __future__ import annotations
 
+import concurrent.futures as cf
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -55,3 +57,19 @@ def natural_fits_asked(runtime, monkeypatch, readings: list) -> list[list[dict]]
         runtime.reconstruct([curve], reading)
         out.append(list(asked))
     return out
+
+
+def together(fn, args):
+    """fn(arg) for every arg at once, from as many threads (a barrier starts them); the results, or the exceptions,
+    in order."""
+    start = threading.Barrier(len(args))
+
+    def call(arg):
+        start.wait()
+        try:
+            return fn(arg)
+        except Exception as e:
+            return e
+
+    with cf.ThreadPoolExecutor(len(args)) as pool:
+        return list(pool.map(call, args))

@@ -38,7 +38,6 @@ curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 async def encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray]) -> Response:
     """Encode curves (any frame, any length ≥ 4) into the latent space (the encoder's mean and log-variance).
     The curves may also be posted as a .npy body (`Content-Type: application/x-npy`), the other fields in the query."""
-    runtime_of(request)  # 503 until the model is loaded
     return await coalesced(request, "/encode", encode_key(req.reading()), curves, lambda enc: JSON(encode_body(enc)))
 
 

@@ -4,7 +4,6 @@ a bad item fails alone; a client that goes away disturbs no one; batch sizes and
 from __future__ import annotations
 
 import concurrent.futures as cf
-import threading
 
 import httpx
 import numpy as np
@@ -12,6 +11,7 @@ import pytest
 from prometheus_client import CollectorRegistry
 
 from curve_vae.inference.batching import GraphBatcher
+from tests.helpers import together
 
 BATCHING = {"micro_batch": True, "micro_batch_rows": 16, "micro_batch_wait_ms": 30.0}
 
@@ -35,24 +35,9 @@ def batcher(runtime, registry):
     b.close()
 
 
-def _together(fn, args):
-    """fn(arg) for every arg at once, from as many threads; the results, or the exceptions, in order."""
-    start = threading.Barrier(len(args))
-
-    def call(arg):
-        start.wait()
-        try:
-            return fn(arg)
-        except Exception as e:
-            return e
-
-    with cf.ThreadPoolExecutor(len(args)) as pool:
-        return list(pool.map(call, args))
-
-
 def test_each_caller_gets_its_own_rows(batcher, registry, runtime, curves):
     inputs = [curves(k, seed=k).astype(np.float32) for k in (1, 2, 3, 1, 2, 1)]  # 10 rows, different counts
-    got = _together(lambda x: batcher.run("encoder", x, ["mean", "log_var"]), inputs)
+    got = together(lambda x: batcher.run("encoder", x, ["mean", "log_var"]), inputs)
     for x, (mean, log_var) in zip(inputs, got):
         alone = runtime.graphs.encoder.run(["mean", "log_var"], {"curves": x})
         np.testing.assert_allclose(mean, alone[0], rtol=1e-4, atol=1e-4)
@@ -65,7 +50,7 @@ def test_each_caller_gets_its_own_rows(batcher, registry, runtime, curves):
 def test_a_bad_item_fails_alone(batcher, curves):
     good = [curves(1, seed=k).astype(np.float32) for k in range(4)]
     bad = np.zeros((1, 100, 2), np.float32)  # the encoder takes 161 points
-    got = _together(lambda x: batcher.run("encoder", x, ["mean"]), [*good[:2], bad, *good[2:]])
+    got = together(lambda x: batcher.run("encoder", x, ["mean"]), [*good[:2], bad, *good[2:]])
     assert isinstance(got[2], Exception) and "100" in str(got[2])
     assert all(isinstance(r, list) and r[0].shape == (1, 32) for i, r in enumerate(got) if i != 2)
 
@@ -76,7 +61,7 @@ def test_requests_are_routed_to_their_callers_under_concurrency(make_client, cli
     bodies = [
         {"curves": curves(1 + i % 3, 40, seed=i).tolist(), "pose": "as_is" if i % 2 else "auto"} for i in range(12)
     ]
-    answers = _together(lambda body: batched.post("/reconstruct", json=body), bodies)
+    answers = together(lambda body: batched.post("/reconstruct", json=body), bodies)
     for body, answer in zip(bodies, answers):
         assert answer.status_code == 200, answer.text
         alone = client.post("/reconstruct", json=body).json()  # the same app without batching
@@ -92,7 +77,7 @@ def test_requests_are_routed_to_their_callers_under_concurrency(make_client, cli
     # natural fits before they reach the encoder, so whether they meet in its 30 ms window depends on the load)
     before = encoder_runs()
     quick = [{"curves": curves(1, 40, seed=i).tolist(), "pose": "as_is", "spacing": "parameter"} for i in range(12)]
-    assert all(a.status_code == 200 for a in _together(lambda body: batched.post("/reconstruct", json=body), quick))
+    assert all(a.status_code == 200 for a in together(lambda body: batched.post("/reconstruct", json=body), quick))
     assert encoder_runs() - before < 12  # the twelve requests' encoder runs were gathered into fewer runs
 
 
@@ -100,7 +85,7 @@ def test_one_bad_request_fails_alone(make_client, curves):
     batched = make_client(**BATCHING)
     good = {"curves": curves(1, 40).tolist(), "pose": "as_is"}
     bad = {"curves": (curves(1, 40) * 1e300).tolist(), "frame": "model"}  # beyond float32: a 422 of its own
-    answers = _together(lambda body: batched.post("/reconstruct", json=body), [good, good, bad, good])
+    answers = together(lambda body: batched.post("/reconstruct", json=body), [good, good, bad, good])
     assert [a.status_code for a in answers] == [200, 200, 422, 200]
 
 
