@@ -85,6 +85,18 @@ class Metrics:
             ["route"],
             registry=self.registry,
         )
+        self.connections_moved = Counter(
+            "curve_vae_connections_moved",
+            "Responses that asked their client to connect again: this worker held two or more connections beyond "
+            "another (--workers N; service.balance).",
+            registry=self.registry,
+        )
+        self.open_connections = Gauge(
+            "curve_vae_open_connections",
+            "HTTP connections open to each worker (--workers N: one value a worker, by pid).",
+            registry=self.registry,
+            multiprocess_mode="liveall",
+        )
         total: Any = {"registry": self.registry, "multiprocess_mode": "livesum"}  # over the live workers
         self.graph_rows = Gauge(
             "curve_vae_graph_rows",

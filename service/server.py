@@ -160,16 +160,17 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
     from uvicorn.config import STARTUP_FAILURE
     from uvicorn.supervisors import Multiprocess
 
-    from curve_vae.service import listeners
+    from curve_vae.service import balance, listeners
 
     # Workers are fresh processes: they rebuild the same settings from the environment.
     os.environ.update(_as_env(settings))
-    with _shared_metrics():
+    with _shared_metrics(), balance.shared_directory(listeners.balances_connections()):
         app = "curve_vae.service.server:supervised_app"
         if not listeners.balances_connections():
             uvicorn.run(app, factory=True, workers=settings.workers, **common)
             return
-        config = uvicorn.Config(app, factory=True, workers=settings.workers, **common)
+        # each worker's connections counted (service.balance), so that a crowded one asks a client to reconnect
+        config = uvicorn.Config(app, factory=True, workers=settings.workers, http=balance.PROTOCOL, **common)
         try:
             listener = listeners.PerWorkerListener(settings.host, settings.port)
         except OSError as e:
@@ -201,6 +202,7 @@ def supervised_app() -> Any:
     import threading
     import time
 
+    from curve_vae.service import balance
     from curve_vae.service.app import create_app_from_env
 
     supervisor = os.getppid()
@@ -212,7 +214,8 @@ def supervised_app() -> Any:
         os.kill(os.getpid(), signal.SIGTERM)
 
     threading.Thread(target=watch, name="supervisor-watch", daemon=True).start()
-    return create_app_from_env()
+    app = create_app_from_env()
+    return balance.balanced(app, app.state.metrics)
 
 
 @contextlib.contextmanager

@@ -1,0 +1,214 @@
+"""Connections kept shared out evenly among `--workers` processes, however few clients there are.
+
+Linux hands each new connection to one of the workers' SO_REUSEPORT sockets by a hash of its addresses
+(service.listeners), and a keep-alive client stays where it landed. With many connections that evens out; with few
+it often does not: two clients posting 128-curve batches land on one worker half the time, and that worker then
+serves both while the other idles (bench.serve's run A: 145 curves/s against 186 when they are apart). So each
+worker publishes how many connections it holds (one 8-byte file per worker in a directory the server makes), and a
+worker holding at least REBALANCE_MARGIN more than the least-loaded other one answers with `Connection: close`:
+the client connects again, and the kernel deals the new connection afresh. Nothing is refused and no request is
+lost; a client pays one reconnect (loopback: well under a millisecond) each time it is moved, and the moves stop
+once no worker holds two more than another.
+"""
+
+from __future__ import annotations
+
+import atexit
+import contextlib
+import mmap
+import os
+import shutil
+import struct
+import tempfile
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+try:  # uvicorn's "auto" choice: httptools where installed
+    from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol as _Http
+except ImportError:  # pragma: no cover - without httptools
+    from uvicorn.protocols.http.h11_impl import H11Protocol as _Http  # type: ignore[assignment]
+
+#: uvicorn's `http` option for the workers: its HTTP protocol, counting connections (CountedHttp).
+PROTOCOL = "curve_vae.service.balance:CountedHttp"
+#: The environment variable naming the workers' directory (set by service.server for its workers; internal).
+BALANCE_DIR = "CURVE_VAE_BALANCE_DIR"
+#: A worker moves a connection when it holds at least this many more than the least-loaded other worker.
+REBALANCE_MARGIN = 2
+#: How often a worker looks for workers started or gone since (seconds); their counts it reads on every response.
+RESCAN_S = 1.0
+_COUNT = struct.Struct("<q")
+_SUFFIX = ".connections"
+
+
+class Peers:
+    """This worker's published connection count, and the other workers' as they publish theirs."""
+
+    def __init__(self, directory: str | Path, *, pid: int | None = None) -> None:
+        self.dir = Path(directory)
+        self.pid = os.getpid() if pid is None else pid
+        self.path = self.dir / f"{self.pid}{_SUFFIX}"
+        fd, tmp = tempfile.mkstemp(dir=self.dir, prefix=".new-")  # whole before it appears under its name
+        try:
+            os.write(fd, bytes(_COUNT.size))
+            self._map = mmap.mmap(fd, _COUNT.size)
+            os.replace(tmp, self.path)
+        finally:
+            os.close(fd)
+        self.mine = 0
+        self._others: dict[int, mmap.mmap] = {}
+        self._scanned = -float("inf")
+        self.on_count: Callable[[int], None] | None = None  # told each new count (the /metrics gauge)
+
+    def publish(self, count: int) -> None:
+        self.mine = count
+        _COUNT.pack_into(self._map, 0, count)
+        if self.on_count is not None:
+            self.on_count(count)
+
+    def others(self) -> dict[int, int]:
+        """The other live workers' connection counts, by pid."""
+        now = time.monotonic()
+        if now - self._scanned > RESCAN_S:
+            self._rescan()
+            self._scanned = now
+        return {pid: _COUNT.unpack_from(m, 0)[0] for pid, m in self._others.items()}
+
+    def crowded(self) -> bool:
+        """Whether this worker holds REBALANCE_MARGIN or more connections beyond the least-loaded other worker."""
+        if self.mine < REBALANCE_MARGIN:
+            return False
+        counts = self.others()
+        return bool(counts) and self.mine >= min(counts.values()) + REBALANCE_MARGIN
+
+    def _rescan(self) -> None:
+        seen: dict[int, mmap.mmap] = {}
+        with os.scandir(self.dir) as entries:
+            for entry in entries:
+                stem = entry.name.removesuffix(_SUFFIX)
+                if stem == entry.name or not stem.isdigit() or int(stem) == self.pid:
+                    continue
+                pid = int(stem)
+                if not _alive(pid):  # killed outright: nobody else removes its file
+                    with contextlib.suppress(OSError):
+                        os.unlink(entry.path)
+                    continue
+                if pid in self._others:
+                    seen[pid] = self._others.pop(pid)
+                    continue
+                with contextlib.suppress(OSError, ValueError), open(entry.path, "rb") as fh:
+                    seen[pid] = mmap.mmap(fh.fileno(), _COUNT.size, access=mmap.ACCESS_READ)
+        for gone in self._others.values():
+            gone.close()
+        self._others = seen
+
+    def close(self) -> None:
+        """This worker stopping: its file goes, so that the others stop counting it."""
+        with contextlib.suppress(OSError):
+            os.unlink(self.path)
+        for m in self._others.values():
+            m.close()
+        self._others = {}
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+#: This worker's Peers (`join`), which its connections report to.
+_peers: Peers | None = None
+
+
+def join() -> Peers | None:
+    """This worker's Peers in the directory BALANCE_DIR names (None where it is unset: one process, or a platform
+    where the workers share one socket)."""
+    global _peers
+    directory = os.environ.get(BALANCE_DIR)
+    if directory and _peers is None:
+        _peers = Peers(directory)
+    return _peers
+
+
+def leave() -> None:
+    global _peers
+    if _peers is not None:
+        _peers.close()
+        _peers = None
+
+
+class CountedHttp(_Http):
+    """uvicorn's HTTP protocol, publishing this worker's open connections as they come and go (uvicorn's `http`
+    option for the workers, as "curve_vae.service.balance:CountedHttp")."""
+
+    def connection_made(self, transport: Any) -> None:
+        super().connection_made(transport)
+        if _peers is not None:
+            _peers.publish(len(self.connections))
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        super().connection_lost(exc)
+        if _peers is not None:
+            _peers.publish(len(self.connections))
+
+
+class Rebalance:
+    """Pure ASGI: a response from a crowded worker (Peers.crowded) says `Connection: close`, so that its client
+    connects again and the kernel deals the connection afresh; `on_move` is told each time."""
+
+    def __init__(self, app: ASGIApp, peers: Peers, on_move: Callable[[], None] | None = None) -> None:
+        self.app, self.peers, self.on_move = app, peers, on_move
+
+    def __getattr__(self, name: str) -> Any:  # the wrapped app's state, routes, … (tests, uvicorn's lifespan)
+        return getattr(self.app, name)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+
+        async def sending(message: Message) -> None:
+            if message["type"] == "http.response.start" and self.peers.crowded():
+                headers = list(message.get("headers", []))
+                if not any(name.lower() == b"connection" for name, _ in headers):
+                    message = {**message, "headers": [*headers, (b"connection", b"close")]}
+                    if self.on_move is not None:
+                        self.on_move()
+            await send(message)
+
+        await self.app(scope, receive, sending)
+
+
+@contextlib.contextmanager
+def shared_directory(enabled: bool = True) -> Iterator[None]:
+    """The server's part (service.server, `--workers N`): a fresh directory for the workers' counts, named in the
+    environment the workers inherit, removed when the server stops. enabled False: none (one shared socket)."""
+    if not enabled:
+        yield
+        return
+    path = tempfile.mkdtemp(prefix="curve-vae-connections-")
+    os.environ[BALANCE_DIR] = path
+    try:
+        yield
+    finally:
+        os.environ.pop(BALANCE_DIR, None)
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def balanced(app: Any, metrics: Any) -> Any:
+    """A worker's app (service.server.supervised_app): wrapped in Rebalance where the server keeps counts, its
+    counts and moves in `metrics` (curve_vae_open_connections, curve_vae_connections_moved); as it is elsewhere."""
+    peers = join()
+    if peers is None:
+        return app
+    atexit.register(leave)
+    peers.on_count = metrics.open_connections.set
+    return Rebalance(app, peers, metrics.connections_moved.inc)
