@@ -92,14 +92,14 @@ class FrameRows:
     def to_model(self, curves: Ragged, model_size: float) -> np.ndarray:
         """`Frame.to_model` of every curve (N, 2): each point through its own curve's frame, in the model's order."""
         own = curves.owner
-        p = np.einsum("nd,nde->ne", curves.points - self.center[own], self.linear[own])
+        p = ((curves.points - self.center[own])[:, None, :] @ self.linear[own])[:, 0]  # each point times its M
         p = p * (model_size / self.size)[own, None] + np.asarray(MODEL_CENTER)
         return p[curves.reversed_where(self.reverse)]
 
     def to_model_rows(self, rows: np.ndarray, model_size: float) -> np.ndarray:
         """`Frame.to_model` of curves of one length (B, n, 2), each through its own frame, in the model's order."""
         d = rows - self.center[:, None]
-        p = d[..., :1] * self.linear[:, None, 0] + d[..., 1:] * self.linear[:, None, 1]  # p @ M, row by row
+        p = d @ self.linear  # each curve times its M
         p = p * (model_size / self.size)[:, None, None] + np.asarray(MODEL_CENTER)
         p[self.reverse] = p[self.reverse, ::-1]
         return p
@@ -108,7 +108,7 @@ class FrameRows:
         """`Frame.from_model` of every curve (N, 2): model-plane points back to their curves' frames and order."""
         own = curves.owner
         p = (curves.points - np.asarray(MODEL_CENTER)) * (self.size / model_size)[own, None]
-        p = np.einsum("nd,ned->ne", p, self.linear[own]) + self.center[own]  # the transpose: the inverse
+        p = (self.linear[own] @ p[:, :, None])[:, :, 0] + self.center[own]  # times Mᵀ: the inverse
         return p[curves.reversed_where(self.reverse)]
 
 
@@ -150,8 +150,8 @@ def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
     a = (np.eye(2) - 2 * np.outer(normal, normal)) @ rot @ np.diag([-1.0, 1.0])
     turn_flipped = np.arctan2(a[:, 1, 0], a[:, 0, 0])
     flipped = _linear(turn_flipped, ~mirror)
-    posed = np.einsum("knd,kde->kne", pts, drawn)  # chord along −y (a translation changes no statistic below)
-    centroid = np.einsum("kd,kde->ke", centroid, drawn)
+    posed = pts @ drawn  # chord along −y (a translation changes no statistic below)
+    centroid = (centroid[:, None] @ drawn)[:, 0]
     offset = (posed[:, 0, 1] + posed[:, -1, 1]) / 2 - centroid[:, 1]
     box_drawn = _box(pts, drawn)
     level = np.abs(offset) <= 1e-9 * box_drawn[1]
@@ -196,9 +196,9 @@ def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[F
     turns, mirrors, reverses = zip(*poses)
     turn, mir = np.stack(turns, axis=1), np.stack(mirrors, axis=1)  # (k, poses)
     linear = _linear(turn.ravel(), mir.ravel()).reshape(*turn.shape, 2, 2)
-    q = np.einsum("knd,kpde->kpne", pts, linear)  # every pose's bounding box at once (frame.posed_frame)
+    q = pts[:, None] @ linear  # every pose's bounding box at once (frame.posed_frame); (k, poses, n, 2)
     lo, hi = q.min(axis=2), q.max(axis=2)
-    center, size = np.einsum("kpe,kpde->kpd", (lo + hi) / 2, linear).tolist(), (hi - lo).max(axis=2).tolist()
+    center, size = (linear @ ((lo + hi) / 2)[..., None])[..., 0].tolist(), (hi - lo).max(axis=2).tolist()
     turn_, mir_ = turn.tolist(), mir.tolist()
     return [
         [
@@ -219,9 +219,9 @@ def _linear(rotation: np.ndarray, mirror: np.ndarray) -> np.ndarray:
 
 def _box(pts: np.ndarray, linear: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """frame.posed_frame's centre (k, 2) and size (k,): the bounding box taken in the posed orientation."""
-    q = np.einsum("knd,kde->kne", pts, linear)
+    q = pts @ linear
     lo, hi = q.min(axis=1), q.max(axis=1)
-    return np.einsum("ke,kde->kd", (lo + hi) / 2, linear), (hi - lo).max(axis=1)
+    return (linear @ ((lo + hi) / 2)[..., None])[..., 0], (hi - lo).max(axis=1)
 
 
 def _turns_clockwise(pts: np.ndarray) -> np.ndarray:

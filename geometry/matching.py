@@ -63,15 +63,18 @@ def ordered_closest_params(
 
     value, t, k = at(flat_u, 2)
     r = value - flat_p
-    for _ in range(newton):
+    for step in range(newton):
         grad, curv = (r * t).sum(-1), (t * t).sum(-1) + (r * k).sum(-1)
         moved = np.clip(flat_u - np.where(curv > 0, grad / np.where(curv > 0, curv, 1.0), 0.0), lo, hi)
         moved = np.where(inner, moved, flat_u)
-        value, t_moved, k_moved = at(moved, 2)  # the next step's slope and curvature too, where the step is taken
+        last = step == newton - 1  # the next step's slope and curvature too, where there is a next step
+        value, *slopes = at(moved, 0 if last else 2)
         r_moved = value - flat_p
         closer = ((r_moved**2).sum(-1) < (r**2).sum(-1))[:, None]
         flat_u = np.where(closer[:, 0], moved, flat_u)
-        r, t, k = np.where(closer, r_moved, r), np.where(closer, t_moved, t), np.where(closer, k_moved, k)
+        r = np.where(closer, r_moved, r)
+        if not last:
+            t, k = np.where(closer, slopes[0], t), np.where(closer, slopes[1], k)
     if (lengths == lengths[0]).all():  # in order within each curve: a running maximum along each
         ordered = np.maximum.accumulate(flat_u.reshape(count, -1), axis=1).ravel()
     else:
