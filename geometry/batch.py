@@ -131,6 +131,44 @@ def _by_length(curves: Sequence[np.ndarray], per_length: Callable[[np.ndarray], 
     return [out[i] for i in range(len(curves))]
 
 
+def arc_grids(curves: Sequence[np.ndarray], n_points: int, *, upright: bool = False) -> np.ndarray:
+    """(k, n_points, 2): each curve at `n_points` evenly spaced along its length (`frame.resample` by arc length),
+    the curves of each length at once; upright: a curve that turns clockwise overall (`frame.turns_clockwise`) is
+    mirrored in x first. Each curve needs two distinct points."""
+
+    def grids(pts: np.ndarray) -> list[np.ndarray]:
+        s = _arc_lengths(pts)
+        at = np.linspace(0.0, 1.0, n_points)[None, :] * s[:, -1:]  # (k, n_points) lengths to reach
+        # the segment each falls in: the last point not beyond it, one row at a time (np.searchsorted is 1-D)
+        seg = np.stack([np.searchsorted(row, a, side="right") - 1 for row, a in zip(s, at)])
+        seg = np.clip(seg, 0, pts.shape[1] - 2)
+        lo, hi = np.take_along_axis(s, seg, 1), np.take_along_axis(s, seg + 1, 1)
+        w = np.where(hi > lo, (at - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)[..., None]
+        a, b = np.take_along_axis(pts, seg[..., None], 1), np.take_along_axis(pts, seg[..., None] + 1, 1)
+        out = a + (b - a) * w
+        if upright:
+            out[_turns_clockwise(pts), :, 0] *= -1.0
+        return list(out)
+
+    return np.stack(_by_length(curves, grids)) if len(curves) else np.zeros((0, n_points, 2))
+
+
+def arc_fractions_of(curves: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """`frame.arc_fractions` of every curve, the curves of each length at once."""
+
+    def fractions(pts: np.ndarray) -> list[np.ndarray]:
+        s = _arc_lengths(pts)
+        return list(s / s[:, -1:])
+
+    return _by_length(curves, fractions)
+
+
+def _arc_lengths(pts: np.ndarray) -> np.ndarray:
+    """(k, n): the arc length from each curve's first point to each of its points (frame.cumulative_length)."""
+    seg = np.linalg.norm(np.diff(pts, axis=1), axis=2)
+    return np.concatenate([np.zeros((len(pts), 1)), np.cumsum(seg, axis=1)], axis=1)
+
+
 def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
     """Canonical frames of curves of one length (k, n, 2); see frame.canonical_frame for what each step means."""
     extent = np.ptp(pts, axis=1).max(axis=1)  # (k,)

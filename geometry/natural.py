@@ -192,7 +192,7 @@ class _BatchFit:
 
     def run(self, steps: int) -> None:
         k, nc = len(self.u), self.n_ctrl
-        eye = np.eye(2 * nc)
+        eye = np.eye(nc)
         for _ in range(steps):
             live = self.damping <= 1e8
             if not live.any():
@@ -201,22 +201,26 @@ class _BatchFit:
             tangent = self.slope @ self.ctrl
             tangent[:, [0, -1]] = 0.0  # the ends stay where they are
             uu = (tangent**2).sum(-1) * (1 + lam[:, None]) + 1e-12  # the parameters' block: diagonal, one per point
-            btb = b.transpose(0, 2, 1) @ b
-            cc = np.zeros((k, 2 * nc, 2 * nc))
-            cc[:, :nc, :nc] = cc[:, nc:, nc:] = btb
-            cc += lam[:, None, None] * (cc * eye)
-            cu = np.concatenate([b * tangent[..., :1], b * tangent[..., 1:]], axis=2).transpose(0, 2, 1)
-            gc = (b.transpose(0, 2, 1) @ r).transpose(0, 2, 1).reshape(k, 2 * nc)
+            # the control points' system after eliminating the parameters (the Schur complement), block by block:
+            # Bᵀ·diag(w)·B for x with x, y with y and x with y, the damping on the x and y blocks' diagonals
+            tx, ty = tangent[..., 0], tangent[..., 1]
+            bt = b.transpose(0, 2, 1)
+            damp = (lam[:, None] * (b * b).sum(1))[:, :, None] * eye
+            xx = bt @ (b * (1.0 - tx * tx / uu)[..., None]) + damp
+            yy = bt @ (b * (1.0 - ty * ty / uu)[..., None]) + damp
+            xy = bt @ (b * (-tx * ty / uu)[..., None])
+            schur = np.block([[xx, xy], [xy, yy]]) + 1e-14 * np.eye(2 * nc)
             gu = (tangent * r).sum(-1)
-            schur = cc - (cu / uu[:, None, :]) @ cu.transpose(0, 2, 1) + 1e-14 * eye
+            rhs = (bt @ (r - tangent * (gu / uu)[..., None])).transpose(0, 2, 1).reshape(k, 2 * nc)
             try:
-                dc = np.linalg.solve(schur, (gc - (cu @ (gu / uu)[..., None])[..., 0])[..., None])[..., 0]
+                dc = np.linalg.solve(schur, rhs[..., None])[..., 0]
             except np.linalg.LinAlgError:
                 return
-            du = (gu - (dc[:, None, :] @ cu)[:, 0]) / uu
+            dctrl = dc.reshape(k, 2, nc).transpose(0, 2, 1)  # (k, nc, 2)
+            du = (gu - ((b @ dctrl) * tangent).sum(-1)) / uu
             u = np.maximum.accumulate(np.clip(self.u - du, 0.0, 1.0), axis=1)
             u[:, 0], u[:, -1] = 0.0, 1.0
-            ctrl = self.ctrl - dc.reshape(k, 2, nc).transpose(0, 2, 1)
+            ctrl = self.ctrl - dctrl
             basis, slope = self._basis(u)
             res = basis @ ctrl - self.pts
             cost = (res**2).sum((1, 2))

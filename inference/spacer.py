@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.errors import InvalidInput
-from curve_vae.geometry.frame import arc_fractions, resample, turns_clockwise
+from curve_vae.geometry.batch import arc_fractions_of, arc_grids
 from curve_vae.inference.weights import read_weights
 
 SPACER_KIND = "dilated-conv1d-cumsoftmax-v1"
@@ -32,7 +32,7 @@ TURN_SCALE = GRID / 20.0
 
 def on_grid(curves: Sequence[np.ndarray]) -> np.ndarray:
     """(k, GRID, 2): each polyline (n, 2) at GRID points evenly spaced along its length."""
-    return np.stack([resample(np.asarray(c, np.float64), GRID) for c in curves])
+    return arc_grids(curves, GRID)
 
 
 def spacer_inputs(grid: np.ndarray) -> np.ndarray:
@@ -87,13 +87,16 @@ class Spacer:
         """Each polyline's (n, 2) guessed parameters at its own points (n,): 0 and 1 at its ends, never falling."""
         if not curves:
             return []
-        pts = [np.asarray(c, np.float64) for c in curves]
         # the parameters of a mirror image are the curve's own: each curve is read the way round it turns
         # counter-clockwise, so that a curve and its mirror image give the network the same numbers to the last bit
-        upright = [c * [-1.0, 1.0] if turns_clockwise(c) else c for c in pts]
-        grid = self.grid_params(spacer_inputs(on_grid(upright)))
-        at = np.linspace(0.0, 1.0, GRID)
-        return [np.interp(arc_fractions(c), at, u) for c, u in zip(pts, grid)]
+        grid = self.grid_params(spacer_inputs(arc_grids(curves, GRID, upright=True)))
+        # each point's parameter, linearly between the grid's (which are evenly spaced in arc length)
+        out = []
+        for f, u in zip(arc_fractions_of(curves), grid):
+            x = f * (GRID - 1)
+            j = np.minimum(x.astype(np.int64), GRID - 2)
+            out.append(u[j] + (u[j + 1] - u[j]) * (x - j))
+        return out
 
 
 def _pair(weights: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, np.ndarray]:

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from curve_vae.geometry import canonical_frame, pose_frames, random_control_points, sample_bspline
-from curve_vae.geometry.batch import FrameRows, Ragged, canonical_frames, pose_frames_of
+from curve_vae.geometry.batch import FrameRows, Ragged, arc_fractions_of, arc_grids, canonical_frames, pose_frames_of
+from curve_vae.geometry.frame import arc_fractions, resample, turns_clockwise
 
 
 def _drawn(count: int, seed: int = 0) -> list[np.ndarray]:
@@ -108,3 +109,24 @@ def test_a_set_turns_with_its_curves():
     after = shared_canonical_frames([c @ turn for c in curves])
     for c, fa, fb in zip(curves, before, after):
         np.testing.assert_allclose(fb.to_model(c @ turn, 100.0), fa.to_model(c, 100.0), atol=1e-9)
+
+
+@pytest.mark.parametrize("n_points", [4, 128, 161])
+def test_arc_grids_of_a_batch_are_each_curves_own_resampling(n_points):
+    """Curves of many lengths, loops and repeated points: each as frame.resample by arc length spaces it alone (to
+    rounding), mirrored in x where upright and the curve turns clockwise."""
+    curves = _drawn(60, seed=3)
+    together = arc_grids(curves, n_points)
+    upright = arc_grids(curves, n_points, upright=True)
+    for c, got, up in zip(curves, together, upright):
+        alone = resample(c, n_points)
+        scale = np.ptp(c, axis=0).max()
+        np.testing.assert_allclose(got, alone, rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(up, alone * ([-1.0, 1.0] if turns_clockwise(c) else 1.0), rtol=0, atol=1e-12 * scale)
+    assert arc_grids([], 5).shape == (0, 5, 2)
+
+
+def test_arc_fractions_of_a_batch_are_each_curves_own():
+    curves = _drawn(40, seed=4)
+    for c, got in zip(curves, arc_fractions_of(curves)):
+        np.testing.assert_allclose(got, arc_fractions(c), rtol=0, atol=1e-15)
