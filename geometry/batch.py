@@ -150,7 +150,8 @@ def arc_grids(curves: Sequence[np.ndarray], n_points: int, *, upright: bool = Fa
             out[_turns_clockwise(pts), :, 0] *= -1.0
         return list(out)
 
-    return np.stack(_by_length(curves, grids)) if len(curves) else np.zeros((0, n_points, 2))
+    rows: list[np.ndarray] = _by_length(curves, grids)
+    return np.stack(rows) if rows else np.zeros((0, n_points, 2))
 
 
 def arc_fractions_of(curves: Sequence[np.ndarray]) -> list[np.ndarray]:

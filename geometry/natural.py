@@ -23,7 +23,7 @@ from scipy.ndimage import gaussian_filter1d
 
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry.bspline import basis_and_slope
-from curve_vae.geometry.frame import arc_fractions
+from curve_vae.geometry.frame import CLOSED, arc_fractions
 from curve_vae.geometry.metrics import turning_angles
 
 #: Control points of the spline whose parameters `natural_params` finds: the paper's curves have 10.
@@ -39,6 +39,12 @@ NATURAL_STARTS: tuple[tuple[float, float], ...] = tuple((s, w) for s in (0.5, 1.
 
 #: Steps every start runs before the fit keeps only the closest and the arc-length one.
 NATURAL_SCOUT_STEPS = 15
+
+#: natural_readings_of's `arc_reading`: which curves keep the arc-length start's fit as a second reading.
+ARC_READINGS = ("always", "loops_and_corners")
+#: A turn at one point (radians, ~69°) past which "loops_and_corners" keeps it: the superellipses' corners, some of
+#: whose answers came back crossing themselves from the closest start's reading alone (docs/RESULTS.md, service 0.21.0).
+ARC_CORNER = 1.2
 
 #: A guess at polylines' parameters: (n, 2) polylines of one length -> each one's parameters (n,).
 Guess = Callable[[list[np.ndarray]], list[np.ndarray]]
@@ -75,13 +81,19 @@ def natural_readings_of(
     steps: int = 40,
     scout: int = NATURAL_SCOUT_STEPS,
     guess: Guess | None = None,
+    arc_reading: str = "always",
 ) -> list[list[np.ndarray]]:
     """`natural_readings` of many polylines at once: the curves fitted with as many points are fitted together,
     every start of every curve one row of one Levenberg–Marquardt (a batch costs about what its longest curve's
     fit does, not the sum). `scout`: the steps every start runs before only the closest and the arc-length one go
     on (of `steps` in all). `guess`: where to start besides the arc-length fractions, instead of NATURAL_STARTS'
     stretched lengths — given the polylines as the fit sees them (each scaled, from the end it turns most towards,
-    at most NATURAL_FIT_POINTS), their parameters (inference.spacer's guesses)."""
+    at most NATURAL_FIT_POINTS), their parameters (inference.spacer's guesses). `arc_reading`: "always", the fit
+    from the arc-length fractions carries on beside the closest start's, a second reading where the two end apart;
+    "loops_and_corners", only for a closed-looking curve (`frame.CLOSED`) or one that turns more than ARC_CORNER at
+    a point, a smooth open curve getting the closest start's alone."""
+    if arc_reading not in ARC_READINGS:
+        raise ValueError(f"arc_reading must be one of {', '.join(ARC_READINGS)}, got {arc_reading!r}")
     out: list[list[np.ndarray]] = [[] for _ in curves]
     fits: dict[int, list[tuple[int, np.ndarray, bool, np.ndarray | None]]] = {}  # fitted length -> curves
     for i, points in enumerate(curves):
@@ -104,7 +116,9 @@ def natural_readings_of(
             some = np.unique(np.round(np.linspace(0, len(pts) - 1, NATURAL_FIT_POINTS)).astype(int))
         fits.setdefault(len(pts) if some is None else len(some), []).append((i, pts, flip, some))
     for group in fits.values():
-        fitted = _fit([pts if some is None else pts[some] for _, pts, _, some in group], n_ctrl, steps, scout, guess)
+        fitted = _fit(
+            [pts if some is None else pts[some] for _, pts, _, some in group], n_ctrl, steps, scout, guess, arc_reading
+        )
         for (i, pts, flip, some), readings in zip(group, fitted):
             if some is not None:
                 u = arc_fractions(pts)
@@ -139,10 +153,15 @@ def _starts(pts: np.ndarray) -> np.ndarray:
 
 
 def _fit(
-    curves: list[np.ndarray], n_ctrl: int, steps: int, scout: int, guess: Guess | None = None
+    curves: list[np.ndarray],
+    n_ctrl: int,
+    steps: int,
+    scout: int,
+    guess: Guess | None = None,
+    arc_reading: str = "always",
 ) -> list[list[np.ndarray]]:
     """`natural_readings_of`' fit of polylines of one length (n, 2) as listed, all at once: every start of every
-    curve scouts, then each curve carries on with its closest start and the arc-length one."""
+    curve scouts, then each curve carries on with its closest start and the arc-length one (`arc_reading`)."""
     if guess is None:
         starts = [_starts(pts) for pts in curves]
     else:
@@ -154,7 +173,8 @@ def _fit(
     rows: list[int] = []
     for i in range(len(curves)):
         best = int(first[i] + fit.cost[owner == i].argmin())
-        rows += [best, int(first[i])] if best != first[i] else [best]
+        arc = best != first[i] and (arc_reading == "always" or _keeps_arc(curves[i]))
+        rows += [best, int(first[i])] if arc else [best]
     fit.keep(rows)
     fit.run(steps - min(scout, steps))
     owner = owner[rows]
@@ -166,6 +186,13 @@ def _fit(
             order = order[:1]
         out.append([fit.u[k].copy() for k in order])
     return out
+
+
+def _keeps_arc(pts: np.ndarray) -> bool:
+    """arc_reading "loops_and_corners": whether a polyline looks closed (its chord shorter than frame.CLOSED of its
+    extent, twice its furthest point from its centroid: an airfoil, a loop) or turns more than ARC_CORNER at a point."""
+    reach = 2 * np.linalg.norm(pts - pts.mean(axis=0), axis=1).max()
+    return bool(np.hypot(*(pts[-1] - pts[0])) < CLOSED * reach or np.abs(turning_angles(pts)).max() > ARC_CORNER)
 
 
 class _BatchFit:

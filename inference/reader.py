@@ -60,6 +60,12 @@ LEARNED_NATURAL_STEPS = (8, 24)
 #: paper's curves by arc length 1.05×, 1.15× from the nine starts), in 0.62× the time; 4/8 read a little farther, and
 #: the reading table's superellipse and cardioid need more than 8 (docs/RESULTS.md, "The spacing guesser").
 GUESSED_NATURAL_STEPS = (6, 12)
+#: Which curves keep the arc-length start's fit as a second natural reading beside the guess's (natural_readings_of's
+#: `arc_reading`): loops and curves with a corner. Paired against every curve (scripts/arc_reading.py, the family
+#: suite, 200 a set): the paper's curves come back 1.0–1.8% closer (fewer candidates for the ranker to mistake),
+#: polygons 2.7% and waves 1.4% farther, airfoils, NACA sections and closed outlines as before, no answer more
+#: crossing itself; a 128-curve default request reads 13.1 candidates a curve instead of 17.7 (docs/RESULTS.md).
+GUESSED_ARC_READING = "loops_and_corners"
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -252,7 +258,7 @@ class Reader:
             return {}
         if self.spacer is not None:
             scout, steps = GUESSED_NATURAL_STEPS
-            return {"scout": scout, "steps": steps, "guess": self.spacer.guesses}
+            return {"scout": scout, "steps": steps, "guess": self.spacer.guesses, "arc_reading": GUESSED_ARC_READING}
         scout, steps = LEARNED_NATURAL_STEPS
         return {"scout": scout, "steps": steps}
 

@@ -181,3 +181,38 @@ def test_a_guess_is_where_the_fit_starts_beside_the_arc_length_fractions():
 def _unit(c: np.ndarray) -> np.ndarray:
     """A curve as natural_readings_of scales it: from its first point, by its larger extent."""
     return (c - c[0]) / np.ptp(c, axis=0).max()
+
+
+def test_with_arc_reading_loops_and_corners_a_smooth_open_curve_gets_the_closest_starts_fit_alone():
+    """arc_reading "loops_and_corners": a smooth open curve gets the closest start's reading alone; a closed-looking
+    one (a loop whose ends meet, as an airfoil's outline) and one with a corner keep the arc-length start's as their
+    second, as "always" gives every curve.
+    Both are splines drawn by arc length, guessed at their own parameters (the closer start)."""
+    from curve_vae.geometry.bspline import arc_length_params, evaluate_bspline
+    from curve_vae.geometry.natural import natural_readings_of
+
+    rng = np.random.default_rng(9)
+    a = np.linspace(0.0, 2 * np.pi, 10)
+    loop_ctrl = np.stack([np.cos(a) + 0.4 * np.cos(2 * a), 0.5 * np.sin(a)], axis=1) * 10  # first = last
+    corner_ctrl = np.array([[0, 0], [2, 1], [4, 3], [5, 6], [5, 6], [5, 6], [6, 3], [8, 1], [10, 0], [12, 0]], float)
+    ctrl = [random_control_points(rng, 1)[0], loop_ctrl, corner_ctrl]  # smooth, a loop, a corner (a triple point)
+    truth = [arc_length_params(c, 150) for c in ctrl]
+    curves = [evaluate_bspline(c, u) for c, u in zip(ctrl, truth)]
+
+    def guess(fitted):
+        out = []
+        for pts in fitted:
+            k = next(i for i, c in enumerate(curves) if np.allclose(_unit(c), pts) or np.allclose(_unit(c)[::-1], pts))
+            out.append(truth[k] if np.allclose(_unit(curves[k]), pts) else (1.0 - truth[k])[::-1])
+        return out
+
+    always = natural_readings_of(curves, steps=4, scout=2, guess=guess)
+    loops = natural_readings_of(curves, steps=4, scout=2, guess=guess, arc_reading="loops_and_corners")
+    assert [len(r) for r in always] == [2, 2, 2]
+    assert [len(r) for r in loops] == [1, 2, 2]
+    np.testing.assert_array_equal(loops[0][0], always[0][0])  # the closest start's, carried on alike
+    for k in (1, 2):
+        for r, s in zip(loops[k], always[k]):
+            np.testing.assert_array_equal(r, s)
+    with pytest.raises(ValueError, match="arc_reading"):
+        natural_readings_of(curves, guess=guess, arc_reading="never")

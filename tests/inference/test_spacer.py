@@ -107,12 +107,19 @@ def test_the_shipped_guesser_puts_the_papers_curves_drawn_by_arc_length_near_the
 
 
 def test_the_learned_reading_starts_its_natural_fit_from_the_guess(shipped_runtime, monkeypatch):
-    """Pose "learned" with spacing "search" fits natural spacings from the guesser's guesses in GUESSED_NATURAL_STEPS;
-    the search and spacing "natural" keep the fit's own starts and steps."""
+    """Pose "learned" with spacing "search" fits natural spacings from the guesser's guesses in GUESSED_NATURAL_STEPS,
+    the arc-length start's fit kept as GUESSED_ARC_READING says; the search and spacing "natural" keep the fit's own
+    starts and steps (and every curve's arc-length reading)."""
     scout, steps = reader_module.GUESSED_NATURAL_STEPS
     spacer = shipped_runtime.reader.spacer
+    arc = reader_module.GUESSED_ARC_READING
     expected = {
-        Reading(pose="learned", spacing="search"): {"scout": scout, "steps": steps, "guess": spacer.guesses},
+        Reading(pose="learned", spacing="search"): {
+            "scout": scout,
+            "steps": steps,
+            "guess": spacer.guesses,
+            "arc_reading": arc,
+        },
         Reading(pose="search", spacing="search"): {},
         Reading(pose="learned", spacing="natural"): {},
     }
