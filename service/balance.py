@@ -4,7 +4,8 @@ Linux hands each new connection to one of the workers' SO_REUSEPORT sockets by a
 (service.listeners), and a keep-alive client stays where it landed. With many connections that evens out; with few
 it often does not: two clients posting 128-curve batches land on one worker half the time, and that worker then
 serves both while the other idles (bench.serve's run A: 145 curves/s against 186 when they are apart). So each
-worker publishes how many connections it holds (one 8-byte file per worker in a directory the server makes), and a
+worker publishes how many connections it holds (a small file per worker in a directory the server makes: the count
+and the worker's start time, so that a dead worker's pid used again by another process is not taken for it), and a
 worker holding at least REBALANCE_MARGIN more than the least-loaded other one answers with `Connection: close`:
 the client connects again, and the kernel deals the new connection afresh. Nothing is refused and no request is
 lost; a client pays one reconnect (loopback: well under a millisecond) each time it is moved, and the moves stop
@@ -40,7 +41,7 @@ BALANCE_DIR = "CURVE_VAE_BALANCE_DIR"
 REBALANCE_MARGIN = 2
 #: How often a worker looks for workers started or gone since (seconds); their counts it reads on every response.
 RESCAN_S = 1.0
-_COUNT = struct.Struct("<q")
+_SLOT = struct.Struct("<qq")  # the worker's open connections, and its start time (/proc/PID/stat, clock ticks)
 _SUFFIX = ".connections"
 
 
@@ -53,8 +54,8 @@ class Peers:
         self.path = self.dir / f"{self.pid}{_SUFFIX}"
         fd, tmp = tempfile.mkstemp(dir=self.dir, prefix=".new-")  # whole before it appears under its name
         try:
-            os.write(fd, bytes(_COUNT.size))
-            self._map = mmap.mmap(fd, _COUNT.size)
+            os.write(fd, _SLOT.pack(0, _start_time(self.pid) or 0))
+            self._map = mmap.mmap(fd, _SLOT.size)
             os.replace(tmp, self.path)
         finally:
             os.close(fd)
@@ -65,7 +66,7 @@ class Peers:
 
     def publish(self, count: int) -> None:
         self.mine = count
-        _COUNT.pack_into(self._map, 0, count)
+        struct.pack_into("<q", self._map, 0, count)
         if self.on_count is not None:
             self.on_count(count)
 
@@ -75,7 +76,7 @@ class Peers:
         if now - self._scanned > RESCAN_S:
             self._rescan()
             self._scanned = now
-        return {pid: _COUNT.unpack_from(m, 0)[0] for pid, m in self._others.items()}
+        return {pid: _SLOT.unpack_from(m, 0)[0] for pid, m in self._others.items()}
 
     def crowded(self) -> bool:
         """Whether this worker holds REBALANCE_MARGIN or more connections beyond the least-loaded other worker."""
@@ -92,15 +93,18 @@ class Peers:
                 if stem == entry.name or not stem.isdigit() or int(stem) == self.pid:
                     continue
                 pid = int(stem)
-                if not _alive(pid):  # killed outright: nobody else removes its file
+                slot = self._others.pop(pid, None)
+                if slot is None:
+                    with contextlib.suppress(OSError, ValueError), open(entry.path, "rb") as fh:
+                        slot = mmap.mmap(fh.fileno(), _SLOT.size, access=mmap.ACCESS_READ)
+                if slot is None:
+                    continue
+                if _start_time(pid) != _SLOT.unpack_from(slot, 0)[1]:  # killed outright, its pid gone or another's
+                    slot.close()
                     with contextlib.suppress(OSError):
-                        os.unlink(entry.path)
+                        os.unlink(entry.path)  # nobody else removes its file
                     continue
-                if pid in self._others:
-                    seen[pid] = self._others.pop(pid)
-                    continue
-                with contextlib.suppress(OSError, ValueError), open(entry.path, "rb") as fh:
-                    seen[pid] = mmap.mmap(fh.fileno(), _COUNT.size, access=mmap.ACCESS_READ)
+                seen[pid] = slot
         for gone in self._others.values():
             gone.close()
         self._others = seen
@@ -114,14 +118,14 @@ class Peers:
         self._others = {}
 
 
-def _alive(pid: int) -> bool:
+def _start_time(pid: int) -> int | None:
+    """When process `pid` started (clock ticks since boot, /proc/PID/stat's 22nd field), or None where there is no such
+    process or it has exited (a zombie): a pid used again by a later process has another start time."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return None
+    return None if fields[0] in ("Z", "X") else int(fields[19])
 
 
 #: This worker's Peers (`join`), which its connections report to.

@@ -6,6 +6,7 @@ from __future__ import annotations
 import http.client
 import os
 import re
+import struct
 import subprocess
 import sys
 
@@ -54,6 +55,21 @@ def test_a_worker_killed_outright_is_not_counted_and_its_file_goes(tmp_path, mon
     mine.publish(10)
     assert mine.others() == {} and not mine.crowded()
     assert not dead.path.exists()
+
+
+def test_a_dead_workers_pid_used_again_by_another_process_is_not_taken_for_it(tmp_path, monkeypatch):
+    """The file names a pid that is alive, but the process there started at another time than the worker that wrote
+    it (its start time is in the file): not a worker, not counted, its file removed."""
+    monkeypatch.setattr(balance, "RESCAN_S", 0.0)
+    other = Peers(tmp_path, pid=os.getppid())
+    other.publish(0)
+    mine = Peers(tmp_path)
+    mine.publish(10)
+    assert mine.others() == {os.getppid(): 0}  # the real start time: a worker
+    struct.pack_into("<q", other._map, 8, balance._start_time(os.getppid()) - 1)  # as an earlier process's
+    other._map.flush()
+    assert mine.others() == {} and not mine.crowded()
+    assert not other.path.exists()
 
 
 def test_workers_started_later_are_found_and_stopped_ones_forgotten(tmp_path, monkeypatch):
