@@ -18,11 +18,10 @@ import atexit
 import contextlib
 import mmap
 import os
-import shutil
 import struct
 import tempfile
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +34,7 @@ except ImportError:  # pragma: no cover - without httptools
 
 #: uvicorn's `http` option for the workers: its HTTP protocol, counting connections (CountedHttp).
 PROTOCOL = "curve_vae.service.balance:CountedHttp"
-#: The environment variable naming the workers' directory (set by service.server for its workers; internal).
+#: The environment variable naming the workers' directory (made by service.server for its workers; internal).
 BALANCE_DIR = "CURVE_VAE_BALANCE_DIR"
 #: A worker moves a connection when it holds at least this many more than the least-loaded other worker.
 REBALANCE_MARGIN = 2
@@ -171,9 +170,6 @@ class Rebalance:
     def __init__(self, app: ASGIApp, peers: Peers, on_move: Callable[[], None] | None = None) -> None:
         self.app, self.peers, self.on_move = app, peers, on_move
 
-    def __getattr__(self, name: str) -> Any:  # the wrapped app's state, routes, … (tests, uvicorn's lifespan)
-        return getattr(self.app, name)
-
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
@@ -189,22 +185,6 @@ class Rebalance:
             await send(message)
 
         await self.app(scope, receive, sending)
-
-
-@contextlib.contextmanager
-def shared_directory(enabled: bool = True) -> Iterator[None]:
-    """The server's part (service.server, `--workers N`): a fresh directory for the workers' counts, named in the
-    environment the workers inherit, removed when the server stops. enabled False: none (one shared socket)."""
-    if not enabled:
-        yield
-        return
-    path = tempfile.mkdtemp(prefix="curve-vae-connections-")
-    os.environ[BALANCE_DIR] = path
-    try:
-        yield
-    finally:
-        os.environ.pop(BALANCE_DIR, None)
-        shutil.rmtree(path, ignore_errors=True)
 
 
 def balanced(app: Any, metrics: Any) -> Any:

@@ -46,6 +46,12 @@ class Metrics:
 
     def __init__(self) -> None:
         self.registry = CollectorRegistry()
+        self._http()
+        self._inference()
+        self._connections()
+        self._runtime_gauges()
+
+    def _http(self) -> None:
         self.requests = Counter(
             "curve_vae_http_requests",
             "HTTP requests answered, by route template and status.",
@@ -59,6 +65,8 @@ class Metrics:
             buckets=LATENCY_BUCKETS,
             registry=self.registry,
         )
+
+    def _inference(self) -> None:
         self.batch_size = Histogram(
             "curve_vae_batch_size",
             "Curves (or latents) in each inference request; for /interpolate, curves returned.",
@@ -85,6 +93,8 @@ class Metrics:
             ["route"],
             registry=self.registry,
         )
+
+    def _connections(self) -> None:
         self.connections_moved = Counter(
             "curve_vae_connections_moved",
             "Responses that asked their client to connect again: this worker held two or more connections beyond "
@@ -97,6 +107,8 @@ class Metrics:
             registry=self.registry,
             multiprocess_mode="liveall",
         )
+
+    def _runtime_gauges(self) -> None:
         total: Any = {"registry": self.registry, "multiprocess_mode": "livesum"}  # over the live workers
         self.graph_rows = Gauge(
             "curve_vae_graph_rows",

@@ -164,7 +164,12 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
 
     # Workers are fresh processes: they rebuild the same settings from the environment.
     os.environ.update(_as_env(settings))
-    with _shared_metrics(), balance.shared_directory(listeners.balances_connections()):
+    counts = (  # each worker's open connections (service.balance), where each worker has a socket of its own
+        _env_directory(balance.BALANCE_DIR, "curve-vae-connections-")
+        if listeners.balances_connections()
+        else contextlib.nullcontext()
+    )
+    with _shared_metrics(), counts:
         app = "curve_vae.service.server:supervised_app"
         if not listeners.balances_connections():
             uvicorn.run(app, factory=True, workers=settings.workers, **common)
@@ -218,22 +223,27 @@ def supervised_app() -> Any:
     return balance.balanced(app, app.state.metrics)
 
 
-@contextlib.contextmanager
-def _shared_metrics() -> Iterator[None]:
+def _shared_metrics() -> contextlib.AbstractContextManager[None]:
     """A fresh directory where the workers keep their Prometheus values, so that a scrape of any one of them
     answers for all (service.metrics); removed when the server stops. One set in the environment is used as it is
     (the operator's, who then empties it between runs, as prometheus-client asks)."""
     from curve_vae.service.metrics import MULTIPROC_DIR
 
     if os.environ.get(MULTIPROC_DIR):
-        yield
-        return
-    path = tempfile.mkdtemp(prefix="curve-vae-metrics-")
-    os.environ[MULTIPROC_DIR] = path
+        return contextlib.nullcontext()
+    return _env_directory(MULTIPROC_DIR, "curve-vae-metrics-")
+
+
+@contextlib.contextmanager
+def _env_directory(name: str, prefix: str) -> Iterator[None]:
+    """A fresh directory, named by environment variable `name` for the workers to inherit, removed (and the variable
+    unset) when the server stops."""
+    path = tempfile.mkdtemp(prefix=prefix)
+    os.environ[name] = path
     try:
         yield
     finally:
-        os.environ.pop(MULTIPROC_DIR, None)
+        os.environ.pop(name, None)
         shutil.rmtree(path, ignore_errors=True)
 
 
