@@ -39,6 +39,7 @@ from curve_vae.geometry.frame import (
 from curve_vae.geometry.matching import ordered_closest_params
 from curve_vae.geometry.mesh import Mesh, revolve
 from curve_vae.geometry.metrics import (
+    closeness,
     closest_squared_distances,
     curve_length,
     mse_per_curve,
@@ -64,6 +65,7 @@ __all__ = [
     "canonical_frame",
     "clamped_uniform_knots",
     "closest_params",
+    "closeness",
     "closest_squared_distances",
     "curve_length",
     "evaluate_bspline",

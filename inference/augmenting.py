@@ -13,9 +13,15 @@ import numpy as np
 
 from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.mixing import mix
+from curve_vae.inference.results import Augmented, Interpolation
 
 if TYPE_CHECKING:
+    from curve_vae.inference.graphs import ModelGraphs
     from curve_vae.inference.prepared import Prepared
+
+#: Draws of one item at most: a mix that crosses itself is drawn again (as /sample redraws), up to this many times.
+MAX_REDRAWS = 10
 
 
 def neighbour_pools(mean: np.ndarray, mode: str, neighbours: int | None) -> np.ndarray:
@@ -61,12 +67,68 @@ class AugmentPlan:
 
     def draw(self, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
         """Sources (m, k) (anchor first) and weights (m, k) of items start … stop-1."""
-        sources = np.empty((stop - start, self.k), np.int64)
-        weights = np.empty((stop - start, self.k))
-        for row, i in enumerate(range(start, stop)):
-            rng = np.random.default_rng([self.seed, i])
+        return self.draw_items(np.arange(start, stop), attempt=0)
+
+    def draw_items(self, items: np.ndarray, *, attempt: int) -> tuple[np.ndarray, np.ndarray]:
+        """Sources and weights of the given items at their `attempt`-th draw: the first from default_rng([seed, i]),
+        a redraw of a mix that crossed itself from default_rng([seed, i, attempt]) (still the item's alone)."""
+        sources = np.empty((len(items), self.k), np.int64)
+        weights = np.empty((len(items), self.k))
+        for row, i in enumerate(items):
+            rng = np.random.default_rng([self.seed, int(i)] + ([attempt] if attempt else []))
             anchor = int(rng.integers(len(self.pools)))
             sources[row, 0] = anchor
             sources[row, 1:] = rng.choice(self.pools[anchor], size=self.k - 1, replace=False)
             weights[row] = rng.dirichlet(np.ones(self.k))
         return sources, weights
+
+
+def augmented(
+    g: ModelGraphs, plan: AugmentPlan, start: int, stop: int, *, n_points: int | None, spacing: str, length: int
+) -> Augmented:
+    """Items start … stop-1 of the plan's sequence, each a valid curve: a mix that crosses itself (after
+    inference.untangling) is drawn again from its item's own generator, up to MAX_REDRAWS draws; one still crossing
+    then is returned and counted `invalid`."""
+    sources, weights = plan.draw(start, stop)
+    made = _mixed(g, plan, sources, weights, n_points=n_points, spacing=spacing, length=length)
+    curves, frames, valid = made.curves.copy(), list(made.frames), made.valid.copy()
+    splines = None if made.splines is None else list(made.splines)
+    redrawn = 0
+    for attempt in range(1, MAX_REDRAWS):
+        bad = np.flatnonzero(~valid)
+        if not len(bad):
+            break
+        redrawn += len(bad)
+        sources[bad], weights[bad] = plan.draw_items(start + bad, attempt=attempt)
+        again = _mixed(g, plan, sources[bad], weights[bad], n_points=n_points, spacing=spacing, length=length)
+        curves[bad], valid[bad] = again.curves, again.valid
+        for j, b in enumerate(bad):
+            frames[b] = again.frames[j]
+            if splines is not None and again.splines is not None:
+                splines[b] = again.splines[j]
+    return Augmented(
+        curves,
+        frames,
+        splines,
+        sources=sources,
+        weights=weights,
+        seed=plan.seed,
+        offset=start,
+        redrawn=redrawn,
+        invalid=int((~valid).sum()),
+    )
+
+
+def _mixed(
+    g: ModelGraphs,
+    plan: AugmentPlan,
+    sources: np.ndarray,
+    weights: np.ndarray,
+    *,
+    n_points: int | None,
+    spacing: str,
+    length: int,
+) -> Interpolation:
+    full = np.zeros((len(sources), len(plan.mean)))
+    np.put_along_axis(full, sources, weights, axis=1)
+    return mix(g, plan.prep, full, n_points=n_points, spacing=spacing, length=length)

@@ -47,11 +47,14 @@ def with_output(body: dict[str, Any], splines: Sequence[Spline] | None, output: 
 
 def encode_body(enc: Encoding) -> dict[str, Any]:
     # float64 as the JSON always carried: orjson would write float32 at float32's shorter precision
-    return {
+    body = {
         "mean": enc.mean.astype(np.float64),
         "log_var": enc.log_var.astype(np.float64),
         "frames": frames_json(enc.frames),
     }
+    if enc.closeness is not None:  # the reading decoded each latent (closest placement): how close it came
+        body["closeness"] = enc.closeness.json()
+    return body
 
 
 def decode_body(made: Curves, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
@@ -60,12 +63,24 @@ def decode_body(made: Curves, *, metrics: bool = False, output: str = "points") 
 
 
 def reconstruct_body(rec: Reconstruction, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
-    body = {"curves": [np.ascontiguousarray(c) for c in rec.curves], "mse": rec.mse}
+    body = {
+        "curves": [np.ascontiguousarray(c) for c in rec.curves],
+        "mse": rec.mse,
+        "closeness": rec.closeness.json(),
+        "repaired": rec.repaired.tolist(),
+    }
     return with_output(with_metrics(body, rec.curves, metrics), rec.splines, output)
 
 
 def interpolate_body(mix: Interpolation, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
-    body = {"weights": mix.weights, "curves": np.ascontiguousarray(mix.curves), "frames": frames_json(mix.frames)}
+    body = {
+        "weights": mix.weights,
+        "curves": np.ascontiguousarray(mix.curves),
+        "frames": frames_json(mix.frames),
+        "valid": mix.valid.tolist(),
+        "repaired": mix.repaired.tolist(),
+        "ends": mix.ends.json(),
+    }
     return with_output(with_metrics(body, mix.curves, metrics), mix.splines, output)
 
 
@@ -92,6 +107,8 @@ def augment_body(made: Augmented, *, metrics: bool = False) -> dict[str, Any]:
         "frames": frames_json(made.frames),
         "seed": made.seed,
         "offset": made.offset,
+        "redrawn": made.redrawn,
+        "invalid": made.invalid,
     }
     return with_metrics(body, made.curves, metrics)
 

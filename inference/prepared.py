@@ -26,8 +26,11 @@ class ReadCurve:
     ctrl: np.ndarray | None = None  # (n_ctrl, 2) its control points, with a B-spline head
     params: np.ndarray | None = None  # (n_points,) its points' spline parameters, with a head that learns them
     feet: np.ndarray | None = None  # with closest placement or refine: each caller point's spline parameter
+    repair: np.ndarray | None = None  # (n_ctrl, 2) float64: how `ctrl` was moved to uncross the answer (untangling)
 
-    ARRAYS: ClassVar[tuple[str, ...]] = ("model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet")
+    ARRAYS: ClassVar[tuple[str, ...]] = (
+        "model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet", "repair"
+    )  # fmt: skip
 
     @property
     def decoded_yet(self) -> bool:
@@ -51,7 +54,7 @@ class ReadCurve:
     def with_decoding(
         self, decoded: np.ndarray, ctrl: np.ndarray | None, params: np.ndarray | None, feet: np.ndarray | None
     ) -> ReadCurve:
-        return replace(self, decoded=decoded, ctrl=ctrl, params=params, feet=feet)
+        return replace(self, decoded=decoded, ctrl=ctrl, params=params, feet=feet, repair=None)
 
 
 @dataclass(frozen=True)

@@ -44,6 +44,7 @@ from curve_vae.inference.prepared import Prepared, ReadCurve
 from curve_vae.inference.ranker import RANKED_READS, Ranker
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.spacer import Spacer
+from curve_vae.inference.untangling import untangle_rows
 
 #: A natural reading whose parameters are all within this of the points' index fractions reads the curve as given:
 #: spacing "search" does not try it beside "parameter".
@@ -90,6 +91,7 @@ class Reader:
         self.closest = closest  # each caller point placed at its closest point on the decoded spline
         self.fitter = fitter
         self.cache = cache
+        self.untangle = True  # answers that cross themselves where their inputs do not are untangled (untangling)
 
     def read(
         self, curves: Sequence[np.ndarray], reading: Reading, *, decoded: bool = True, shared: bool = False
@@ -124,9 +126,20 @@ class Reader:
                 todo, self.fitter.refine([inputs[i] for i in todo], [read[i] for i in todo], reading.refine)
             ):
                 read[i] = row
+        missing: list[int] = []
         if decoded or self.closest:
             missing = [i for i, r in enumerate(read) if not r.decoded_yet]
             for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [read[i] for i in missing])[0]):
+                read[i] = row
+        if self.untangle:  # rows read or decoded just now (cached rows were untangled when they were read)
+            fresh = sorted(set(todo) | set(missing))
+            untangled = untangle_rows(
+                [inputs[i] for i in fresh],
+                [read[i] for i in fresh],
+                model_size=self.graphs.model_size,
+                degree=self.graphs.spline_degree,
+            )
+            for i, row in zip(fresh, untangled):
                 read[i] = row
         if self.cache is not None:
             for k, row in zip(keys, read):

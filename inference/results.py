@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from curve_vae.geometry import Frame
+from curve_vae.geometry import Frame, closeness
 
 
 @dataclass(frozen=True)
@@ -33,6 +33,39 @@ class Spline:
 
 
 @dataclass(frozen=True)
+class Closeness:
+    """How close each answer came to its input, relative to the input's size (geometry.closeness): the RMS and the
+    largest distance over the input's points, each ÷ its bounding-box diagonal, and the index of that farthest point.
+    Unitless: 0.001 is 0.1% of the curve's diagonal, an airfoil's or a stroke's alike."""
+
+    rms: np.ndarray  # (B,)
+    max: np.ndarray  # (B,)
+    max_at: np.ndarray  # (B,) int
+
+    @classmethod
+    def of(cls, inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]) -> Closeness:
+        return cls(*closeness(inputs, outputs))
+
+    def part(self, cut: slice) -> Closeness:
+        return Closeness(self.rms[cut], self.max[cut], self.max_at[cut])
+
+    def json(self) -> list[dict[str, Any]]:
+        """As the API reports it: one {rms, max, max_at} per curve (null where float64 overflowed)."""
+        return [
+            {"rms": _finite(r), "max": _finite(m), "max_at": int(i)} for r, m, i in zip(self.rms, self.max, self.max_at)
+        ]
+
+
+def _finite(value: Any) -> float | None:
+    v = float(value)
+    return v if np.isfinite(v) else None
+
+
+def no_closeness(count: int = 0) -> Closeness:
+    return Closeness(np.zeros(count), np.zeros(count), np.zeros(count, np.int64))
+
+
+@dataclass(frozen=True)
 class Encoding:
     """Latent means and log-variances (B, latent_dim) of the curves, and the frame (with its pose) each was mapped
     from (None for frame "model"); with refine, the means are the fitted latents."""
@@ -40,6 +73,7 @@ class Encoding:
     mean: np.ndarray
     log_var: np.ndarray
     frames: list[Frame | None]
+    closeness: Closeness | None = None  # where the reading decoded each latent (closest placement)
 
 
 def _cuts(sizes: Sequence[int]) -> list[slice]:
@@ -49,7 +83,10 @@ def _cuts(sizes: Sequence[int]) -> list[slice]:
 
 def split_encoding(enc: Encoding, sizes: Sequence[int]) -> list[Encoding]:
     """`enc` cut into consecutive parts of `sizes` curves (inference.coalescing: each request's own)."""
-    return [Encoding(enc.mean[c], enc.log_var[c], enc.frames[c]) for c in _cuts(sizes)]
+    return [
+        Encoding(enc.mean[c], enc.log_var[c], enc.frames[c], None if enc.closeness is None else enc.closeness.part(c))
+        for c in _cuts(sizes)
+    ]
 
 
 def head_splines(splines: Sequence[Spline | None], has_splines: bool) -> list[Spline] | None:
@@ -78,13 +115,23 @@ class Reconstruction:
     latents: np.ndarray  # (B, latent_dim)
     frames: list[Frame | None]
     splines: list[Spline] | None = None
+    closeness: Closeness = field(default_factory=no_closeness)  # relative to each input's size
+    # (B,) bool: the decoded curve crossed itself where the input does not, and its spline was untangled near the
+    # crossing (inference.untangling); its latent decodes to the curve before
+    repaired: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
 
 
 def split_reconstruction(rec: Reconstruction, sizes: Sequence[int]) -> list[Reconstruction]:
     """`rec` cut into consecutive parts of `sizes` curves (inference.coalescing: each request's own)."""
     return [
         Reconstruction(
-            rec.curves[c], rec.mse[c], rec.latents[c], rec.frames[c], None if rec.splines is None else rec.splines[c]
+            rec.curves[c],
+            rec.mse[c],
+            rec.latents[c],
+            rec.frames[c],
+            None if rec.splines is None else rec.splines[c],
+            rec.closeness.part(c),
+            rec.repaired[c],
         )
         for c in _cuts(sizes)
     ]
@@ -95,6 +142,9 @@ class Interpolation(Curves):
     """Curves decoded from affine mixes of the inputs' latents (paper eqs. 9, 10), one per weight row."""
 
     weights: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # (rows, inputs)
+    valid: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))  # (rows,) free of self-crossings
+    repaired: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))  # (rows,) untangled (inference.untangling)
+    ends: Closeness = field(default_factory=no_closeness)  # each input's reconstruction in the set's pose, vs the input
 
 
 @dataclass(frozen=True)
@@ -117,3 +167,5 @@ class Augmented(Curves):
     weights: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  # (m, k)
     seed: int = 0
     offset: int = 0
+    redrawn: int = 0  # mixes that crossed themselves and were drawn again (their item's own generator)
+    invalid: int = 0  # items still crossing themselves after MAX_REDRAWS draws (returned; normally 0)

@@ -19,32 +19,30 @@ the encoding cache (`inference.cache`). Nothing here imports torch.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
 
-from curve_vae.geometry import Frame, blend_frames
-from curve_vae.geometry.adapt import is_closed
-from curve_vae.inference.augmenting import AugmentPlan, neighbour_pools
+from curve_vae.geometry import Frame
+from curve_vae.inference.augmenting import AugmentPlan, augmented, neighbour_pools
 from curve_vae.inference.cache import DEFAULT_CACHE_BYTES, EncodingCache
 from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.manifest import Manifest, ModelLoadError  # noqa: F401  (ModelLoadError: part of its API)
+from curve_vae.inference.mixing import mix
 from curve_vae.inference.named_priors import NamedPrior
 from curve_vae.inference.opening import open_model
 from curve_vae.inference.placing import (
-    check_finite,
     check_range,
     closed_rows,
     decoded_to_caller,
     each_to_caller,
-    joined,
     placed_to_caller,
-    to_caller,
 )
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.prior import LatentPrior
@@ -53,6 +51,7 @@ from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import (
     Augmented,
+    Closeness,
     Curves,
     Encoding,
     Interpolation,
@@ -60,6 +59,7 @@ from curve_vae.inference.results import (
     Sampled,
     Spline,
     head_splines,
+    no_closeness,
 )
 from curve_vae.inference.sampling import MAX_DRAWS, Sampler, fresh_seed
 from curve_vae.inference.sessions import SessionConfig
@@ -188,7 +188,10 @@ class CurveRuntime:
         """Latent mean and log-variance of each curve, and the frame (with its pose) each was mapped from; with
         refine, the means are the fitted latents. together: read as one set (`prepare`)."""
         prep = self.prepare(curves, reading, decoded=False, together=together)
-        return Encoding(prep.mean, prep.log_var, prep.frames)
+        decoded = bool(prep.rows) and all(r.decoded_yet for r in prep.rows)  # closest placement decodes to read
+        return Encoding(
+            prep.mean, prep.log_var, prep.frames, Closeness.of(prep.inputs, self._at_inputs(prep)) if decoded else None
+        )
 
     def decode(
         self,
@@ -231,7 +234,16 @@ class CurveRuntime:
             if placed is None:  # curve by curve: n_points asked, no frames, or a head without closest placement
                 placed = each_to_caller(self.graphs, prep, n_points=n_points, spacing=r.spacing)
         curves_out, splines, mse = placed
-        return Reconstruction(curves_out, mse, prep.mean, prep.frames, head_splines(splines, self.has_splines))
+        own = curves_out if n_points is None else self._at_inputs(prep)
+        return Reconstruction(
+            curves_out,
+            mse,
+            prep.mean,
+            prep.frames,
+            head_splines(splines, self.has_splines),
+            closeness=Closeness.of(prep.inputs, own),
+            repaired=np.array([r.repair is not None for r in prep.rows], bool),
+        )
 
     def interpolate(
         self,
@@ -253,50 +265,30 @@ class CurveRuntime:
         """
         r = self.reading(reading)
         prep = self.reader.read(curves, r, decoded=False, shared=True)  # only the latents are mixed
-        return self.mix(prep, np.asarray(weights, np.float64), n_points=n_points, spacing=r.spacing)
+        made = self.mix(prep, np.asarray(weights, np.float64), n_points=n_points, spacing=r.spacing)
+        return dataclasses.replace(made, ends=self._ends(prep))
+
+    def _ends(self, prep: Prepared) -> Closeness:
+        """How close each input's own reconstruction in the set's reading comes (a sweep's ends); none where the
+        reading did not decode them (a model placed by index decodes only the mixes)."""
+        if not all(r.decoded_yet for r in prep.rows):
+            return no_closeness(len(prep.rows))
+        return Closeness.of(prep.inputs, self._at_inputs(prep))
+
+    def _at_inputs(self, prep: Prepared) -> list[np.ndarray]:
+        """Each decoded curve at its input's own points, in the caller's frame: what the closeness compares."""
+        with np.errstate(all="ignore"):
+            placed = placed_to_caller(self.graphs, prep) or each_to_caller(
+                self.graphs, prep, n_points=None, spacing="parameter"
+            )
+        return placed[0]
 
     def mix(
         self, prep: Prepared, weights: np.ndarray, *, n_points: int | None = None, spacing: str = "parameter"
     ) -> Interpolation:
         """Decode weight rows (rows, len(prep.inputs)) over the prepared curves' means; see `interpolate`."""
-        g = self.graphs
-        w = np.asarray(weights, np.float64)
-        mean = prep.mean.astype(np.float64)
-        auto = bool(prep.rows) and prep.rows[0].frame is not None
-        with np.errstate(all="ignore"):
-            # Row by row, never a matrix product: BLAS sums in an order that depends on the number of rows, and
-            # a curve must not change with the batch or page it is made in.
-            z = (w[:, :, None] * mean[None, :, :]).sum(axis=1)  # (rows, latent_dim)
-            check_range(z, "weights")
-            out, ctrl, params = g.decode(z)
-            check_finite(out, "weights", "the weighted latent decodes to non-finite coordinates: weights too extreme")
-            given = [f for f in prep.frames if f is not None]
-            frames: list[Frame | None] = (
-                [blend_frames(given, w[k : k + 1])[0] for k in range(len(w))] if auto else [None] * len(w)
-            )
-            common = _common_length(prep)
-            placed = prep.placed or all(f is not None for f in prep.fractions)
-            blend = n_points is None and common is not None and placed
-            if n_points is None and common is None:
-                n_points = self.n_points
-            closed = bool(prep.inputs) and all(is_closed(c) for c in prep.inputs)  # loops mix into loops
-            results, splines = [], []
-            for k, o in enumerate(out):
-                c, u = None if ctrl is None else ctrl[k], None if params is None else params[k]
-                if closed:
-                    o, c = joined(o, c)
-                if blend:  # placed: blend the spline parameters of the input points (not the head's)
-                    at, head = (prep.fractions, u) if not prep.placed else (prep.feet, None)
-                    positions = w[k] @ np.stack([a for a in at if a is not None])  # every input's (`placed`)
-                    positions = np.maximum.accumulate(np.clip(positions, 0.0, 1.0))  # extrapolating rows stay ordered
-                    curve, spline = to_caller(g, o, frames[k], n_points=None, fractions=positions, ctrl=c, params=head)
-                else:
-                    curve, spline = to_caller(g, o, frames[k], n_points=n_points, spacing=spacing, ctrl=c, params=u)
-                results.append(curve)
-                splines.append(spline)
-            result = np.stack(results) if results else np.zeros((0, self.mix_length(prep, n_points), 2))
-        check_finite(result, "weights", "the interpolant does not fit in float64")
-        return Interpolation(result, frames, head_splines(splines, g.has_splines), weights=w)
+        length = self.mix_length(prep, n_points)
+        return mix(self.graphs, prep, weights, n_points=n_points, spacing=spacing, length=length)
 
     def mix_length(self, prep: Prepared, n_points: int | None) -> int:
         """Points per curve that mixing `prep`'s curves returns: n_points, else their common length, else 161."""
@@ -364,14 +356,9 @@ class CurveRuntime:
     def augment(
         self, plan: AugmentPlan, start: int, stop: int, *, n_points: int | None = None, spacing: str = "parameter"
     ) -> Augmented:
-        """Items start … stop-1 of the plan's sequence."""
-        sources, weights = plan.draw(start, stop)
-        full = np.zeros((len(sources), len(plan.mean)))
-        np.put_along_axis(full, sources, weights, axis=1)
-        made = self.mix(plan.prep, full, n_points=n_points, spacing=spacing)
-        return Augmented(
-            made.curves, made.frames, made.splines, sources=sources, weights=weights, seed=plan.seed, offset=start
-        )
+        """Items start … stop-1 of the plan's sequence, each free of self-crossings (inference.augmenting)."""
+        length = self.mix_length(plan.prep, n_points)
+        return augmented(self.graphs, plan, start, stop, n_points=n_points, spacing=spacing, length=length)
 
     def augment_chunks(
         self,

@@ -35,9 +35,25 @@ MetricsOut = Annotated[
 ]
 
 
+class ClosenessOut(BaseModel):
+    """How close an answer came to its input, relative to the input's size: 0.001 is 0.1% of its diagonal."""
+
+    rms: float | None = Field(
+        description="Root mean squared distance between the input's points and the answer's matched points, ÷ the "
+        "input's bounding-box diagonal (null only where float64 overflowed)."
+    )
+    max: float | None = Field(description="The largest such distance (the worst point), ÷ the same diagonal.")
+    max_at: int = Field(description="Index in the input of that worst point.")
+
+
 class EncodeResponse(BaseModel):
     mean: list[list[float]] = Field(description="Latent mean of each curve (batch × latent_dim).")
     log_var: list[list[float]] = Field(description="Latent log-variance of each curve (batch × latent_dim).")
+    closeness: list[ClosenessOut] | None = Field(
+        None,
+        description="Per curve, where the reading decoded the latent (the shipped model's closest placement): how "
+        "close its decoding comes to the curve, relative to its size (as /reconstruct).",
+    )
     frames: list[FrameInfo] | None = Field(
         description='The frame each curve was mapped from (frame "auto"); pass them to /decode to map back. '
         'null for frame "model".'
@@ -72,12 +88,31 @@ class ReconstructResponse(CurvesResponse):
         "point matched to it (with the shipped model's closest placement, its closest point on the reconstruction; "
         "GET /model: spline.placement)."
     )
+    closeness: list[ClosenessOut] = Field(
+        description="Per curve: how close the reconstruction came relative to the input's size (its RMS and largest "
+        "distance ÷ the input's bounding-box diagonal, and where the largest is): unitless, unlike `mse`."
+    )
+    repaired: list[bool] = Field(
+        description="Per curve: whether the decoded curve crossed itself where the input does not and its spline was "
+        "refitted to the input around the crossing (a valid shape, as close or closer; the returned latent, from "
+        "/encode, decodes to the curve before). Answers never cross themselves where their inputs do not."
+    )
 
 
 class InterpolateResponse(CurvesResponse):
     weights: list[list[float]] = Field(description="The weight row of each returned curve, one entry per input curve.")
     frames: list[FrameInfo] | None = Field(
         description='Frame "auto": the blend of the inputs\' frames each interpolant was mapped into.'
+    )
+    valid: list[bool] = Field(
+        description="Per returned curve: free of self-crossings. An in-between that crossed itself is refitted near "
+        "the crossing to the blend of its ends' answers; false where even that crosses (the ends cannot be joined "
+        "there by valid curves)."
+    )
+    repaired: list[bool] = Field(description="Per returned curve: whether it was refitted near a crossing.")
+    ends: list[ClosenessOut] = Field(
+        description="Per input curve: how close its own reconstruction in the set's reading (the sweep's end) came, "
+        "relative to its size; empty for a model that decodes only the mixes."
     )
 
 
@@ -105,6 +140,10 @@ class AugmentResponse(CurvesResponse):
     frames: list[FrameInfo] | None = Field(description='Frame "auto": the blend of the sources\' frames.')
     seed: int = Field(description="The seed used: the request's, or the one drawn for it (to repeat or page on).")
     offset: int = Field(description="Index of the first returned curve in the seeded sequence.")
+    redrawn: int = Field(
+        0, description="Mixes that crossed themselves and were drawn again, from their item's own seeded generator."
+    )
+    invalid: int = Field(0, description="Curves still crossing themselves after 10 draws each (normally 0).")
 
 
 class BSplineOut(BaseModel):

@@ -47,9 +47,28 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
         rec = model_runtime(a).reconstruct(curves, Reading(**reading), n_points=a.n_points)
         body = reconstruct_body(rec, metrics=a.metrics, output=a.output_as)
     write_output(a.output, body, array_key="curves" if "curves" in body else None)
-    mse = np.asarray(body["mse"])
-    print(f"{a.output}: {len(mse)} curves reconstructed, MSE (paper eq. 4) mean {mse.mean():.4g}", file=sys.stderr)
+    print(f"{a.output}: {reconstruct_summary(body)}", file=sys.stderr)
     return 0
+
+
+def reconstruct_summary(body: dict[str, Any]) -> str:
+    """One line a person reads: how close the curves came relative to their size, the worst point and where it is,
+    how many were untangled, and the paper's MSE in the curves' own units."""
+    mse = np.asarray(body["mse"], np.float64)
+    line = f"{len(mse)} curves reconstructed"
+    near = body.get("closeness") or []
+    if near:
+        rms = np.array([c["rms"] if c["rms"] is not None else np.inf for c in near])
+        worst = np.array([c["max"] if c["max"] is not None else np.inf for c in near])
+        w = int(np.argmax(worst))
+        line += (
+            f", RMS {100 * rms.mean():.3g}% of the diagonal (mean), worst point {100 * worst[w]:.3g}%"
+            f" (curve {w}, point {near[w]['max_at']})"
+        )
+    repaired = int(np.sum(body.get("repaired") or []))
+    if repaired:
+        line += f", {repaired} untangled where they crossed themselves"
+    return line + f"; MSE (paper eq. 4) mean {mse.mean():.4g}"
 
 
 def cmd_encode(a: argparse.Namespace) -> int:

@@ -153,14 +153,23 @@ function thumbnail(parent, curve) {
 function renderMetrics() {
   const dl = $("metrics");
   dl.replaceChildren();
+  const rows = [];
+  // how close each reconstruction came, relative to its curve's size (the answer's closeness)
+  state.recon.forEach((r, i) => {
+    if (!r || !r.closeness) return;
+    const c = r.closeness, pct = (v) => (v === null ? "–" : `${(100 * v).toFixed(2)}%`);
+    rows.push([`${"ABC"[i]} reconstructed within`,
+      `RMS ${pct(c.rms)}, worst ${pct(c.max)} of its size${r.repaired ? " (untangled)" : ""}`]);
+  });
   const m = state.result && state.result.metrics;
-  if (!m) return;
-  const rows = [
-    ["roughness", `${m.smoothness.roughness.toFixed(3)}°`],
-    ["sharpest turn", `${m.smoothness.max_turn.toFixed(1)}°`],
-    ["self-intersects", m.self_intersects ? "yes" : "no"],
-    ["control points", state.result.spline ? state.result.spline.control_points.length : "–"],
-  ];
+  if (m) {
+    rows.push(
+      ["mix roughness", `${m.smoothness.roughness.toFixed(3)}°`],
+      ["mix sharpest turn", `${m.smoothness.max_turn.toFixed(1)}°`],
+      ["mix self-intersects", m.self_intersects ? "yes" : "no"],
+      ["mix control points", state.result.spline ? state.result.spline.control_points.length : "–"],
+    );
+  }
   for (const [k, v] of rows) {
     const dt = document.createElement("dt"); dt.textContent = k; dl.appendChild(dt);
     const dd = document.createElement("dd"); dd.textContent = v; dd.dataset.metric = k; dl.appendChild(dd);
@@ -214,7 +223,8 @@ async function reconstructAll() {
   if (!state.curves.length) return;
   const body = { curves: state.curves, n_points: N_POINTS, output: "both", refine: refine() };
   const r = await api("/reconstruct", body, $("board-error"));
-  state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i], refine: body.refine }));
+  state.recon = r.curves.map((points, i) => ({ points, spline: r.splines[i], mse: r.mse[i], refine: body.refine,
+    closeness: r.closeness[i], repaired: r.repaired[i] }));
 }
 
 function needed() { return state.mode === "triplet" ? 3 : 2; }

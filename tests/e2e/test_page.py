@@ -139,7 +139,13 @@ def _check_pair(page: Page, url: str) -> None:
     del strip_body["weights"]
     strip = httpx.post(url + "/interpolate", json=strip_body, timeout=30).json()
     np.testing.assert_allclose(s["strip"], strip["curves"], atol=1e-9)
-    assert float(page.locator("dd[data-metric=roughness]").inner_text().rstrip("°")) >= 0
+    assert float(page.locator("dd[data-metric='mix roughness']").inner_text().rstrip("°")) >= 0
+    # each reconstruction says how close it came relative to its curve's size: the API's closeness
+    again = httpx.post(url + "/reconstruct", json={"curves": s["curves"], "refine": s["recon"][0]["refine"]}).json()
+    for i, name in enumerate("AB"):
+        near = again["closeness"][i]
+        shown = page.locator(f"dd[data-metric='{name} reconstructed within']").inner_text()
+        assert shown.startswith(f"RMS {100 * near['rms']:.2f}%, worst {100 * near['max']:.2f}% of its size"), shown
 
     page.check("#show-ctrl")
     assert page.locator(".control-polygon").count() == 3  # two reconstructions and the mix

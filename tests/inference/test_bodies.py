@@ -12,6 +12,7 @@ from curve_vae.inference import bodies
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.results import (
     Augmented,
+    Closeness,
     Curves,
     Encoding,
     Interpolation,
@@ -75,10 +76,24 @@ def test_result_bodies_carry_their_parts():
     )
     body = bodies.reconstruct_body(rec, metrics=True, output="both")
     assert [len(c) for c in body["curves"]] == [4, 4] and body["mse"].tolist() == [0.5, 0.25]
+    assert body["closeness"] == [] and body["repaired"] == []  # a hand-made result: none measured
     assert len(body["metrics"]) == len(body["splines"]) == 2
-    mix = Interpolation(np.stack([LINE, LINE]), [FRAME, FRAME], None, weights=np.array([[1.0, 0.0], [0.5, 0.5]]))
+    mix = Interpolation(
+        np.stack([LINE, LINE]),
+        [FRAME, FRAME],
+        None,
+        weights=np.array([[1.0, 0.0], [0.5, 0.5]]),
+        valid=np.array([True, False]),
+        repaired=np.array([False, True]),
+        ends=Closeness(np.array([1e-3, 2e-3]), np.array([4e-3, np.inf]), np.array([3, 0])),
+    )
     body = bodies.interpolate_body(mix, output="bspline")  # no splines: the points stay
-    assert set(body) == {"weights", "curves", "frames"} and body["frames"][1]["size"] == 3.5
+    assert (
+        set(body) == {"weights", "curves", "frames", "valid", "repaired", "ends"} and body["frames"][1]["size"] == 3.5
+    )
+    assert body["valid"] == [True, False] and body["repaired"] == [False, True]
+    assert body["ends"] == [{"rms": 1e-3, "max": 4e-3, "max_at": 3}, {"rms": 2e-3, "max": None, "max_at": 0}]
+    json.dumps(body["ends"], allow_nan=False)  # strict JSON: an overflow is null, never Infinity
     made = bodies.decode_body(Curves(np.stack([LINE]), [None], [_spline()]), output="bspline")
     assert set(made) == {"splines"}
 

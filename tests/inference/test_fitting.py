@@ -68,9 +68,13 @@ def test_a_refined_curve_does_not_depend_on_how_its_points_are_spaced(shipped_ru
 def test_refining_never_raises_the_error_and_each_step_can_only_lower_it(runtime, params_runtime, curves):
     for rt in (runtime, params_runtime):
         c = list(curves(5, seed=2))
-        plain = rt.reconstruct(c).mse
-        one = rt.reconstruct(c, Reading(refine=1)).mse
-        four = rt.reconstruct(c, Reading(refine=4)).mse
+        rt.reader.untangle = False  # the fit's own steps: the untrained model's answers cross, and untangling refits
+        try:
+            plain = rt.reconstruct(c).mse
+            one = rt.reconstruct(c, Reading(refine=1)).mse
+            four = rt.reconstruct(c, Reading(refine=4)).mse
+        finally:
+            rt.reader.untangle = True
         assert (one <= plain * (1 + 1e-9)).all() and (four <= one * (1 + 1e-9)).all()
         assert four.sum() < one.sum()  # the steps themselves fit, not only the matching to closest points
 
@@ -91,8 +95,17 @@ def test_encode_returns_the_refined_latents_that_reconstruct_decodes(runtime, cu
     mean, frames = res.mean, res.frames
     assert not np.allclose(mean, plain)
     decoded = runtime.decode(mean, frames=frames, n_points=50).curves
-    out = runtime.reconstruct(c, Reading(refine=3), n_points=50).curves
-    np.testing.assert_allclose(decoded, np.stack(out), atol=1e-9)
+    rec = runtime.reconstruct(c, Reading(refine=3), n_points=50)
+    # an answer untangled near a crossing says so (the untrained model's curves cross): its latent decodes to the
+    # curve before; the rest are their latents' decodings exactly
+    kept = ~rec.repaired
+    np.testing.assert_allclose(decoded[kept], np.stack(rec.curves)[kept], atol=1e-9)
+    runtime.reader.untangle = False
+    try:
+        plain = runtime.reconstruct(c, Reading(refine=3), n_points=50).curves
+    finally:
+        runtime.reader.untangle = True
+    np.testing.assert_allclose(decoded, np.stack(plain), atol=1e-9)
 
 
 def test_a_model_without_a_head_cannot_refine_and_says_why(raw_runtime, raw_model_dir, curves):

@@ -1,0 +1,95 @@
+"""Curves mixed from prepared curves' latents (paper eqs. 9, 10): the decoding of each weight row, brought to the
+caller's frame, carrying its ends' repairs and untangled where it crosses itself (inference.untangling)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from curve_vae.geometry import Frame, blend_frames
+from curve_vae.geometry.adapt import is_closed, joined_ends
+from curve_vae.geometry.bspline import spline_values
+from curve_vae.geometry.validity import crosses
+from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.placing import check_finite, check_range, joined, to_caller
+from curve_vae.inference.prepared import Prepared
+from curve_vae.inference.results import Interpolation, head_splines
+from curve_vae.inference.untangling import mixed_repairs, untangle_mixes
+
+
+def mix(
+    g: ModelGraphs, prep: Prepared, weights: np.ndarray, *, n_points: int | None, spacing: str, length: int
+) -> Interpolation:
+    """Decode weight rows (rows, len(prep.inputs)) over the prepared curves' means (runtime.interpolate says what
+    comes back); `length`: the points per curve when there are no rows."""
+    w = np.asarray(weights, np.float64)
+    mean = prep.mean.astype(np.float64)
+    auto = bool(prep.rows) and prep.rows[0].frame is not None
+    with np.errstate(all="ignore"):
+        # Row by row, never a matrix product: BLAS sums in an order that depends on the number of rows, and
+        # a curve must not change with the batch or page it is made in.
+        z = (w[:, :, None] * mean[None, :, :]).sum(axis=1)  # (rows, latent_dim)
+        check_range(z, "weights")
+        out, ctrl, params = g.decode(z)
+        check_finite(out, "weights", "the weighted latent decodes to non-finite coordinates: weights too extreme")
+        given = [f for f in prep.frames if f is not None]
+        frames: list[Frame | None] = (
+            [blend_frames(given, w[k : k + 1])[0] for k in range(len(w))] if auto else [None] * len(w)
+        )
+        lengths = {len(c) for c in prep.inputs}
+        common = lengths.pop() if len(lengths) == 1 else None
+        placed = prep.placed or all(f is not None for f in prep.fractions)
+        blend = n_points is None and common is not None and placed
+        closed = bool(prep.inputs) and all(is_closed(c) for c in prep.inputs)  # loops mix into loops
+        if ctrl is not None:
+            ctrl = ctrl.astype(np.float64)
+            shares = mixed_repairs(prep.rows, w)  # the ends' repairs, in proportion: a row [1, 0] is its first end
+            if shares is not None:
+                ctrl += shares
+        positions = _positions(prep, w) if blend else None
+        repaired = np.zeros(len(w), bool)
+        if ctrl is not None and positions is not None and prep.placed and len(w):
+            if closed:
+                ctrl = np.stack([joined_ends(c) for c in ctrl])
+            ends = _end_answers(g, prep, closed)
+            ctrl, repaired, _ = untangle_mixes(ctrl, positions, ends, w, closed=closed, degree=g.spline_degree)
+        results, splines = [], []
+        for k, o in enumerate(out):
+            c, u = None if ctrl is None else ctrl[k], None if params is None else params[k]
+            if closed:
+                o, c = joined(o, c)
+            if positions is not None:  # placed: blend the spline parameters of the input points (not the head's)
+                head = u if not prep.placed else None
+                curve, spline = to_caller(g, o, frames[k], n_points=None, fractions=positions[k], ctrl=c, params=head)
+            else:
+                curve, spline = to_caller(g, o, frames[k], n_points=n_points, spacing=spacing, ctrl=c, params=u)
+            results.append(curve)
+            splines.append(spline)
+        result = np.stack(results) if results else np.zeros((0, length, 2))
+    check_finite(result, "weights", "the interpolant does not fit in float64")
+    return Interpolation(
+        result,
+        frames,
+        head_splines(splines, g.has_splines),
+        weights=w,
+        valid=~crosses(list(result)),
+        repaired=repaired,
+    )
+
+
+def _positions(prep: Prepared, w: np.ndarray) -> np.ndarray:
+    """Each row's blend of the input points' positions along their curves (rows, n): their spline parameters where
+    placed on the splines, else where they sit along the model's points."""
+    at = prep.feet if prep.placed else prep.fractions
+    positions = w @ np.stack([a for a in at if a is not None])  # every input's (`placed`)
+    return np.maximum.accumulate(np.clip(positions, 0.0, 1.0), axis=1)  # extrapolating rows stay ordered
+
+
+def _end_answers(g: ModelGraphs, prep: Prepared, closed: bool) -> np.ndarray:
+    """Each input's answer in the model plane (inputs, n, 2): its spline (repaired, joined where closed) at its
+    points' parameters."""
+    ctrl = np.stack([np.asarray(r.ctrl, np.float64) for r in prep.rows])
+    if closed:
+        ctrl = np.stack([joined_ends(c) for c in ctrl])
+    feet = np.stack([np.asarray(r.feet, np.float64) for r in prep.rows])
+    owner = np.repeat(np.arange(len(ctrl)), feet.shape[1])
+    return spline_values(ctrl, feet.reshape(-1), owner, degree=g.spline_degree)[0].reshape(*feet.shape, 2)

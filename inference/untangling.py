@@ -1,0 +1,87 @@
+"""Answers that are valid shapes: a reconstruction or an in-between that crosses itself where its input does not is
+untangled (geometry.validity.untangled) before it is returned, and says so.
+
+A reconstruction placed on its spline (a B-spline head, closest placement or refine: the shipped model's) is the
+spline at its points' parameters; where it crosses itself and its input does not, the control points around the
+crossing are refitted to the input's own points. The change of control points is kept with the row
+(`ReadCurve.repair`), so that curves mixed from it carry it in proportion: an in-between's control points get the
+weighted sum of its ends' repairs, and a row [1, 0] is its first end's answer to the bit. An in-between that still
+crosses is refitted the same way near its crossings, to the blend of its ends' answers at its points (what the
+point-wise blend of two valid, similar shapes is: valid where they are alike).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+
+from curve_vae.geometry.adapt import is_closed, joined_ends
+from curve_vae.geometry.bspline import spline_values
+from curve_vae.geometry.validity import crosses, new_crossings, untangled
+from curve_vae.inference.prepared import ReadCurve
+
+
+def untangle_rows(
+    inputs: Sequence[np.ndarray], rows: Sequence[ReadCurve], *, model_size: float, degree: int
+) -> list[ReadCurve]:
+    """The rows whose answers (their splines at their points' parameters) cross themselves where the inputs do not,
+    untangled against the inputs' own points; the rest as they are. Rows without a spline or placed points (a model
+    without a B-spline head or closest placement) are returned as they are."""
+    out = list(rows)
+    placed = [i for i, r in enumerate(rows) if r.ctrl is not None and r.feet is not None]
+    if not placed:
+        return out
+    ctrl = [_closed_ctrl(inputs[i], rows[i]) for i in placed]
+    feet = [np.asarray(rows[i].feet, np.float64) for i in placed]
+    lengths = np.array([len(f) for f in feet])
+    owner = np.repeat(np.arange(len(placed)), lengths)
+    answers = np.split(
+        spline_values(np.stack(ctrl), np.concatenate(feet), owner, degree=degree)[0], np.cumsum(lengths)[:-1]
+    )
+    bad = new_crossings([inputs[i] for i in placed], answers)
+    for j in np.flatnonzero(bad):
+        i = placed[j]
+        row = rows[i]
+        target = row.frame.to_model(inputs[i], model_size) if row.frame is not None else np.asarray(inputs[i])
+        fixed, _ = untangled(ctrl[j], feet[j], target, closed=is_closed(inputs[i]), degree=degree)
+        out[i] = dataclasses.replace(row, ctrl=fixed, repair=fixed - ctrl[j])  # float64: the fit's own digits
+    return out
+
+
+def _closed_ctrl(points: np.ndarray, row: ReadCurve) -> np.ndarray:
+    """The row's control points (float64) as its answer draws them: joined for a closed input."""
+    c = np.asarray(row.ctrl, np.float64)
+    return joined_ends(c) if is_closed(points) else c
+
+
+def mixed_repairs(rows: Sequence[ReadCurve], weights: np.ndarray) -> np.ndarray | None:
+    """Each weight row's share of the rows' repairs, (len(weights), n_ctrl, 2); None where no row was repaired."""
+    repairs = [r.repair for r in rows]
+    if all(r is None for r in repairs):
+        return None
+    like = next(r for r in repairs if r is not None)
+    stacked = np.stack([np.zeros_like(like) if r is None else r for r in repairs])  # (inputs, n_ctrl, 2)
+    return np.stack([(w[:, None, None] * stacked).sum(axis=0) for w in np.asarray(weights, np.float64)])
+
+
+def untangle_mixes(
+    ctrl: np.ndarray, params: np.ndarray, ends: np.ndarray, weights: np.ndarray, *, closed: bool, degree: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """In-betweens (rows, n_ctrl, 2) whose splines at `params` (rows, n) cross themselves, untangled against the
+    blend of their ends' answers `ends` (inputs, n, 2) by their weight rows (rows, inputs): the control points, which
+    rows were repaired and which are valid now."""
+    c = np.array(ctrl, np.float64)
+    n = params.shape[1]
+    owner = np.repeat(np.arange(len(c)), n)
+    points = spline_values(c, params.reshape(-1), owner, degree=degree)[0].reshape(len(c), n, 2)
+    bad = crosses(list(points))
+    repaired = np.zeros(len(c), bool)
+    valid = ~bad
+    if bad.any() and not crosses(list(ends)).any():  # ends that cross themselves have no valid blend to aim at
+        for k in np.flatnonzero(bad):
+            target = np.tensordot(weights[k], ends, axes=1)  # (n, 2)
+            c[k], valid[k] = untangled(c[k], params[k], target, closed=closed, degree=degree)
+            repaired[k] = True
+    return c, repaired, valid
