@@ -111,6 +111,34 @@ def polyline_to_caller(
     return frame.from_model(curve, model_size) if frame is not None else curve
 
 
+def spline_params(
+    control_points: np.ndarray,
+    *,
+    degree: int,
+    model_points: int,
+    n_points: int | None = None,
+    spacing: str = "parameter",
+    fractions: np.ndarray | None = None,
+    model_params: np.ndarray | None = None,
+) -> np.ndarray | None:
+    """The parameters at which `spline_to_caller` evaluates a model-plane spline (see there); None: evenly in the
+    parameter, n_points or model_points of them."""
+    count = n_points or model_points
+    if n_points is not None and spacing == "arc_length":
+        return arc_length_params(np.asarray(control_points, np.float64), n_points, degree=degree)
+    if model_params is not None:
+        own = np.linspace(0.0, 1.0, len(model_params))
+        at = (
+            np.asarray(fractions, np.float64)
+            if n_points is None and fractions is not None
+            else np.linspace(0, 1, count)
+        )
+        return np.clip(np.interp(at, own, np.asarray(model_params, np.float64)), 0.0, 1.0)
+    if n_points is None and fractions is not None:
+        return np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
+    return None
+
+
 def spline_to_caller(
     control_points: np.ndarray,
     frame: Frame | None,
@@ -133,21 +161,16 @@ def spline_to_caller(
     """
     c = np.asarray(control_points, np.float64)
     count = n_points or model_points
-    if n_points is not None and spacing == "arc_length":
-        u = arc_length_params(c, n_points, degree=degree)
-    elif model_params is not None:
-        own = np.linspace(0.0, 1.0, len(model_params))
-        at = (
-            np.asarray(fractions, np.float64)
-            if n_points is None and fractions is not None
-            else np.linspace(0, 1, count)
-        )
-        u = np.clip(np.interp(at, own, np.asarray(model_params, np.float64)), 0.0, 1.0)
-    elif n_points is None and fractions is not None:
-        u = np.clip(np.asarray(fractions, np.float64), 0.0, 1.0)
-    else:  # evenly in the parameter: the basis is the same for every curve (cached by sample_bspline)
-        u = None
-    if u is None:
+    u = spline_params(
+        c,
+        degree=degree,
+        model_points=model_points,
+        n_points=n_points,
+        spacing=spacing,
+        fractions=fractions,
+        model_params=model_params,
+    )
+    if u is None:  # evenly in the parameter: the basis is the same for every curve (cached by sample_bspline)
         curve, u = sample_bspline(c, count, degree), np.linspace(0.0, 1.0, count)
     else:
         curve = evaluate_bspline(c, u, degree)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from curve_vae.geometry import Frame, blend_frames
-from curve_vae.geometry.adapt import is_closed, joined_ends
+from curve_vae.geometry.adapt import is_closed, joined_ends, spline_params
 from curve_vae.geometry.bspline import spline_values
 from curve_vae.geometry.validity import crosses
 from curve_vae.inference.graphs import ModelGraphs
@@ -47,11 +47,13 @@ def mix(
                 ctrl += shares
         positions = _positions(prep, w) if blend else None
         repaired = np.zeros(len(w), bool)
-        if ctrl is not None and positions is not None and prep.placed and len(w):
+        if ctrl is not None and len(w):
             if closed:
                 ctrl = np.stack([joined_ends(c) for c in ctrl])
-            ends = _end_answers(g, prep, closed)
-            ctrl, repaired, _ = untangle_mixes(ctrl, positions, ends, w, closed=closed, degree=g.spline_degree)
+            heads = [None if params is None else params[k] for k in range(len(w))]
+            at = [_params_of(g, ctrl[k], heads[k], positions, k, prep.placed, n_points, spacing) for k in range(len(w))]
+            targets = _targets(g, prep, w, at, positions is not None and prep.placed)
+            ctrl, repaired = untangle_mixes(ctrl, at, targets, closed=closed, degree=g.spline_degree)
         results, splines = [], []
         for k, o in enumerate(out):
             c, u = None if ctrl is None else ctrl[k], None if params is None else params[k]
@@ -76,20 +78,68 @@ def mix(
     )
 
 
+def _params_of(
+    g: ModelGraphs,
+    ctrl: np.ndarray,
+    head: np.ndarray | None,
+    positions: np.ndarray | None,
+    k: int,
+    placed: bool,
+    n_points: int | None,
+    spacing: str,
+) -> np.ndarray:
+    """The parameters at which row k's spline is returned (as `to_caller` evaluates it)."""
+    if positions is not None:
+        u = spline_params(
+            ctrl,
+            degree=g.spline_degree,
+            model_points=g.n_points,
+            fractions=positions[k],
+            model_params=None if placed else head,
+        )
+    else:
+        u = spline_params(
+            ctrl, degree=g.spline_degree, model_points=g.n_points, n_points=n_points, spacing=spacing, model_params=head
+        )
+    return np.linspace(0.0, 1.0, n_points or g.n_points) if u is None else u
+
+
+def _targets(g: ModelGraphs, prep: Prepared, w: np.ndarray, at: list[np.ndarray], placed: bool) -> list[np.ndarray]:
+    """What each in-between should pass close to at its parameters `at`: where the inputs were placed on their
+    splines, the blend of their answers point for point; else the blend of their splines at the same parameter."""
+    ends = _end_ctrl(g, prep)
+    feet = [np.asarray(r.feet, np.float64) for r in prep.rows] if prep.placed else []
+    answers = [spline_values(e, f, degree=g.spline_degree)[0] for e, f in zip(ends, feet)]  # each end's answer
+    if placed:
+        return [np.tensordot(row, np.stack(answers), axes=1) for row in w]
+    out = []
+    for row, u in zip(w, at):
+        if answers:  # along each end's answer (a valid polyline), where its points sit on its spline
+            each = np.stack([np.stack([np.interp(u, f, a[:, d]) for d in (0, 1)], 1) for f, a in zip(feet, answers)])
+        else:
+            owner = np.repeat(np.arange(len(ends)), len(u))
+            each = spline_values(ends, np.tile(u, len(ends)), owner, degree=g.spline_degree)[0]
+            each = each.reshape(len(ends), -1, 2)
+        out.append(np.tensordot(row, each, axes=1))
+    return out
+
+
+def _end_ctrl(g: ModelGraphs, prep: Prepared) -> np.ndarray:
+    """Each input's control points (inputs, n_ctrl, 2) as its answer draws them: repaired, joined where closed;
+    decoded here where the reading did not decode them."""
+    if all(r.ctrl is not None for r in prep.rows):
+        ctrl = np.stack([np.asarray(r.ctrl, np.float64) for r in prep.rows])
+    else:
+        decoded = g.decode(prep.mean.astype(np.float64))[1]
+        assert decoded is not None  # a B-spline head: mix only untangles where there are control points
+        ctrl = decoded.astype(np.float64)
+    # each joined where its own input is closed: its answer (a mix joins its ends only when every input is closed)
+    return np.stack([joined_ends(c) if is_closed(p) else c for c, p in zip(ctrl, prep.inputs)])
+
+
 def _positions(prep: Prepared, w: np.ndarray) -> np.ndarray:
     """Each row's blend of the input points' positions along their curves (rows, n): their spline parameters where
     placed on the splines, else where they sit along the model's points."""
     at = prep.feet if prep.placed else prep.fractions
     positions = w @ np.stack([a for a in at if a is not None])  # every input's (`placed`)
     return np.maximum.accumulate(np.clip(positions, 0.0, 1.0), axis=1)  # extrapolating rows stay ordered
-
-
-def _end_answers(g: ModelGraphs, prep: Prepared, closed: bool) -> np.ndarray:
-    """Each input's answer in the model plane (inputs, n, 2): its spline (repaired, joined where closed) at its
-    points' parameters."""
-    ctrl = np.stack([np.asarray(r.ctrl, np.float64) for r in prep.rows])
-    if closed:
-        ctrl = np.stack([joined_ends(c) for c in ctrl])
-    feet = np.stack([np.asarray(r.feet, np.float64) for r in prep.rows])
-    owner = np.repeat(np.arange(len(ctrl)), feet.shape[1])
-    return spline_values(ctrl, feet.reshape(-1), owner, degree=g.spline_degree)[0].reshape(*feet.shape, 2)

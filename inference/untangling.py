@@ -67,21 +67,22 @@ def mixed_repairs(rows: Sequence[ReadCurve], weights: np.ndarray) -> np.ndarray 
 
 
 def untangle_mixes(
-    ctrl: np.ndarray, params: np.ndarray, ends: np.ndarray, weights: np.ndarray, *, closed: bool, degree: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """In-betweens (rows, n_ctrl, 2) whose splines at `params` (rows, n) cross themselves, untangled against the
-    blend of their ends' answers `ends` (inputs, n, 2) by their weight rows (rows, inputs): the control points, which
-    rows were repaired and which are valid now."""
+    ctrl: np.ndarray, params: Sequence[np.ndarray], targets: Sequence[np.ndarray], *, closed: bool, degree: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """In-betweens (rows, n_ctrl, 2) whose splines at their `params` (n_k,) cross themselves, untangled against
+    `targets` (n_k, 2), the blend of their ends at those points: the control points, and which rows were repaired.
+    A row whose target crosses itself too is left as it is (its ends cannot be joined there by a valid blend)."""
     c = np.array(ctrl, np.float64)
-    n = params.shape[1]
-    owner = np.repeat(np.arange(len(c)), n)
-    points = spline_values(c, params.reshape(-1), owner, degree=degree)[0].reshape(len(c), n, 2)
-    bad = crosses(list(points))
+    lengths = np.array([len(u) for u in params])
+    owner = np.repeat(np.arange(len(c)), lengths)
+    flat = spline_values(c, np.concatenate(params), owner, degree=degree)[0] if len(c) else np.zeros((0, 2))
+    points = np.split(flat, np.cumsum(lengths)[:-1])
+    bad = crosses(points)
     repaired = np.zeros(len(c), bool)
-    valid = ~bad
-    if bad.any() and not crosses(list(ends)).any():  # ends that cross themselves have no valid blend to aim at
-        for k in np.flatnonzero(bad):
-            target = np.tensordot(weights[k], ends, axes=1)  # (n, 2)
-            c[k], valid[k] = untangled(c[k], params[k], target, closed=closed, degree=degree)
+    if bad.any():
+        rows = np.flatnonzero(bad)
+        aimed = rows[~crosses([targets[k] for k in rows])]
+        for k in aimed:
+            c[k], _ = untangled(c[k], params[k], targets[k], closed=closed, degree=degree)
             repaired[k] = True
-    return c, repaired, valid
+    return c, repaired

@@ -89,7 +89,8 @@ def cmd_augment(a: argparse.Namespace) -> int:
             shape, body = _write_augment(a, chunks, progress, seed, write_npy_chunks)
     if body is not None:
         write_output(a.output, body)
-    print(f"{a.output}: {a.count} new curves of {shape[1]} points ({a.mode}s), seed {seed}", file=sys.stderr)
+    redrawn = f", {body['redrawn']} mixes that crossed themselves drawn again" if body and body["redrawn"] else ""
+    print(f"{a.output}: {a.count} new curves of {shape[1]} points ({a.mode}s), seed {seed}{redrawn}", file=sys.stderr)
     return 0
 
 
@@ -156,6 +157,9 @@ def _write_augment(a: argparse.Namespace, chunks: Any, progress: Any, seed: int,
         "frames": _frames(parts, frames_json),
         "seed": seed,
         "offset": a.offset,
+        # mixes that crossed themselves, drawn again (a server's JSON pages say so too)
+        "redrawn": sum(int(getattr(m, "redrawn", 0)) for m in parts),
+        "invalid": sum(int(getattr(m, "invalid", 0)) for m in parts),
     }
     if a.metrics:
         body["metrics"] = [x for m in parts for x in (m.metrics or _metrics(m))]

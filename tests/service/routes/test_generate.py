@@ -168,7 +168,9 @@ def test_the_stream_holds_one_chunk_at_a_time(make_client, runtime, monkeypatch)
         },
     )
     assert r.status_code == 200 and len(r.content) == 128 + 1000 * 7 * 2 * 4
-    assert max(seen) == runtime.graphs.batch_size and sum(seen) == 1000
+    # a chunk's first decoding is batch_size rows; its mixes that cross themselves are drawn again, fewer at a time
+    assert max(seen) == runtime.graphs.batch_size and sum(seen) >= 1000
+    assert seen[:1] == [runtime.graphs.batch_size]
 
 
 # ----------------------------------------------------------------------------- metrics on request
