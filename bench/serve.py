@@ -161,7 +161,7 @@ def augment(server: Server, seeds: np.ndarray, count: int) -> dict[str, float]:
     with Client(server.url) as c:
         c.model()
         start = time.perf_counter()
-        chunks = [a.curves for a in c.augment_chunks(list(seeds), count, seed=1, chunk=4096)]
+        chunks = [a.stacked() for a in c.augment_chunks(list(seeds), count, seed=1, chunk=4096)]
         client_s = time.perf_counter() - start
     assert got == count and streamed.shape[0] == count
     assert np.array_equal(np.concatenate(chunks), streamed)  # the same curves, whatever the chunks

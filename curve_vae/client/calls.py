@@ -4,36 +4,44 @@ the query) and how its answer becomes a result object. `Client` and `AsyncClient
 from __future__ import annotations
 
 import io
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 import orjson
 
+from curve_vae.client.design import BSplineFit, Fitted, Revolved
 from curve_vae.client.results import (
     Augmented,
+    Closeness,
     Curves,
     Encoded,
     Interpolated,
     ModelRef,
     Reconstructed,
     Sampled,
-    curves_of,
+    bools,
+    curve_list,
 )
 from curve_vae.inference.choices import FrameMode, Pose, Spacing
 
 NPY = "application/x-npy"
 JSON_OPTIONS = orjson.OPT_SERIALIZE_NUMPY
 
+Headers = Mapping[str, str]
+NO_HEADERS: Headers = MappingProxyType({})
+
 
 @dataclass(frozen=True)
 class Call:
-    """One HTTP request and the parser of its answer (response body, the model that answered -> result)."""
+    """One HTTP request and the parser of its answer (response body, the model that answered, the response's
+    headers -> result)."""
 
     method: str
     path: str
-    parse: Callable[[bytes, ModelRef], Any]
+    parse: Callable[[bytes, ModelRef, Headers], Any]
     json: Any = None
     content: bytes | None = None
     params: dict[str, str] = field(default_factory=dict)
@@ -76,30 +84,50 @@ def _load(body: bytes) -> dict[str, Any]:
     return orjson.loads(body)
 
 
-def parse_encoded(body: bytes, model: ModelRef) -> Encoded:
+def parse_encoded(body: bytes, model: ModelRef, _headers: Headers = NO_HEADERS) -> Encoded:
     d = _load(body)
-    return Encoded(model, np.asarray(d["mean"], np.float64), np.asarray(d["log_var"], np.float64), d.get("frames"))
+    return Encoded(
+        model,
+        np.asarray(d["mean"], np.float64),
+        np.asarray(d["log_var"], np.float64),
+        d.get("frames"),
+        closeness=Closeness.parse(d.get("closeness")),
+    )
 
 
 def _curves_part(d: dict[str, Any]) -> dict[str, Any]:
-    return {"curves": curves_of(d.get("curves") or []), "splines": d.get("splines"), "metrics": d.get("metrics")}
+    return {"curves": curve_list(d.get("curves")), "splines": d.get("splines"), "metrics": d.get("metrics")}
 
 
-def parse_curves(body: bytes, model: ModelRef) -> Curves:
+def parse_curves(body: bytes, model: ModelRef, _headers: Headers = NO_HEADERS) -> Curves:
     return Curves(model, **_curves_part(_load(body)))
 
 
-def parse_reconstructed(body: bytes, model: ModelRef) -> Reconstructed:
+def parse_reconstructed(body: bytes, model: ModelRef, _headers: Headers = NO_HEADERS) -> Reconstructed:
     d = _load(body)
-    return Reconstructed(model, **_curves_part(d), mse=np.asarray(d["mse"], np.float64))
+    return Reconstructed(
+        model,
+        **_curves_part(d),
+        mse=np.asarray(d["mse"], np.float64),
+        closeness=Closeness.parse(d.get("closeness")),
+        repaired=bools(d.get("repaired")),
+    )
 
 
-def parse_interpolated(body: bytes, model: ModelRef) -> Interpolated:
+def parse_interpolated(body: bytes, model: ModelRef, _headers: Headers = NO_HEADERS) -> Interpolated:
     d = _load(body)
-    return Interpolated(model, **_curves_part(d), weights=np.asarray(d["weights"]), frames=d.get("frames"))
+    return Interpolated(
+        model,
+        **_curves_part(d),
+        weights=np.asarray(d["weights"], np.float64),
+        frames=d.get("frames"),
+        valid=bools(d.get("valid")),
+        repaired=bools(d.get("repaired")),
+        ends=Closeness.parse(d.get("ends")),
+    )
 
 
-def parse_sampled(body: bytes, model: ModelRef) -> Sampled:
+def parse_sampled(body: bytes, model: ModelRef, _headers: Headers = NO_HEADERS) -> Sampled:
     d = _load(body)
     return Sampled(
         model,
@@ -112,7 +140,7 @@ def parse_sampled(body: bytes, model: ModelRef) -> Sampled:
     )
 
 
-def parse_augmented(body: bytes, model: ModelRef) -> Augmented:
+def parse_augmented(body: bytes, model: ModelRef, _headers: Headers = NO_HEADERS) -> Augmented:
     d = _load(body)
     return Augmented(
         model,
@@ -122,19 +150,25 @@ def parse_augmented(body: bytes, model: ModelRef) -> Augmented:
         frames=d.get("frames"),
         seed=int(d["seed"]),
         offset=int(d["offset"]),
+        redrawn=_count(d.get("redrawn")),
+        invalid=_count(d.get("invalid")),
     )
 
 
-def parse_npy(body: bytes, _model: ModelRef) -> np.ndarray:
+def _count(value: Any) -> int | None:
+    return None if value is None else int(value)
+
+
+def parse_fitted(body: bytes, model: ModelRef, _headers: Headers = NO_HEADERS) -> Fitted:
+    return Fitted(model, [BSplineFit.from_json(f) for f in _load(body)["fits"]])
+
+
+def parse_npy(body: bytes, _model: ModelRef, _headers: Headers = NO_HEADERS) -> np.ndarray:
     return np.load(io.BytesIO(body), allow_pickle=False)
 
 
-def parse_json(body: bytes, _model: ModelRef) -> Any:
+def parse_json(body: bytes, _model: ModelRef, _headers: Headers = NO_HEADERS) -> Any:
     return _load(body)
-
-
-def parse_bytes(body: bytes, _model: ModelRef) -> bytes:
-    return body
 
 
 # ------------------------------------------------------------------------------------------ the endpoints
@@ -163,8 +197,13 @@ def augment_call(curves: Sequence[Any], fields: dict[str, Any], *, npy: bool) ->
 
 
 def fit_call(curves: Sequence[Any], fields: dict[str, Any]) -> Call:
-    return Call("POST", "/fit", parse_json, json={"curves": [array(c) for c in curves], **fields})
+    return Call("POST", "/fit", parse_fitted, json={"curves": [array(c) for c in curves], **fields})
 
 
 def revolve_call(curve: Any, fields: dict[str, Any]) -> Call:
-    return Call("POST", "/revolve", parse_bytes, json={"curve": array(curve), **fields})
+    asked = str(fields.get("format", "obj"))  # the service's default format
+
+    def parse(body: bytes, model: ModelRef, headers: Headers = NO_HEADERS) -> Revolved:
+        return Revolved.from_answer(model, body, headers, asked)
+
+    return Call("POST", "/revolve", parse, json={"curve": array(curve), **fields})

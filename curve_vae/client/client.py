@@ -1,14 +1,15 @@
 """`Client` and `AsyncClient`: one method per endpoint, numpy arrays in and out, safe retries, streamed /augment.
 
     with Client("http://127.0.0.1:8000") as c:
-        rec = c.reconstruct(curves)                        # Reconstructed: curves, mse, splines, model
+        rec = c.reconstruct(curves)                        # Reconstructed: curves, mse, closeness, splines, model
         for chunk in c.augment_chunks(seeds, 100_000, seed=1, chunk=4096):
-            train_on(chunk.curves)                         # (4096, n, 2) float32, items chunk.offset …
+            train_on(chunk.stacked())                      # (4096, n, 2) float32, items chunk.offset …
 
-Large batches of curves of one length go as `.npy` bodies by themselves; answers are parsed into result objects
-(curves.results) that carry the model that made them. What is retried: a dropped or refused connection, a timeout,
-503 (a full queue; its Retry-After is respected) and 429, up to `retries` times with exponential backoff and
-jitter; never a 4xx, which raises `ApiError` with the service's status, field and message at once.
+One curve (an (n, 2) array) goes as a batch of one (client.inputs). Large batches of curves of one length go as
+`.npy` bodies by themselves; answers are parsed into result objects (client.results, client.design) that carry the
+model that made them. What is retried: a dropped or refused connection, a timeout, 503 (a full queue; its
+Retry-After is respected) and 429, up to `retries` times with exponential backoff and jitter; never a 4xx, which
+raises `ApiError` with the service's status, field and message at once.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 from curve_vae.client import calls as k
 from curve_vae.client.endpoints import Endpoints, augment_fields
 from curve_vae.client.errors import ApiError, RetriesExhausted
+from curve_vae.client.inputs import CurvesLike, as_batch
 from curve_vae.client.results import Augmented, ModelRef
 from curve_vae.inference.choices import FrameMode, Pose, Spacing
 
@@ -136,11 +138,12 @@ class Client(Endpoints):
 
     def _call(self, call: k.Call) -> Any:
         model = self.model_ref()
-        return call.parse(self.send(**_request(call)).content, model)
+        response = self.send(**_request(call))
+        return call.parse(response.content, model, response.headers)
 
     def augment_chunks(
         self,
-        curves: Sequence[Any],
+        curves: CurvesLike,
         count: int,
         *,
         chunk: int = DEFAULT_CHUNK,
@@ -157,14 +160,20 @@ class Client(Endpoints):
         """Items offset … offset + count - 1 of a seeded augmentation sequence, `chunk` curves at a time, each a .npy
         request of its own (float32 curves; sources and weights: `augment`, JSON). A chunk whose connection drops
         is asked again from its offset; the curves are the same whatever the chunk size (item i depends on the seed
-        and i alone). Without a seed one is drawn, and every chunk carries it."""
+        and i alone). Without a seed one is drawn, and every chunk carries it. One curve is refused at once (a
+        mix needs two), before the first chunk is asked for."""
+        seeds = as_batch(curves, "augment_chunks", at_least=2)
         seed = fresh_seed() if seed is None else seed
         fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points)
+        return self._chunks(seeds, count, chunk, offset, seed, fields)
+
+    def _chunks(
+        self, curves: Sequence[Any], count: int, chunk: int, offset: int, seed: int, fields: dict[str, Any]
+    ) -> Iterator[Augmented]:
         for start in range(offset, offset + count, chunk):
             n = min(chunk, offset + count - start)
-            call = k.augment_call(curves, {"count": n, "offset": start, **fields}, npy=True)
-            out = self._call(call)
-            yield Augmented(self.model_ref(), out, seed=seed, offset=start)
+            out = self._call(k.augment_call(curves, {"count": n, "offset": start, **fields}, npy=True))
+            yield Augmented(self.model_ref(), list(out), seed=seed, offset=start)
 
 
 class AsyncClient(Endpoints):
@@ -235,11 +244,12 @@ class AsyncClient(Endpoints):
 
     async def _call(self, call: k.Call) -> Any:
         model = await self.model_ref()
-        return call.parse((await self.send(**_request(call))).content, model)
+        response = await self.send(**_request(call))
+        return call.parse(response.content, model, response.headers)
 
-    async def augment_chunks(
+    def augment_chunks(
         self,
-        curves: Sequence[Any],
+        curves: CurvesLike,
         count: int,
         *,
         chunk: int = DEFAULT_CHUNK,
@@ -253,13 +263,19 @@ class AsyncClient(Endpoints):
         refine: int | None = None,
         n_points=None,
     ) -> AsyncIterator[Augmented]:
-        """See `Client.augment_chunks`."""
+        """See `Client.augment_chunks`: an async iterator (`async for chunk in c.augment_chunks(…)`)."""
+        seeds = as_batch(curves, "augment_chunks", at_least=2)
         seed = fresh_seed() if seed is None else seed
         fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points)
+        return self._chunks(seeds, count, chunk, offset, seed, fields)
+
+    async def _chunks(
+        self, curves: Sequence[Any], count: int, chunk: int, offset: int, seed: int, fields: dict[str, Any]
+    ) -> AsyncIterator[Augmented]:
         for start in range(offset, offset + count, chunk):
             n = min(chunk, offset + count - start)
             out = await self._call(k.augment_call(curves, {"count": n, "offset": start, **fields}, npy=True))
-            yield Augmented(await self.model_ref(), out, seed=seed, offset=start)
+            yield Augmented(await self.model_ref(), list(out), seed=seed, offset=start)
 
 
 def _exhausted(last: Exception | None, retries: int) -> ApiError:

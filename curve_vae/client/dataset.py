@@ -12,7 +12,7 @@ sequence for each epoch, the same for the same (seed, e).
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -20,6 +20,7 @@ import torch
 from torch.utils.data import IterableDataset, get_worker_info
 
 from curve_vae.client.client import Client
+from curve_vae.client.inputs import CurvesLike, as_batch
 
 
 class AugmentDataset(IterableDataset):
@@ -28,7 +29,7 @@ class AugmentDataset(IterableDataset):
     def __init__(
         self,
         url: str,
-        seeds: Sequence[Any],
+        seeds: CurvesLike,
         count: int,
         *,
         seed: int,
@@ -38,7 +39,8 @@ class AugmentDataset(IterableDataset):
     ) -> None:
         super().__init__()
         self.url, self.count, self.seed, self.batch = url, count, seed, batch
-        self.seeds = [np.asarray(c, np.float64) for c in seeds]
+        # one curve is refused here, in the process that made the dataset, not later in each worker
+        self.seeds = [np.asarray(c, np.float64) for c in as_batch(seeds, "AugmentDataset", at_least=2)]
         self.client_options = client or {}
         self.fields = fields  # /augment's other fields: mode, neighbours, n_points, pose, spacing, …
         self.epoch = 0
@@ -63,4 +65,4 @@ class AugmentDataset(IterableDataset):
                 start = j * self.batch
                 n = min(self.batch, self.count - start)
                 (chunk,) = c.augment_chunks(self.seeds, n, seed=seed, offset=start, chunk=n, **self.fields)
-                yield torch.from_numpy(np.ascontiguousarray(chunk.curves, np.float32))
+                yield torch.from_numpy(np.ascontiguousarray(chunk.stacked(), np.float32))

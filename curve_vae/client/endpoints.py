@@ -4,10 +4,10 @@ The reading's fields are typed with inference.choices' values, the service's own
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import Any
 
 from curve_vae.client import calls as k
+from curve_vae.client.inputs import CurvesLike, as_batch
 from curve_vae.inference.choices import FrameMode, Pose, Spacing
 
 #: A batch of curves of one length with at least this many points in all goes as a .npy body.
@@ -24,15 +24,17 @@ class Endpoints:
 
     def encode(
         self,
-        curves: Sequence[Any],
+        curves: CurvesLike,
         *,
         frame: FrameMode | None = None,
         pose: Pose | None = None,
         spacing: Spacing | None = None,
         refine: int | None = None,
     ) -> Any:
-        """Latent means and log-variances (`Encoded`) of curves (each (n, 2))."""
+        """Latent means and log-variances (`Encoded`: mean, log_var, frames, closeness) of curves, or of one curve
+        (an (n, 2) array: answered as a batch of one)."""
         fields = k.reading(frame, pose, spacing, refine)
+        curves = as_batch(curves, "encode")
         return self._call(k.curves_call("/encode", curves, fields, k.parse_encoded, npy_points=self.npy_points))
 
     def decode(
@@ -45,7 +47,7 @@ class Endpoints:
 
     def reconstruct(
         self,
-        curves: Sequence[Any],
+        curves: CurvesLike,
         *,
         frame: FrameMode | None = None,
         pose: Pose | None = None,
@@ -55,15 +57,17 @@ class Endpoints:
         output=None,
         metrics=None,
     ) -> Any:
-        """Each curve through the model (`Reconstructed`: curves, mse, splines)."""
+        """Each curve through the model (`Reconstructed`: curves, mse, closeness, repaired, splines); one curve (an
+        (n, 2) array) is answered as a batch of one, its curve `.curve`."""
         fields = {**k.reading(frame, pose, spacing, refine), **k.output(n_points, output, metrics)}
+        curves = as_batch(curves, "reconstruct")
         return self._call(
             k.curves_call("/reconstruct", curves, fields, k.parse_reconstructed, npy_points=self.npy_points)
         )
 
     def interpolate(
         self,
-        curves: Sequence[Any],
+        curves: CurvesLike,
         *,
         steps=None,
         weights=None,
@@ -75,7 +79,10 @@ class Endpoints:
         output=None,
         metrics=None,
     ) -> Any:
-        """Curves between curves (`Interpolated`): an even sweep of `steps`, or one curve per row of `weights`."""
+        """Curves between curves (`Interpolated`: curves, weights, valid, repaired, ends): an even sweep of `steps`,
+        or one curve per row of `weights`. Needs two curves or more: one curve is refused (InvalidInput) before
+        sending."""
+        curves = as_batch(curves, "interpolate", at_least=2)
         fields = {
             **k.reading(frame, pose, spacing, refine),
             **k.output(n_points, output, metrics),
@@ -117,7 +124,7 @@ class Endpoints:
 
     def augment(
         self,
-        curves: Sequence[Any],
+        curves: CurvesLike,
         count: int,
         *,
         mode=None,
@@ -132,22 +139,25 @@ class Endpoints:
         output=None,
         metrics=None,
     ) -> Any:
-        """One page of new curves between `curves` (`Augmented`, with sources and weights); see `augment_chunks`
-        for any count."""
+        """One page of new curves between `curves` (`Augmented`, with sources, weights and redrawn); see
+        `augment_chunks` for any count. Needs two curves or more: one curve is refused (InvalidInput) before
+        sending."""
+        curves = as_batch(curves, "augment", at_least=2)
         fields = {
             **augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points),
             **k._fields(offset=offset, output=output, metrics=metrics),
         }
         return self._call(k.augment_call(curves, {"count": count, **fields}, npy=False))
 
-    def fit(self, curves: Sequence[Any], *, n_ctrl=None, tolerance=None, param=None, n_points=None) -> Any:
-        """Least-squares cubic B-splines of the curves: the service's JSON body ({"fits": [...]})."""
-        return self._call(
-            k.fit_call(curves, k._fields(n_ctrl=n_ctrl, tolerance=tolerance, param=param, n_points=n_points))
-        )
+    def fit(self, curves: CurvesLike, *, n_ctrl=None, tolerance=None, param=None, n_points=None) -> Any:
+        """Least-squares cubic B-splines of the curves (`Fitted`: one `BSplineFit` per curve); one curve (an (n, 2)
+        array) is answered as a batch of one, its fit `.spline`."""
+        fields = k._fields(n_ctrl=n_ctrl, tolerance=tolerance, param=param, n_points=n_points)
+        return self._call(k.fit_call(as_batch(curves, "fit"), fields))
 
     def revolve(self, curve: Any, *, segments=None, axis=None, axis_position=None, format=None) -> Any:
-        """A surface of revolution of a profile curve: the mesh file's bytes (OBJ text, or binary STL)."""
+        """A surface of revolution of a profile curve (`Revolved`: the mesh file's bytes, OBJ text or binary STL,
+        with its format, counts, `save` and `mesh`)."""
         fields = k._fields(segments=segments, axis=axis, axis_position=axis_position, format=format)
         return self._call(k.revolve_call(curve, fields))
 

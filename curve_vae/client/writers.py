@@ -14,7 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +22,7 @@ import numpy as np
 
 from curve_vae import __version__
 from curve_vae.client.client import Client, fresh_seed
+from curve_vae.client.inputs import CurvesLike, as_batch
 from curve_vae.client.results import Augmented, ModelRef
 from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path, atomic_write_text
@@ -38,7 +39,7 @@ def manifest_path(path: str | Path) -> Path:
 def write_augment(
     path: str | Path,
     client: Client,
-    curves: Sequence[Any],
+    curves: CurvesLike,
     count: int,
     *,
     seed: int | None = None,
@@ -46,8 +47,10 @@ def write_augment(
     **fields: Any,
 ) -> dict[str, Any]:
     """Stream `count` augmented curves (client.augment_chunks) into `path` (.npy, .npz or .parquet, written
-    atomically) and its manifest; returns the manifest. `fields`: /augment's other fields (mode, neighbours, …)."""
+    atomically) and its manifest; returns the manifest. `fields`: /augment's other fields (mode, neighbours, …).
+    One curve is refused (a mix needs two) before anything is asked or written."""
     seed = fresh_seed() if seed is None else seed
+    curves = as_batch(curves, "write_augment", at_least=2)
     chunks = client.augment_chunks(curves, count, seed=seed, chunk=chunk, **fields)
     body = {"curves": [np.asarray(c, np.float64).tolist() for c in curves], "count": count, "seed": seed}
     request = {
@@ -75,7 +78,7 @@ def write_chunks(path: str | Path, count: int, chunks: Iterable[Augmented]) -> t
             for block in npy_chunks(shape, (_curves(c) for c in everything)):
                 f.write(block)
     elif suffix == ".npz":
-        data = np.concatenate([c.curves for c in everything]) if first is not None else np.zeros(shape, np.float32)
+        data = np.concatenate([_curves(c) for c in everything]) if first is not None else np.zeros(shape, np.float32)
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.savez(f, curves=data.astype(np.float32))
     else:
@@ -85,7 +88,7 @@ def write_chunks(path: str | Path, count: int, chunks: Iterable[Augmented]) -> t
 
 def _curves(chunk: Augmented) -> np.ndarray:
     """A chunk's curves, one array (n, n_points, 2): an augmentation's curves all have the same length."""
-    return np.asarray(chunk.curves)
+    return chunk.stacked()
 
 
 def _chained(first: Augmented | None, rest: Iterable[Augmented]) -> Iterable[Augmented]:
@@ -104,7 +107,7 @@ def _write_parquet(path: Path, chunks: Iterable[Augmented], n_points: int) -> No
     with atomic_path(path) as tmp:
         with pq.ParquetWriter(str(tmp), schema) as writer:  # a row group per chunk: bounded memory
             for c in chunks:
-                flat = pa.array(np.asarray(c.curves, np.float32).reshape(-1), pa.float32())
+                flat = pa.array(_curves(c).astype(np.float32, copy=False).reshape(-1), pa.float32())
                 points = pa.FixedSizeListArray.from_arrays(flat, 2)
                 offsets = pa.array(np.arange(len(c.curves) + 1, dtype=np.int32) * n_points)
                 lists = pa.ListArray.from_arrays(offsets, points).cast(schema.field("curve").type)

@@ -39,6 +39,10 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
             if a.output_as != "bspline":
                 body["curves"] = [np.asarray(x).tolist() for x in rec.curves]
             body["mse"] = rec.mse.tolist()
+            if rec.closeness is not None:
+                body["closeness"] = rec.closeness.json()
+            if rec.repaired is not None:
+                body["repaired"] = rec.repaired.tolist()
             if a.output_as != "points":
                 body["splines"] = rec.splines
             if a.metrics:
@@ -84,6 +88,8 @@ def cmd_encode(a: argparse.Namespace) -> int:
         with server_client(a) as c:
             enc = c.encode(curves, **reading)
             body = {"mean": enc.mean, "log_var": enc.log_var, "frames": enc.frames}
+            if enc.closeness is not None:
+                body["closeness"] = enc.closeness.json()
     else:
         body = encode_body(model_runtime(a).encode(curves, Reading(**reading)))
     write_output(a.output, body)

@@ -21,7 +21,7 @@ def cmd_fit(a: argparse.Namespace) -> int:
     curves = read_curves(a.input)
     if a.server:
         with server_client(a) as c:
-            body = c.fit(curves, n_ctrl=a.n_ctrl, tolerance=a.tolerance, param=a.param, n_points=a.n_points)
+            body = c.fit(curves, n_ctrl=a.n_ctrl, tolerance=a.tolerance, param=a.param, n_points=a.n_points).json()
     else:
         body = fit_body(curves, a.n_ctrl, param=a.param, n_points=a.n_points, tolerance=a.tolerance)
     write_output(a.output, body)
@@ -46,7 +46,9 @@ def cmd_revolve(a: argparse.Namespace) -> int:
     fmt = a.format or ("stl" if a.output.endswith(".stl") else "obj")
     if a.server:
         with server_client(a) as c:
-            data = c.revolve(curves[0], segments=a.segments, axis=a.axis, axis_position=a.axis_position, format=fmt)
+            data = c.revolve(
+                curves[0], segments=a.segments, axis=a.axis, axis_position=a.axis_position, format=fmt
+            ).data
         what = f"{len(data)} bytes from {a.server}"
     else:
         mesh = revolve(curves[0], segments=a.segments, axis=a.axis, axis_position=a.axis_position)

@@ -38,7 +38,7 @@ def cmd_sample(a: argparse.Namespace) -> int:
             kw = {"temperature": a.temperature, "prior": a.prior, "valid": a.valid, "n_points": a.n_points}
             made = c.sample(a.count, seed=seed, **kw, output=a.output_as, metrics=a.metrics or None)
             body = _sample_body_of(made, a.output_as, a.metrics)
-            prior, rejected, points = made.prior, made.rejected, np.shape(made.curves)[1]
+            prior, rejected, points = made.prior, made.rejected, made.stacked().shape[1]
     else:
         runtime = model_runtime(a)
         made = runtime.sample(
@@ -127,7 +127,7 @@ def _remote_chunks(a: argparse.Namespace, c: Any, seeds: list, seed: int) -> Any
             for o in range(a.offset, a.offset + a.count, page)
         )
     first = next(made, None)
-    length = int(np.shape(first.curves)[1]) if first is not None else a.n_points or 161
+    length = int(first.stacked().shape[1]) if first is not None else a.n_points or 161
 
     def chained() -> Any:
         if first is not None:
@@ -158,8 +158,8 @@ def _write_augment(a: argparse.Namespace, chunks: Any, progress: Any, seed: int,
         "seed": seed,
         "offset": a.offset,
         # mixes that crossed themselves, drawn again (a server's JSON pages say so too)
-        "redrawn": sum(int(getattr(m, "redrawn", 0)) for m in parts),
-        "invalid": sum(int(getattr(m, "invalid", 0)) for m in parts),
+        "redrawn": sum(int(getattr(m, "redrawn", 0) or 0) for m in parts),
+        "invalid": sum(int(getattr(m, "invalid", 0) or 0) for m in parts),
     }
     if a.metrics:
         body["metrics"] = [x for m in parts for x in (m.metrics or _metrics(m))]

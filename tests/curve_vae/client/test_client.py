@@ -20,6 +20,7 @@ from tests.helpers import ONE_SLOT, bspline_curves
 C1 = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 C2 = [[0, 0], [1.5, 0.5], [3, 2], [4, 4], [5, 6.5], [6.5, 8], [8, 8.5]]
 C3 = [[0, 4], [2, 5], [4, 4], [6, 2], [8, 1], [10, 2], [12, 4]]
+PROFILE = [[0, 0], [3, 0], [4, 1], [3, 3], [0, 5]]
 
 
 def raw(url: str, path: str, body: dict) -> dict:
@@ -59,13 +60,13 @@ def test_every_method_gives_the_raw_answer_as_arrays(live_server):
         want = raw(url, "/augment", {"curves": [C1, C2, C3], "count": 5, "mode": "triplet", "seed": 2})
         np.testing.assert_array_equal(page.curves, want["curves"])
         assert page.sources.tolist() == want["sources"] and page.seed == 2
-        assert c.fit([C1], n_ctrl=5) == raw(url, "/fit", {"curves": [C1], "n_ctrl": 5})
-        mesh = c.revolve([[0, 0], [3, 0], [4, 1], [3, 3], [0, 5]], segments=12)
-        assert (
-            mesh
-            == httpx.post(
-                url + "/revolve", json={"curve": [[0, 0], [3, 0], [4, 1], [3, 3], [0, 5]], "segments": 12}
-            ).content
+        assert c.fit([C1], n_ctrl=5).json() == raw(url, "/fit", {"curves": [C1], "n_ctrl": 5})
+        mesh = c.revolve(PROFILE, segments=12)
+        want = httpx.post(url + "/revolve", json={"curve": PROFILE, "segments": 12})
+        assert mesh.data == want.content and mesh.media_type == want.headers["content-type"]
+        assert (mesh.n_vertices, mesh.n_faces) == (
+            int(want.headers["x-mesh-vertices"]),
+            int(want.headers["x-mesh-faces"]),
         )
 
 
@@ -193,7 +194,7 @@ def test_a_busy_answer_is_retried_after_its_retry_after(status):
     handler = _server([_busy(status), _busy(status), _fit_answer()], seen)
     with Client("http://x", retries=2, backoff=30, transport=httpx.MockTransport(handler)) as c:  # Retry-After: 0
         t = time.monotonic()
-        assert c.fit([C1]) == {"fits": []}
+        assert c.fit([C1]).fits == []
     assert len(seen) == 3 and time.monotonic() - t < 5
     assert len({r.content for r in seen}) == 1  # the same request each time
 
@@ -246,6 +247,7 @@ def test_augment_chunks_ask_for_each_chunk_from_its_offset_with_one_seed():
     seeds = {b["seed"] for b in bodies}
     assert len(seeds) == 1 and [a.seed for a in got] == [*seeds] * 3  # drawn once, carried by every chunk
     assert [a.offset for a in got] == [3, 7, 11] and [len(a.curves) for a in got] == [4, 4, 2]
+    assert all(a.stacked().dtype == np.float32 for a in got)  # as streamed: no float64 copy of a chunk
 
 
 def test_a_fresh_seed_is_a_json_safe_integer():
@@ -257,8 +259,8 @@ def test_the_async_client_retries_as_the_sync_one():
     seen: list[httpx.Request] = []
     handler = _server([_busy(), _fit_answer()], seen)
 
-    async def run() -> dict:
+    async def run() -> list:
         async with AsyncClient("http://x", retries=1, transport=httpx.MockTransport(handler)) as c:
-            return await c.fit([C1])
+            return (await c.fit([C1])).fits
 
-    assert asyncio.run(run()) == {"fits": []} and len(seen) == 2
+    assert asyncio.run(run()) == [] and len(seen) == 2

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from curve_vae.client import Client
+from curve_vae.errors import InvalidInput
 
 torch = pytest.importorskip("torch")
 
@@ -75,3 +76,8 @@ def test_another_epoch_is_another_sequence_the_same_each_time():
     assert ds.epoch_seed() not in (7, one)
     ds.set_epoch(1)
     assert ds.epoch_seed() == one and not torch.equal(next(iter(ds)), first)
+
+
+def test_one_seed_curve_is_refused_when_the_dataset_is_made():
+    with pytest.raises(InvalidInput, match="AugmentDataset needs at least 2 curves, got one curve"):
+        AugmentDataset("http://x", np.array(C1), 4, seed=1)

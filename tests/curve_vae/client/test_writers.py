@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 
+import httpx
 import numpy as np
 import pytest
 
@@ -103,3 +104,12 @@ def test_a_manifest_of_another_endpoint_is_not_made_again(tmp_path):
     with pytest.raises(InvalidInput, match=r"s\.npy\.manifest\.json: made by /sample; only /augment batches"):
         regenerate(tmp_path / "s.npy.manifest.json", tmp_path / "again.npy")
     assert not (tmp_path / "again.npy").exists()
+
+
+def test_one_seed_curve_is_refused_before_anything_is_asked_or_written(tmp_path):
+    seen: list[str] = []
+    transport = httpx.MockTransport(lambda r: seen.append(r.url.path) or httpx.Response(500))
+    with Client("http://x", transport=transport) as c:
+        with pytest.raises(InvalidInput, match="write_augment needs at least 2 curves, got one curve"):
+            write_augment(tmp_path / "b.npy", c, np.array(C1), 8, seed=1)
+    assert seen == [] and list(tmp_path.iterdir()) == []
