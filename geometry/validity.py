@@ -43,7 +43,7 @@ def new_crossings(inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]) -
     bad = crosses(outputs)
     if bad.any():
         idx = np.flatnonzero(bad)
-        bad[idx] = ~crosses([inputs[i] for i in idx])
+        bad[idx] = ~crosses([inputs[int(i)] for i in idx])
     return bad
 
 

@@ -40,20 +40,10 @@ def mix(
         placed = prep.placed or all(f is not None for f in prep.fractions)
         blend = n_points is None and common is not None and placed
         closed = bool(prep.inputs) and all(is_closed(c) for c in prep.inputs)  # loops mix into loops
-        if ctrl is not None:
-            ctrl = ctrl.astype(np.float64)
-            shares = mixed_repairs(prep.rows, w)  # the ends' repairs, in proportion: a row [1, 0] is its first end
-            if shares is not None:
-                ctrl += shares
         positions = _positions(prep, w) if blend else None
         repaired = np.zeros(len(w), bool)
-        if ctrl is not None and len(w):
-            if closed:
-                ctrl = np.stack([joined_ends(c) for c in ctrl])
-            heads = [None if params is None else params[k] for k in range(len(w))]
-            at = [_params_of(g, ctrl[k], heads[k], positions, k, prep.placed, n_points, spacing) for k in range(len(w))]
-            targets = _targets(g, prep, w, at, positions is not None and prep.placed)
-            ctrl, repaired = untangle_mixes(ctrl, at, targets, closed=closed, degree=g.spline_degree)
+        if ctrl is not None:
+            ctrl, repaired = _valid_ctrl(g, prep, w, ctrl, params, positions, n_points, spacing, closed)
         results, splines = [], []
         for k, o in enumerate(out):
             c, u = None if ctrl is None else ctrl[k], None if params is None else params[k]
@@ -76,6 +66,37 @@ def mix(
         valid=~crosses(list(result)),
         repaired=repaired,
     )
+
+
+def _valid_ctrl(
+    g: ModelGraphs,
+    prep: Prepared,
+    w: np.ndarray,
+    ctrl: np.ndarray,
+    params: np.ndarray | None,
+    positions: np.ndarray | None,
+    n_points: int | None,
+    spacing: str,
+    closed: bool,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rows' control points (float64, joined where every input is closed) carrying their ends' repairs in
+    proportion (a row [1, 0] is its first end's answer), those that still cross untangled against the blend of their
+    ends (inference.untangling); and which rows carry a repair of either kind."""
+    ctrl = ctrl.astype(np.float64)
+    shares = mixed_repairs(prep.rows, w)
+    carried = np.zeros(len(w), bool)
+    if shares is not None:
+        ctrl += shares
+        carried = np.abs(shares).reshape(len(w), -1).max(axis=1) > 0
+    if closed:
+        ctrl = np.stack([joined_ends(c) for c in ctrl])
+    if not len(w):
+        return ctrl, carried
+    heads = [None if params is None else params[k] for k in range(len(w))]
+    at = [_params_of(g, ctrl[k], heads[k], positions, k, prep.placed, n_points, spacing) for k in range(len(w))]
+    targets = _Targets(g, prep, w, at, positions is not None and prep.placed)
+    ctrl, repaired = untangle_mixes(ctrl, at, targets, closed=closed, degree=g.spline_degree)
+    return ctrl, repaired | carried
 
 
 def _params_of(
@@ -104,24 +125,36 @@ def _params_of(
     return np.linspace(0.0, 1.0, n_points or g.n_points) if u is None else u
 
 
-def _targets(g: ModelGraphs, prep: Prepared, w: np.ndarray, at: list[np.ndarray], placed: bool) -> list[np.ndarray]:
-    """What each in-between should pass close to at its parameters `at`: where the inputs were placed on their
-    splines, the blend of their answers point for point; else the blend of their splines at the same parameter."""
-    ends = _end_ctrl(g, prep)
-    feet = [np.asarray(r.feet, np.float64) for r in prep.rows] if prep.placed else []
-    answers = [spline_values(e, f, degree=g.spline_degree)[0] for e, f in zip(ends, feet)]  # each end's answer
-    if placed:
-        return [np.tensordot(row, np.stack(answers), axes=1) for row in w]
-    out = []
-    for row, u in zip(w, at):
+class _Targets:
+    """What in-between k should pass close to at its parameters `at[k]`, made only for the rows that need one: where
+    the inputs were placed on their splines and share a length, the blend of their answers point for point; else the
+    blend of the ends at the same parameter, along each end's answer where it has one."""
+
+    def __init__(self, g: ModelGraphs, prep: Prepared, w: np.ndarray, at: list[np.ndarray], placed: bool) -> None:
+        self.g, self.prep, self.w, self.at, self.placed = g, prep, w, at, placed
+        self._ends: tuple[np.ndarray, list[np.ndarray], list[np.ndarray]] | None = None
+
+    def ends(self) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray]]:
+        """The ends' control points, their points' parameters and their answers (made once)."""
+        if self._ends is None:
+            ctrl = _end_ctrl(self.g, self.prep)
+            feet = [np.asarray(r.feet, np.float64) for r in self.prep.rows] if self.prep.placed else []
+            answers = [spline_values(e, f, degree=self.g.spline_degree)[0] for e, f in zip(ctrl, feet)]
+            self._ends = ctrl, feet, answers
+        return self._ends
+
+    def __getitem__(self, k: int) -> np.ndarray:
+        ctrl, feet, answers = self.ends()
+        row, u = self.w[k], self.at[k]
+        if self.placed:
+            return np.tensordot(row, np.stack(answers), axes=1)
         if answers:  # along each end's answer (a valid polyline), where its points sit on its spline
             each = np.stack([np.stack([np.interp(u, f, a[:, d]) for d in (0, 1)], 1) for f, a in zip(feet, answers)])
         else:
-            owner = np.repeat(np.arange(len(ends)), len(u))
-            each = spline_values(ends, np.tile(u, len(ends)), owner, degree=g.spline_degree)[0]
-            each = each.reshape(len(ends), -1, 2)
-        out.append(np.tensordot(row, each, axes=1))
-    return out
+            owner = np.repeat(np.arange(len(ctrl)), len(u))
+            each = spline_values(ctrl, np.tile(u, len(ctrl)), owner, degree=self.g.spline_degree)[0]
+            each = each.reshape(len(ctrl), -1, 2)
+        return np.tensordot(row, each, axes=1)
 
 
 def _end_ctrl(g: ModelGraphs, prep: Prepared) -> np.ndarray:

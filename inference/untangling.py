@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 
@@ -21,6 +22,10 @@ from curve_vae.geometry.adapt import is_closed, joined_ends
 from curve_vae.geometry.bspline import spline_values
 from curve_vae.geometry.validity import crosses, new_crossings, untangled
 from curve_vae.inference.prepared import ReadCurve
+
+
+class _Indexed(Protocol):
+    def __getitem__(self, k: int) -> np.ndarray: ...
 
 
 def untangle_rows(
@@ -67,10 +72,11 @@ def mixed_repairs(rows: Sequence[ReadCurve], weights: np.ndarray) -> np.ndarray 
 
 
 def untangle_mixes(
-    ctrl: np.ndarray, params: Sequence[np.ndarray], targets: Sequence[np.ndarray], *, closed: bool, degree: int
+    ctrl: np.ndarray, params: Sequence[np.ndarray], targets: _Indexed, *, closed: bool, degree: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """In-betweens (rows, n_ctrl, 2) whose splines at their `params` (n_k,) cross themselves, untangled against
-    `targets` (n_k, 2), the blend of their ends at those points: the control points, and which rows were repaired.
+    `targets[k]` (n_k, 2), the blend of their ends at those points (asked for only for the rows that cross): the
+    control points, and which rows were repaired.
     A row whose target crosses itself too is left as it is (its ends cannot be joined there by a valid blend)."""
     c = np.array(ctrl, np.float64)
     lengths = np.array([len(u) for u in params])
@@ -81,8 +87,8 @@ def untangle_mixes(
     repaired = np.zeros(len(c), bool)
     if bad.any():
         rows = np.flatnonzero(bad)
-        aimed = rows[~crosses([targets[k] for k in rows])]
-        for k in aimed:
-            c[k], _ = untangled(c[k], params[k], targets[k], closed=closed, degree=degree)
+        aims = {int(k): targets[int(k)] for k in rows}
+        for k in (int(k) for k in rows[~crosses(list(aims.values()))]):
+            c[k], _ = untangled(c[k], params[k], aims[k], closed=closed, degree=degree)
             repaired[k] = True
     return c, repaired

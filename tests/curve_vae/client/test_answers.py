@@ -15,17 +15,7 @@ import shapely
 
 from curve_vae.client import AsyncClient, Client, Closeness
 from curve_vae.errors import InvalidInput
-
-C1 = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
-C2 = [[0, 0], [1.5, 0.5], [3, 2], [4, 4], [5, 6.5], [6.5, 8], [8, 8.5]]
-C3 = [[0, 4], [2, 5], [4, 4], [6, 2], [8, 1], [10, 2], [12, 4]]
-PROFILE = [[0, 0], [3, 0], [4, 1], [3, 3], [0, 5]]
-
-
-def raw(url: str, path: str, body: dict) -> dict:
-    r = httpx.post(url + path, json=body, timeout=60)
-    assert r.status_code == 200, r.text
-    return r.json()
+from tests.curve_vae.client.test_client import C1, C2, C3, PROFILE, raw
 
 
 def _curve() -> np.ndarray:
