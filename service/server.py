@@ -11,6 +11,7 @@ import argparse
 import contextlib
 import copy
 import json
+import logging
 import os
 import shutil
 import sys
@@ -23,58 +24,86 @@ from pydantic import ValidationError
 from curve_vae.inference.choices import choices
 from curve_vae.service.settings import Settings
 
-# (flag, settings field, type, help); the default and variable are appended from Settings.
-_OPTIONS: list[tuple[str, str, Any, str]] = [
-    ("--host", "host", str, "interface to listen on; 0.0.0.0 for every interface"),
-    ("--port", "port", int, "TCP port; 0 picks a free one"),
-    (
-        "--model-dir",
-        "model_dir",
-        str,
-        "directory with encoder.onnx, decoder.onnx and manifest.json, or a shipped model's name: default, paper",
-    ),
-    ("--providers", "providers", str, "onnxruntime providers: cpu, cuda (an error where CUDA cannot load) or auto"),
-    ("--workers", "workers", int, "worker processes, each loading its own ONNX sessions; 0: one per CPU"),
-    ("--log-level", "log_level", str, "uvicorn and service log level"),
-    ("--cors-origins", "cors_origins", str, "comma-separated origins allowed to call from a browser; empty: CORS off"),
-    ("--max-curves", "max_curves", int, "most curves, latents or interpolants per request"),
-    ("--max-points", "max_points", int, "most points per curve, in and out"),
-    ("--max-body-bytes", "max_body_bytes", int, "larger request bodies are answered 413"),
-    ("--max-stream-curves", "max_stream_curves", int, "most curves in one streamed .npy (POST /augment format npy)"),
-    ("--max-mesh-triangles", "max_mesh_triangles", int, "most triangles in one POST /revolve mesh"),
-    (
-        "--max-refine-work",
-        "max_refine_work",
-        int,
-        "most refine work in one request: steps × (input points + 300 per curve)",
-    ),
-    ("--placement", "placement", str, "model: as the model's manifest says; closest or index whatever it says"),
-    ("--batch-size", "batch_size", int, "curves per ONNX run"),
-    ("--intra-op-threads", "intra_op_threads", int, "onnxruntime threads per inference; 0: the CPU quota shared out"),
-    ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),
-    ("--spinning", "spinning", str, "true: onnxruntime threads spin-wait between runs"),
-    (
-        "--inference-concurrency",
-        "inference_concurrency",
-        int,
-        "inferences at once; 0: one per CPU of a worker, at least 2",
-    ),
-    ("--sessions", "sessions", int, "onnxruntime session pairs per worker; 0: one per inference running at once"),
-    ("--micro-batch", "micro_batch", str, "true: gather concurrent requests' graph runs into one run"),
-    ("--micro-batch-rows", "micro_batch_rows", int, "most rows (curves, latents) of one micro-batched run"),
-    ("--micro-batch-wait-ms", "micro_batch_wait_ms", float, "most milliseconds a run waits for others to join it"),
-    (
-        "--coalesce-curves",
-        "coalesce_curves",
-        int,
-        "most curves of concurrent /encode and /reconstruct requests read as one batch; 0: each alone",
-    ),
-    ("--access-log", "access_log", str, "true: log a line per request (uvicorn's access log)"),
-    ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
-    ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
-    ("--priors-dir", "priors_dir", str, "directory of priors fitted with `curve-vae prior` (NAME.npz: prior NAME)"),
-    ("--cache-bytes", "cache_bytes", int, "bytes of the encoding cache (curves posted again skip the encoder); 0: off"),
-]
+# (flag, settings field, type, help) in `serve --help`'s groups; the default and variable are appended from Settings.
+_Option = tuple[str, str, Any, str]
+_GROUPS: dict[str, list[_Option]] = {
+    "what everyone sets": [
+        ("--host", "host", str, "interface to listen on; 0.0.0.0 for every interface"),
+        ("--port", "port", int, "TCP port; 0 picks a free one"),
+        (
+            "--model-dir",
+            "model_dir",
+            str,
+            "directory with encoder.onnx, decoder.onnx and manifest.json, or a shipped model's name: default, paper",
+        ),
+        ("--providers", "providers", str, "onnxruntime providers: cpu, cuda (an error where CUDA cannot load) or auto"),
+        ("--workers", "workers", int, "worker processes, each loading its own ONNX sessions; 0: one per CPU"),
+        ("--log-level", "log_level", str, "uvicorn and service log level"),
+        ("--access-log", "access_log", str, "true: log a line per request (uvicorn's access log)"),
+        (
+            "--cors-origins",
+            "cors_origins",
+            str,
+            "comma-separated origins allowed to call from a browser; empty: CORS off",
+        ),
+        ("--priors-dir", "priors_dir", str, "directory of priors fitted with `curve-vae prior` (NAME.npz: prior NAME)"),
+        (
+            "--cache-bytes",
+            "cache_bytes",
+            int,
+            "bytes of the encoding cache (curves posted again skip the encoder); 0: off",
+        ),
+    ],
+    "limits (what one request may ask; beyond them a 4xx or 5xx that says which)": [
+        ("--max-curves", "max_curves", int, "most curves, latents or interpolants per request"),
+        ("--max-points", "max_points", int, "most points per curve, in and out"),
+        ("--max-body-bytes", "max_body_bytes", int, "larger request bodies are answered 413"),
+        (
+            "--max-stream-curves",
+            "max_stream_curves",
+            int,
+            "most curves in one streamed .npy (POST /augment format npy)",
+        ),
+        ("--max-mesh-triangles", "max_mesh_triangles", int, "most triangles in one POST /revolve mesh"),
+        (
+            "--max-refine-work",
+            "max_refine_work",
+            int,
+            "most refine work in one request: steps × (input points + 300 per curve)",
+        ),
+        ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
+        ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
+    ],
+    "tuning (the defaults suit most machines: measure before changing them, docs/BENCHMARKS.md)": [
+        ("--placement", "placement", str, "model: as the model's manifest says; closest or index whatever it says"),
+        ("--batch-size", "batch_size", int, "curves per ONNX run"),
+        (
+            "--intra-op-threads",
+            "intra_op_threads",
+            int,
+            "onnxruntime threads per inference; 0: the CPU quota shared out",
+        ),
+        ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),
+        ("--spinning", "spinning", str, "true: onnxruntime threads spin-wait between runs"),
+        (
+            "--inference-concurrency",
+            "inference_concurrency",
+            int,
+            "inferences at once; 0: one per CPU of a worker, at least 2",
+        ),
+        ("--sessions", "sessions", int, "onnxruntime session pairs per worker; 0: one per inference running at once"),
+        ("--micro-batch", "micro_batch", str, "true: gather concurrent requests' graph runs into one run"),
+        ("--micro-batch-rows", "micro_batch_rows", int, "most rows (curves, latents) of one micro-batched run"),
+        ("--micro-batch-wait-ms", "micro_batch_wait_ms", float, "most milliseconds a run waits for others to join it"),
+        (
+            "--coalesce-curves",
+            "coalesce_curves",
+            int,
+            "most curves of concurrent /encode and /reconstruct requests read as one batch; 0: each alone",
+        ),
+    ],
+}
+_OPTIONS: list[_Option] = [option for group in _GROUPS.values() for option in group]
 _CHOICES = {
     name: list(choices(Settings.model_fields[name].annotation)) for name in ("providers", "log_level", "placement")
 }
@@ -82,20 +111,23 @@ _CHOICES = {
 
 def configure_parser(parser: argparse.ArgumentParser) -> None:
     """Add the serve options to `parser` (the `serve` subcommand's parser)."""
+    parser.usage = "%(prog)s [--host HOST] [--port PORT] [--model-dir DIR] [--workers N] [options]"
     fields = Settings.model_fields
-    for flag, name, kind, text in _OPTIONS:
-        field = fields[name]
-        default = field.get_default(call_default_factory=True)
-        default_text = ",".join(default) if isinstance(default, list) else default
-        default_text = "none" if default_text in ("", None) else default_text
-        parser.add_argument(
-            *([flag, "--model"] if name == "model_dir" else [flag]),
-            dest=name,
-            type=kind,
-            default=None,
-            choices=_CHOICES.get(name),
-            help=f"{text} (default: {default_text}; env CURVE_VAE_{name.upper()})",
-        )
+    for title, options in _GROUPS.items():
+        group = parser.add_argument_group(title)
+        for flag, name, kind, text in options:
+            field = fields[name]
+            default = field.get_default(call_default_factory=True)
+            default_text = ",".join(default) if isinstance(default, list) else default
+            default_text = "none" if default_text in ("", None) else default_text
+            group.add_argument(
+                *([flag, "--model"] if name == "model_dir" else [flag]),
+                dest=name,
+                type=kind,
+                default=None,
+                choices=_CHOICES.get(name),
+                help=f"{text} (default: {default_text}; env CURVE_VAE_{name.upper()})",
+            )
 
 
 def settings_from_args(args: argparse.Namespace) -> Settings:
@@ -126,13 +158,26 @@ def _log_config(level: str) -> dict[str, Any]:
     return config
 
 
+def where(host: str, port: int) -> str:
+    """The startup log's line saying where people find the page, the API docs and the metrics."""
+    shown = {"0.0.0.0": "127.0.0.1", "::": "[::1]", "": "127.0.0.1"}.get(host, f"[{host}]" if ":" in host else host)
+    base = f"http://{shown}:{port}"
+    return f"the page: {base}/ · the API docs: {base}/docs · metrics: {base}/metrics"
+
+
 def _graceful_server_class() -> type:
     import uvicorn
 
     class GracefulServer(uvicorn.Server):
         """uvicorn's server, but a stop by SIGTERM or SIGINT, once in-flight requests have finished, is a success
         (exit 0): uvicorn would raise the signal again after shutting down, and exit -15 looks like a crash to an
-        orchestrator."""
+        orchestrator. Once it listens, it says where the page, the API docs and the metrics are."""
+
+        def _log_started_message(self, listeners: Any) -> None:
+            super()._log_started_message(listeners)
+            if listeners and self.config.uds is None and self.config.fd is None:
+                port = self.config.port or listeners[0].getsockname()[1]
+                logging.getLogger("uvicorn.error").info(where(self.config.host, port))
 
         @contextlib.contextmanager
         def capture_signals(self):
@@ -172,6 +217,7 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
     with _shared_metrics(), counts:
         app = "curve_vae.service.server:supervised_app"
         if not listeners.balances_connections():
+            listeners.log.info(where(settings.host, settings.port))
             uvicorn.run(app, factory=True, workers=settings.workers, **common)
             return
         # each worker's connections counted (service.balance), so that a crowded one asks a client to reconnect
@@ -182,6 +228,7 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
             listeners.log.error("cannot listen on %s:%d: %s", settings.host, settings.port, e)
             raise SystemExit(3) from None
         listeners.announce(settings.host, listener.port)
+        listeners.log.info(where(settings.host, listener.port))
         supervisor = Multiprocess(config, sockets=[listener])  # type: ignore[list-item]  # a socket in a worker
         try:
             supervisor.run()
@@ -193,6 +240,23 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
             raise SystemExit(STARTUP_FAILURE)  # uvicorn's supervisor stops, but would exit 0
 
 
+def _first_worker(supervisor: int) -> bool:
+    """Whether this worker is the first of `supervisor`'s to start: it claims a file in the workers' shared
+    directory (the Prometheus values'); without one, every worker is the first."""
+    from curve_vae.service.metrics import MULTIPROC_DIR
+
+    directory = os.environ.get(MULTIPROC_DIR)
+    if not directory:
+        return True
+    try:
+        os.close(os.open(os.path.join(directory, f"started-{supervisor}"), os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
 #: How often a worker looks for its supervisor, seconds.
 SUPERVISOR_CHECK_S = 1.0
 
@@ -202,7 +266,6 @@ def supervised_app() -> Any:
     worker when its supervisor is gone: a supervisor killed outright (SIGKILL, the OOM killer) cannot stop its
     workers, and they would go on holding the port, the model's memory and a share of the connections that no one
     restarts. The worker asks itself to stop (SIGTERM: requests in flight finish) once its parent is another."""
-    import logging
     import signal
     import threading
     import time
@@ -211,6 +274,11 @@ def supervised_app() -> Any:
     from curve_vae.service.app import create_app_from_env
 
     supervisor = os.getppid()
+    if not _first_worker(supervisor):  # the startup log says each thing once: the first worker to start says it
+        for name in ("uvicorn.error", "service"):
+            logger = logging.getLogger(name)
+            if logger.getEffectiveLevel() == logging.INFO:
+                logger.setLevel(logging.WARNING)
 
     def watch() -> None:
         while os.getppid() == supervisor:

@@ -77,12 +77,27 @@ def test_concurrent_requests(live_server, curves):
 
 
 def test_two_workers(server_factory, model_dir):
-    """Workers are separate processes that rebuild the settings from the environment."""
-    server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2", "--max-curves", "3")
-    server.wait_ready(timeout=60)
+    """Workers are separate processes that rebuild the settings from the environment; at the info level the startup
+    log says once what is served and where the page, the API docs and the metrics are, not once per worker."""
+    args = ("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2", "--max-curves", "3")
+    server = server_factory(*args, "--log-level", "info")
+    server.wait_ready(timeout=60, listeners=2)
     r = httpx.post(f"{server.url}/encode", json={"curves": [C] * 4}, timeout=30)
     assert r.status_code == 422 and "at most 3 curves" in r.json()["detail"]
     assert server.stop() == 0
+    log = server.output()
+    page = f"the page: {server.url}/ · the API docs: {server.url}/docs · metrics: {server.url}/metrics"
+    assert log.count(page) == 1, log
+    for line in ("serving curve-vae", "onnxruntime: ", "Application startup complete"):
+        assert log.count(line) == 1, (line, log)
+
+
+def test_one_process_says_where_the_page_is(server_factory, model_dir):
+    args = ("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "1")
+    server = server_factory(*args, "--log-level", "info")
+    server.wait_ready(timeout=60)
+    assert server.stop() == 0
+    assert f"the page: {server.url}/ · the API docs: {server.url}/docs" in server.output()
 
 
 def test_two_workers_share_the_connections_out(server_factory, model_dir, curves):
@@ -244,6 +259,24 @@ def test_help_names_defaults_and_variables():
     assert out.returncode == 0
     for text in ("--providers", "CURVE_VAE_PROVIDERS", "default: auto", "--model-dir", "CURVE_VAE_MAX_BODY_BYTES"):
         assert text in out.stdout
+
+
+def test_help_puts_what_everyone_sets_first_and_tuning_under_its_own_heading():
+    """Every Settings field has its flag once, in a group: the options people set first, then limits, then tuning."""
+    from curve_vae.service.server import _GROUPS
+    from curve_vae.service.settings import Settings
+
+    text = _serve("--help").stdout
+    first, limits, tuning = (text.index(f"\n{title}:") for title in _GROUPS)
+    assert first < limits < tuning
+    for flag in ("--host", "--port", "--model-dir", "--workers"):
+        assert first < text.index(f"  {flag}") < limits, flag
+    for flag in ("--spinning", "--micro-batch", "--inter-op-threads", "--sessions", "--coalesce-curves"):
+        assert text.index(f"  {flag}") > tuning, flag
+    assert text.splitlines()[0].startswith("usage: ") and len(text.split("\n\n")[0].splitlines()) == 1
+    flags = [name for options in _GROUPS.values() for _, name, _, _ in options]
+    assert sorted(flags) == sorted(set(flags))
+    assert set(flags) <= set(Settings.model_fields)
 
 
 def test_flags_override_the_environment(monkeypatch):
