@@ -37,7 +37,8 @@ ORDER = ["dataset", "train", "average", "export", "evaluate", "prior", "sample",
 
 def readme_commands() -> list[list[str]]:
     """The `.venv/bin/curve-vae …` lines of the README's bash blocks (comments dropped; `serve` runs elsewhere)."""
-    text = "\n".join((ROOT / page).read_text() for page in ("README.md", "docs/TRAINING.md", "docs/API.md"))
+    pages = ("README.md", "docs/TRAINING.md", "docs/API.md", "docs/CLI.md")
+    text = "\n".join((ROOT / page).read_text() for page in pages)
     blocks = re.findall(r"```bash\n(.*?)```", text, flags=re.S)
     commands = []
     for block in blocks:
