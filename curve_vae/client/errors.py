@@ -8,7 +8,7 @@ from curve_vae.errors import ClientError
 
 
 class ApiError(ClientError):
-    """An answer that is not a success: `status` (HTTP), `loc` (the field, curve and point, e.g. "curves[2][17][1]";
+    """An answer that is not a success: `status` (HTTP), `loc` (the field, curve and point, e.g. `curves[2][17][1]`;
     "" where the service named none), `msg` (what is wrong there), `detail` (the service's one line) and `errors`
     (every problem it found). A 4xx is never retried: the same request gets the same answer."""
 

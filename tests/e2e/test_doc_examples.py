@@ -1,5 +1,6 @@
-"""The curl examples of README.md and docs/API.md, pasted as they are against `curve-vae serve` on the shipped model:
-each works, and the answer each shows (its `# ...` lines) is what the service answers (tests/e2e/doc_answers.py)."""
+"""The curl examples of README.md, docs/index.md (Get started) and docs/API.md, pasted as they are against `curve-vae
+serve` on the shipped model: each works, and the answer each shows (its `# ...` lines) is what the service answers
+(tests/e2e/doc_answers.py)."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 #: The pages whose curl examples must work as pasted.
-DOCUMENTED = ("README.md", "docs/API.md")
+DOCUMENTED = ("README.md", "docs/index.md", "docs/API.md")
 
 
 def _curl_blocks() -> list[str]:
