@@ -356,7 +356,14 @@ def _fit_shipped_prior(
 
 
 def measure_export(
-    out: str | Path, manifest: Manifest, data_cfg: Any, test: np.ndarray, *, fresh_seed: int, suite_count: int
+    out: str | Path,
+    manifest: Manifest,
+    data_cfg: Any,
+    test: np.ndarray,
+    *,
+    fresh_seed: int,
+    suite_count: int,
+    fresh_count: int = 1000,
 ) -> dict[str, Any]:
     """Measure the exported graphs as the service runs them (both test sets, the priors' samples, the family
     suite) and store the report in the manifest's `metrics`, written atomically; returns the report."""
@@ -367,7 +374,7 @@ def measure_export(
     from curve_vae.training.data import generate_curves
     from curve_vae.training.evaluate import run_evaluation, runtime_codec
 
-    fresh, _ = generate_curves(1000, fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
+    fresh, _ = generate_curves(fresh_count, fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points)
     runtime = CurveRuntime.load(out, providers="cpu")
     enc, dec, _ = runtime_codec(runtime)
     scratch = Path(tempfile.mkdtemp(prefix="curve-vae-export-"))  # run_evaluation's report.json, not kept

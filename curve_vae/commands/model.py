@@ -9,6 +9,7 @@ from pathlib import Path
 from curve_vae.commands.options import (
     DATA_HELP,
     DEFAULT_MODELS,
+    FRESH_TEST_COUNT,
     FRESH_TEST_SEED,
     add_morph_option,
     add_suite_option,
@@ -44,7 +45,15 @@ def cmd_export(a: argparse.Namespace) -> int:
     )
     print(f"exported {a.checkpoint} → {a.out}/: {', '.join(manifest.files)}, manifest.json")
     if a.evaluate:
-        report = measure_export(a.out, manifest, data_cfg, test, fresh_seed=a.fresh_seed, suite_count=a.suite_count)
+        report = measure_export(
+            a.out,
+            manifest,
+            data_cfg,
+            test,
+            fresh_seed=a.fresh_seed,
+            fresh_count=a.fresh_count,
+            suite_count=a.suite_count,
+        )
         for name, r in report["test_sets"].items():
             print(f"{name}: MSE {r['mse']:.4f} (median {r['mse_median']:.4f}) over {r['n_curves']} curves")
         if "families" in report:
@@ -74,7 +83,7 @@ def cmd_evaluate(a: argparse.Namespace) -> int:
     sets = {"test": load_test_split(data_cfg, data_path(a, data_cfg))}
     if a.fresh_seed >= 0:
         sets[f"fresh_seed_{a.fresh_seed}"] = generate_curves(
-            1000, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points
+            a.fresh_count, a.fresh_seed, n_ctrl=data_cfg.n_ctrl, n_points=data_cfg.n_points
         )[0]
     log = Path(a.checkpoint).parent / "log.jsonl" if a.checkpoint else None
     report = run_evaluation(
@@ -157,6 +166,22 @@ def cmd_triton(a: argparse.Namespace) -> int:
     return 0
 
 
+def _add_fresh_count(s: argparse.ArgumentParser) -> None:
+    s.add_argument(
+        "--fresh-count",
+        type=_positive_int,
+        default=FRESH_TEST_COUNT,
+        help=f"curves of the second test set; its samples' report draws as many (default: {FRESH_TEST_COUNT})",
+    )
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
 def _add_export(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("export", help="export a checkpoint to ONNX + manifest (the service's model)")
     s.add_argument("--checkpoint", required=True, help="a training checkpoint (best.pt / last.pt)")
@@ -172,6 +197,7 @@ def _add_export(sub: argparse._SubParsersAction) -> None:
         default=FRESH_TEST_SEED,
         help=f"seed of the second test set (default: {FRESH_TEST_SEED})",
     )
+    _add_fresh_count(s)
     s.add_argument(
         "--training-info",
         default="",
@@ -231,8 +257,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         "--fresh-seed",
         type=int,
         default=FRESH_TEST_SEED,
-        help=f"also test on 1000 curves of this seed, -1 to skip (default: {FRESH_TEST_SEED})",
+        help=f"also test on --fresh-count curves of this seed, -1 to skip (default: {FRESH_TEST_SEED})",
     )
+    _add_fresh_count(s)
     s.add_argument(
         "--out", default="runs/evaluation", help="report.json and figures go here (default: runs/evaluation)"
     )

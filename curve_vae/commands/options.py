@@ -16,6 +16,7 @@ from curve_vae.training.mixes import MIX_VERSION, MIXES
 DATA_HELP = "data/curves-<digest of the configuration>.npz: one file per configuration"
 DEFAULT_MODELS = "models"
 FRESH_TEST_SEED = 7919  # the second test set: a seed no training or model selection uses
+FRESH_TEST_COUNT = 1000  # its curves
 
 
 def add_data_options(p: argparse.ArgumentParser) -> None:

@@ -146,12 +146,13 @@ def cmd_train(a: argparse.Namespace) -> int:
 
         ds = load_or_generate(data_config(a), data_path(a, data_config(a)))
         enc, dec, _ = torch_codec(run_dir / "best.pt")
-        report = run_evaluation(enc, dec, {"test": ds.test}, run_dir, log_path=run_dir / "log.jsonl")
-        print(
-            f"test MSE (paper eq. 4) {report['test_sets']['test']['mse']:.4f}; "
-            f"report {run_dir / 'report.json'}, figures {run_dir}/*.png"
+        report = run_evaluation(
+            enc, dec, {"test": ds.test}, run_dir, log_path=run_dir / "log.jsonl", figures=not a.no_figures
         )
-    elif (run_dir / "log.jsonl").exists():
+        figures = "" if a.no_figures else f", figures {run_dir}/*.png"
+        mse = report["test_sets"]["test"]["mse"]
+        print(f"test MSE (paper eq. 4) {mse:.4f}; report {run_dir / 'report.json'}{figures}")
+    elif (run_dir / "log.jsonl").exists() and not a.no_figures:
         plot_training(run_dir / "log.jsonl", run_dir / "training.png")
     return 0
 
@@ -195,6 +196,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--no-progress",
         action="store_true",
         help="no progress bar (none either when stderr is not a terminal); one line per epoch",
+    )
+    s.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="write the report without its figures (training.png, reconstructions and interpolations: seconds)",
     )
     s.add_argument(
         "--init-from",
