@@ -6,6 +6,7 @@
 #   RUN=/tmp/r2 INIT=/tmp/r/best.pt BUDGET=170 LR=1.2e-4 WARMUP=0.1 bash scripts/gpu_stage.sh   # stage 2
 #
 # Settings (environment): BUDGET seconds of training (400), LR peak (3e-4), WARMUP (0.05), NTRAIN curves (2000000),
+# NVAL and NTEST (2000 and 1000: validation and test curves),
 # MIX_VERSION (the latest), PARAMS (1: --spline-params, a head that learns its points' parameters; default: INIT's
 # head), MATCH (index, closest, twin or mixed: what the reconstruction error measures, `curve-vae train --match`;
 # mixed — index for curves at their own spacing, closest points for the rest — lets the decoder give a respaced curve
@@ -36,7 +37,8 @@ if [ "${PARAMS:-}" = 1 ]; then params=(--spline-params); fi
 params+=(--match "${MATCH:-index}")
 if [ "${ONLY_ENCODER:-}" = 1 ]; then params+=(--only-encoder); fi
 python3 -m curve_vae.cli train --run-dir "$RUN" --init-from "${INIT:-$REPO/models/vae.pt}" --mix broad \
-  "${mix_version[@]}" "${params[@]}" --n-train "${NTRAIN:-2000000}" --data "${DATA:-/tmp/d.npz}" --workers "${WORKERS:-16}" \
+  "${mix_version[@]}" "${params[@]}" --n-train "${NTRAIN:-2000000}" \
+  --n-val "${NVAL:-2000}" --n-test "${NTEST:-1000}" --data "${DATA:-/tmp/d.npz}" --workers "${WORKERS:-16}" \
   --device "${DEVICE:-cuda}" --batch-size 512 --lr "${LR:-3e-4}" --warmup "${WARMUP:-0.05}" --epochs 1000 \
   --time-budget "${BUDGET:-400}" --snapshots 1 --no-progress 2>&1 | tee "$OUT/train.log"
 python3 - <<'PY'

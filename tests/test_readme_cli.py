@@ -21,7 +21,7 @@ TINY_DATA = ["--n-train", "256", "--n-val", "64", "--n-test", "64"]
 TINY = {
     "dataset": TINY_DATA,
     "train": [*TINY_DATA, "--epochs", "1", "--no-progress"],
-    "export": ["--prior-components", "2", "--suite-count", "8"],
+    "export": ["--prior-components", "2", "--suite-count", "8", "--fresh-count", "64"],
     "evaluate": ["--fresh-seed", "-1", "--suite-count", "8", "--morph-count", "2"],
     "average": ["--bn-curves", "128"],
     "augment": ["--count", "300"],

@@ -26,7 +26,7 @@ def _augment(tmp_path: Path, *extra: str, terminal: bool) -> str:
     """Run `curve-vae augment` with stderr on a 100-column pseudo-terminal or a pipe; what it wrote to stderr."""
     seeds = tmp_path / "seeds.json"
     seeds.write_text(json.dumps(SEEDS))
-    cmd = [sys.executable, "-m", "curve_vae.cli", "augment", str(seeds), "--count", "2000", "--seed", "1"]
+    cmd = [sys.executable, "-m", "curve_vae.cli", "augment", str(seeds), "--count", "400", "--seed", "1"]
     cmd += ["-o", str(tmp_path / "out.npy"), "--force", *extra]
     if not terminal:
         return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=120, check=True).stderr
@@ -51,10 +51,10 @@ def _augment(tmp_path: Path, *extra: str, terminal: bool) -> str:
 @pytest.mark.skipif(not (ROOT / "models" / "manifest.json").is_file(), reason="no shipped model")
 def test_augment_shows_a_bar_on_a_terminal_only(tmp_path):
     shown = _augment(tmp_path, terminal=True)
-    assert "augment:" in shown and "/2000" in shown, shown[-500:]
+    assert "augment:" in shown and "/400" in shown, shown[-500:]
     assert "augment:" not in _augment(tmp_path, terminal=False)
     assert "augment:" not in _augment(tmp_path, "--no-progress", terminal=True)
-    assert "2000 new curves" in _augment(tmp_path, "--no-progress", terminal=True)
+    assert "400 new curves" in _augment(tmp_path, "--no-progress", terminal=True)
 
 
 class _Stream:

@@ -19,6 +19,8 @@ def _stage(tmp_path: Path, **settings: str) -> tuple[subprocess.CompletedProcess
         "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",  # python3: this interpreter's
         "DEVICE": "cpu",
         "NTRAIN": "600",
+        "NVAL": "64",
+        "NTEST": "32",
         "WORKERS": "1",
         "BUDGET": "2",
         "OUT": str(out),

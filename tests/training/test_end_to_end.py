@@ -34,7 +34,7 @@ def trained(tmp_path_factory):
     assert main(["train", "--run-dir", str(cut), "--stop-after", "2", "--snapshots", "2", *common]) == 0
     after_two = _log(cut)
     assert main(["train", "--run-dir", str(cut), "--resume", "--snapshots", "2", *common]) == 0
-    assert main(["train", "--run-dir", str(whole), *common]) == 0
+    assert main(["train", "--run-dir", str(whole), *common, "--no-figures"]) == 0  # only its weights are compared
     return tmp, data, cut, whole, after_two
 
 
@@ -66,7 +66,7 @@ def test_export_parity_and_manifest(trained):
     assert (
         main(
             ["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--version", "9.9.9"]
-            + ["--suite-count", "20"]  # the family suite's bookkeeping: tests/training/test_suite.py
+            + ["--suite-count", "20", "--fresh-count", "64"]  # the suite: tests/training/test_suite.py
         )
         == 0
     )
@@ -75,6 +75,7 @@ def test_export_parity_and_manifest(trained):
     for name, meta in manifest["files"].items():
         assert file_sha256(out / name) == meta["sha256"], name
     assert set(manifest["metrics"]["test_sets"]) == {"test", "fresh_seed_7919"}
+    assert manifest["metrics"]["test_sets"]["fresh_seed_7919"]["n_curves"] == 64  # --fresh-count
     assert manifest["training"]["train"]["epochs"] == 3
 
     model = model_from_checkpoint(cut / "best.pt")
@@ -100,7 +101,7 @@ def test_evaluate_exported_model(trained, capsys):
     tmp, data, _, _, _ = trained
     out = tmp / "eval"
     args = ["evaluate", "--model-dir", str(tmp / "models"), "--data", data, "--out", str(out), "--suite-count", "20"]
-    assert main([*args, "--morph-count", "4"]) == 0
+    assert main([*args, "--morph-count", "4", "--fresh-count", "64"]) == 0
     printed = capsys.readouterr().out
     assert "test: MSE" in printed and "fresh_seed_7919: MSE" in printed
     report = json.loads((out / "report.json").read_text())
@@ -142,6 +143,7 @@ def test_ddp_two_cpu_processes(tmp_path):
         "--epochs",
         "2",
         *TINY[:-2],
+        "--no-figures",
         "--threads",
         "1",
     ]
@@ -169,6 +171,7 @@ def test_init_from_shipped_weights(trained):
         "--run-dir",
         str(run),
         *TINY,
+        "--no-figures",
         "--data",
         data,
         "--epochs",
@@ -188,6 +191,7 @@ def test_init_from_shipped_weights(trained):
         "--run-dir",
         str(tmp / "bad"),
         *TINY,
+        "--no-figures",
         "--data",
         data,
         "--epochs",
@@ -207,6 +211,7 @@ def test_time_budget_anneals_and_stops(tmp_path):
         "--run-dir",
         str(run),
         *TINY,
+        "--no-figures",
         "--data",
         str(tmp_path / "d.npz"),
         "--variant",

@@ -67,6 +67,7 @@ def test_a_run_with_only_encoder_keeps_the_starting_decoder(tmp_path, monkeypatc
     start = tmp_path / "start.pt"
     torch.save({"model_config": cfg.__dict__, "model": VAE(cfg).state_dict()}, start)
     tiny = ["--n-train", "128", "--n-val", "32", "--n-test", "32", "--epochs", "1", "--batch-size", "64"]
+    tiny += ["--no-figures"]
     assert main(["train", "--run-dir", "enc", "--init-from", str(start), "--only-encoder", *tiny, "--no-progress"]) == 0
     was, now = torch.load(start)["model"], load_checkpoint(tmp_path / "enc" / "last.pt")["model"]
     assert all(torch.equal(was[k], now[k]) for k in was if not k.startswith("encoder."))
@@ -168,8 +169,8 @@ def test_sigkill_mid_epoch_then_resume(tmp_path):
     """A training run killed with SIGKILL mid-epoch resumes from its last checkpoint, losing at most that epoch."""
     run, data = tmp_path / "run", str(tmp_path / "curves.npz")
     args = [sys.executable, "-m", "curve_vae.cli", "train", "--run-dir", str(run), "--data", data, "--epochs", "3",
-            "--n-train", "768", "--n-val", "64", "--n-test", "32", "--batch-size", "64", "--threads", "1",
-            "--no-progress", "--resume"]  # fmt: skip
+            "--n-train", "384", "--n-val", "32", "--n-test", "32", "--batch-size", "64", "--threads", "1",
+            "--no-progress", "--no-figures", "--resume"]  # fmt: skip
     proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=os.environ)
     log = run / "log.jsonl"
     deadline = time.monotonic() + 120

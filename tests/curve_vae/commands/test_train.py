@@ -12,8 +12,11 @@ from curve_vae.cli import main
 from curve_vae.training.config import ModelConfig
 from curve_vae.training.model import VAE
 
-TINY = ["--n-train", "128", "--n-val", "32", "--n-test", "32", "--epochs", "1", "--no-progress"]
-SMALL = ["--n-train", "96", "--n-val", "16", "--n-test", "16", "--epochs", "1", "--no-progress", "--batch-size", "32"]
+TINY = ["--n-train", "128", "--n-val", "32", "--n-test", "32", "--epochs", "1", "--no-progress", "--no-figures"]
+SMALL = [
+    *["--n-train", "96", "--n-val", "16", "--n-test", "16", "--epochs", "1", "--no-progress", "--batch-size", "32"],
+    "--no-figures",
+]
 
 
 def _start_weights(tmp_path: Path) -> Path:
@@ -34,6 +37,7 @@ def test_init_from_keeps_the_checkpoints_spline_head(tmp_path, monkeypatch):
     tiny = [*TINY, "--batch-size", "64"]
     assert main(["train", "--run-dir", "kept", "--init-from", str(start), *tiny]) == 0
     assert json.loads((tmp_path / "kept" / "config.json").read_text())["model"]["spline_ctrl"] == 31
+    assert (tmp_path / "kept" / "report.json").exists() and not list((tmp_path / "kept").glob("*.png"))  # --no-figures
     assert main(["train", "--run-dir", "dropped", "--init-from", str(start), "--spline-ctrl", "0", *tiny]) == 0
     assert json.loads((tmp_path / "dropped" / "config.json").read_text())["model"]["spline_ctrl"] == 0
 
