@@ -12,6 +12,12 @@ import svgelements as se
 
 from curve_vae.curvefiles.common import CurveFileError, drawn_curves
 
+#: The longer side of a written drawing, in CSS pixels: its curves keep their own coordinates in the viewBox, and a
+#: browser shows an airfoil of chord 1 at this width, not at one pixel.
+DISPLAY_PX = 800
+#: Stroke width on screen, in CSS pixels, whatever the drawing's scale (vector-effect: non-scaling-stroke).
+STROKE_PX = 1.5
+
 #: Points per curved segment (cubic, quadratic, arc) of a drawing's path.
 SAMPLES_PER_SEGMENT = 16
 
@@ -84,13 +90,17 @@ def svg_text(paths: list[np.ndarray], *, beziers: bool) -> str:
     size = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-9))
     pad = 0.05 * size
     x0, y0, w, h = lo[0] - pad, -hi[1] - pad, hi[0] - lo[0] + 2 * pad, hi[1] - lo[1] + 2 * pad
+    px = DISPLAY_PX / max(w, h)
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{_fmt(w)}" height="{_fmt(h)}" '
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w * px:.0f}px" height="{max(h * px, 1):.0f}px" '
         f'viewBox="{_fmt(x0)} {_fmt(y0)} {_fmt(w)} {_fmt(h)}">',
-        f'<g fill="none" stroke="#1f77b4" stroke-width="{_fmt(size / 300)}">',
+        "<desc>curve-vae: each path is a curve in its own coordinates, y up: its point (x, y) is drawn at (x, -y), "
+        "SVG's y pointing down.</desc>",
+        f'<g fill="none" stroke="#1f77b4" stroke-width="{STROKE_PX}">',
     ]
     for i, p in enumerate(paths):
-        lines.append(f'<path id="curve-{i}" d="{_d_beziers(p) if beziers else _d_points(p)}"/>')
+        d = _d_beziers(p) if beziers else _d_points(p)
+        lines.append(f'<path id="curve-{i}" vector-effect="non-scaling-stroke" d="{d}"/>')
     lines += ["</g>", "</svg>", ""]
     return "\n".join(lines)

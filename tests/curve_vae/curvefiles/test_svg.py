@@ -106,3 +106,18 @@ def test_a_path_of_fewer_than_4_points_is_skipped_naming_it(tmp_path):
     with pytest.warns(CurveFileWarning, match=r"d\.svg: path#tick: 3 points, not a curve; skipped"):
         (curve,) = read_curves(path)
     np.testing.assert_array_equal(curve, [[0, 0], [1, -1], [2, 0], [3, -1]])
+
+
+def test_an_airfoils_svg_is_drawn_at_a_size_people_see_and_read_back_at_its_own(tmp_path):
+    """An airfoil of chord 1 is written 800 px wide (width and height in px, the curve's own coordinates in the
+    viewBox, a stroke of 1.5 screen pixels at any scale) and read back at chord 1; the file says its y convention."""
+    t = np.linspace(0, 2 * np.pi, 81)
+    airfoil = np.c_[0.5 + 0.5 * np.cos(t), 0.06 * np.sin(t)]
+    out = tmp_path / "airfoil.svg"
+    write_output(str(out), {"curves": [airfoil.tolist()], "mse": [0.0]})
+    svg = se.SVG.parse(str(out))
+    assert (svg.width, round(svg.height)) == (800, round(800 * (0.12 + 0.1) / 1.1))
+    text = out.read_text()
+    assert 'vector-effect="non-scaling-stroke"' in text and 'stroke-width="1.5"' in text
+    assert "(x, -y)" in text  # the y convention, stated
+    np.testing.assert_allclose(read_curves(out)[0], airfoil, atol=1e-9)
