@@ -15,6 +15,7 @@ import numpy as np
 
 from curve_vae.geometry import Frame, curve_length, fit_bspline, fit_bspline_auto, self_intersects, smoothness
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.exploring import Explored
 from curve_vae.inference.results import Augmented, Curves, Encoding, Interpolation, Reconstruction, Sampled, Spline
 
 
@@ -191,3 +192,15 @@ def _number(value: Any) -> float | None:
     """A JSON number, or null where float64 overflowed (curves near the float limit)."""
     v = float(value)
     return v if math.isfinite(v) else None
+
+
+def explore_body(made: Explored, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
+    d = made.directions
+    body = {
+        "curves": made.curves.tolist(),
+        "offsets": made.offsets.tolist(),
+        "valid": made.valid.tolist(),
+        "directions": [{"deviation": float(v), "share": float(s)} for v, s in zip(d.deviations, d.shares)],
+        "prior": made.prior,
+    }
+    return with_output(with_metrics(body, made.curves, metrics), made.splines, output)

@@ -81,7 +81,7 @@ class Sampler:
         sequence at item offset, so pages of it are the curves of one larger request.
         """
         g = self.graphs
-        chosen = self._chosen(prior)
+        chosen = self.resolve(prior)
         rngs = [np.random.default_rng([seed, i]) for i in range(offset, offset + count)]
         named = self.named.get(chosen)
         learned = named.mixture if named is not None else self.prior
@@ -117,7 +117,7 @@ class Sampler:
         invalid = int((~ok).sum()) if valid else 0
         return Drawn(z, out, ctrl, params, chosen, rejected=int(draws.sum() - count), invalid=invalid)
 
-    def _chosen(self, prior: str | None) -> str:
+    def resolve(self, prior: str | None) -> str:
         """The prior a request names (None: the learned one where the model ships it, else the standard), checked."""
         chosen = prior or ("learned" if self.prior is not None else "standard")
         if chosen == "learned" and self.prior is None:

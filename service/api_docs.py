@@ -109,6 +109,13 @@ DECODE = {
         {"latents": [[0.0] * 32], "frames": [{"center": [4.0, 1.75], "size": 8.0}]},
     ),
 }
+EXPLORE = {
+    "3×3 grid": example("The 3×3 grid around a curve, ±1 standard deviation", {"curves": [C1]}),
+    "a wider row": example(
+        "Five curves along the direction the data varies most, ±2 standard deviations",
+        {"curves": [C1], "steps": 5, "directions": 1, "spread": 2.0},
+    ),
+}
 SAMPLE = {
     "seeded": example("Three curves, reproducible", {"count": 3, "seed": 7, "n_points": 50}),
     "tame": example("Closer to typical shapes", {"count": 2, "seed": 1, "temperature": 0.5}),

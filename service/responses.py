@@ -130,6 +130,21 @@ class SampleResponse(CurvesResponse):
     invalid: int = Field(description="Curves still invalid after 10 draws each (returned as drawn; normally 0).")
 
 
+class DirectionOut(BaseModel):
+    deviation: float = Field(description="The distribution's standard deviation along the direction, in latent units.")
+    share: float = Field(description="The direction's share of the distribution's total variance.")
+
+
+class ExploreResponse(CurvesResponse):
+    offsets: list[list[float]] = Field(
+        description="Per curve: its offset along each direction, in standard deviations (the last direction varies "
+        "fastest: for two, row by row of the grid)."
+    )
+    valid: list[bool] = Field(description="Per curve: false where it crosses itself.")
+    directions: list[DirectionOut] = Field(description="The principal directions followed, the largest first.")
+    prior: str = Field(description="The distribution whose directions they are: learned, standard or a named prior.")
+
+
 class AugmentResponse(CurvesResponse):
     sources: list[list[int]] = Field(
         description="Indices into the request's `curves` of each new curve's sources: its anchor first."

@@ -89,6 +89,48 @@ class DecodeRequest(_Request, OutputIn):
     )
 
 
+class ExploreRequest(CurvesIn, ReadingIn, OutputIn):
+    """One curve whose neighbours along the directions the data varies most are decoded."""
+
+    curves: list[Curve] = Field(
+        min_length=1, max_length=1, description="The one curve to explore around, as a list of one curve."
+    )
+    steps: int = Field(
+        3,
+        ge=2,
+        le=9,
+        strict=True,
+        description="Offsets per direction, evenly from −spread to spread: steps**directions curves (3 and 2: a 3×3 "
+        "grid whose middle is the curve's own reconstruction).",
+    )
+    spread: float = Field(
+        1.0,
+        gt=0,
+        le=4,
+        strict=False,
+        allow_inf_nan=False,
+        description="The largest offset, in standard deviations of the latent distribution along each direction.",
+    )
+    directions: int = Field(
+        2, ge=1, le=4, strict=True, description="How many principal directions, the largest variance first."
+    )
+    prior: str | None = Field(
+        None,
+        pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]*$",
+        max_length=100,
+        description="The latent distribution whose principal directions are followed, as /sample names them "
+        '(omitted: learned where the model ships it; "standard": the latent\'s first axes).',
+    )
+
+    @model_validator(mode="after")
+    def _not_too_many(self) -> ExploreRequest:
+        if self.steps**self.directions > 256:
+            raise PydanticCustomError(
+                "too_many", "steps**directions curves would be {n}; at most 256", {"n": self.steps**self.directions}
+            )
+        return self
+
+
 class InterpolateRequest(CurvesIn, ReadingIn, OutputIn):
     """Curves whose latent means are mixed (paper eqs. 9 and 10)."""
 

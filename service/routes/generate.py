@@ -1,7 +1,7 @@
-"""The generating routes: /sample (new curves from a latent distribution) and /augment (new curves between given
-ones, as seeded JSON pages or one streamed .npy file). Each is built by service.routing.model_route (the request
-validated and within its limits), runs the runtime in a worker thread and answers the body inference.bodies builds,
-shared with the command line."""
+"""The generating routes: /sample (new curves from a latent distribution), /explore (curves around one) and /augment
+(new curves between given ones, as seeded JSON pages or one streamed .npy file). Each is built by
+service.routing.model_route (the request validated and within its limits), runs the runtime in a worker thread and
+answers the body inference.bodies builds, shared with the command line."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response, StreamingResponse
 
 from curve_vae.inference.augmenting import AugmentPlan
-from curve_vae.inference.bodies import augment_body, sample_body, with_output
+from curve_vae.inference.bodies import augment_body, explore_body, sample_body, with_output
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.inference.sampling import fresh_seed
 from curve_vae.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
@@ -65,6 +65,39 @@ async def sample(request: Request, req: s.SampleRequest, _curves: list[np.ndarra
         return JSON(with_output(sample_body(made, metrics=req.metrics), made.splines, req.output))
 
     return await run_inference(request, "/sample", req.count, work)
+
+
+@model_route(
+    generate_router,
+    "/explore",
+    s.ExploreRequest,
+    examples=docs.EXPLORE,
+    response_model=r.ExploreResponse,
+    responses=docs.POST_ERRORS,
+    summary="Curves around one curve, along the directions the data varies most",
+    openapi_extra=docs.curl_sample("/explore", docs.ONE_CURVE),
+)
+async def explore(request: Request, req: s.ExploreRequest, curves: list[np.ndarray]) -> Response:
+    """Encode the curve, move its latent mean along the principal directions of the latent distribution (the learned
+    one where the model ships it: the directions along which the training curves vary most), `steps` offsets per
+    direction from −spread to spread standard deviations, and decode each in the curve's own frame. The grid's middle
+    is the curve's own reconstruction; each curve says whether it crosses itself."""
+    runtime = runtime_of(request)
+    check_output(req.output, runtime)
+
+    def work() -> Response:
+        made = runtime.explore(
+            curves[0],
+            req.reading(),
+            steps=req.steps,
+            spread=req.spread,
+            directions=req.directions,
+            prior=req.prior,
+            n_points=req.n_points,
+        )
+        return JSON(explore_body(made, metrics=req.metrics, output=req.output))
+
+    return await run_inference(request, "/explore", req.steps**req.directions, work)
 
 
 AUGMENT_NPY = {
