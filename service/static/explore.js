@@ -1,0 +1,119 @@
+// curve-vae's page: exploring. The in-betweens with their weights (click one to take it as a curve), the sweep
+// animated, and around a selected curve the grid of its neighbours along the directions the data varies most
+// (POST /explore), click one to take it in the curve's place.
+"use strict";
+
+// "0.75 A + 0.25 B": a row of weights by the names of the curves they weigh (zero weights left out).
+function weightsLabel(weights) {
+  return weights.map((w, i) => [w, NAMES[i]]).filter(([w]) => Math.abs(w) > 1e-9)
+    .map(([w, name]) => `${Number(w.toFixed(2))} ${name}`).join(" + ");
+}
+// "A.75 B.25": the same, short enough to sit under a thumbnail.
+function shortLabel(weights) {
+  return weights.map((w, i) => [w, NAMES[i]]).filter(([w]) => Math.abs(w) > 1e-9)
+    .map(([w, name]) => `${name}${String(Number(w.toFixed(2))).replace(/^(-?)0\./, "$1.")}`).join(" ");
+}
+const byName = (weights) => Object.fromEntries(weights.map((w, i) => [NAMES[i], w]));
+
+function renderStrip() {
+  // pair: one row; triplet: the barycentric grid as a triangle, row k holding the k+1 mixes with A's weight (n-k)/n
+  const strip = $("strip");
+  strip.replaceChildren();
+  const rows = [];
+  const items = state.strip.map((curve, k) => ({ curve, weights: state.stripWeights[k] || [] }));
+  if (state.mode === "triplet") {
+    for (let k = 0, i = 0; i < items.length; k++) { rows.push(items.slice(i, i + k + 1)); i += k + 1; }
+  } else if (items.length) rows.push(items);
+  strip.classList.toggle("triangle-grid", state.mode === "triplet");
+  for (const row of rows) {
+    const div = document.createElement("div");
+    div.className = "strip-row";
+    strip.appendChild(div);
+    for (const { curve, weights } of row) {
+      const label = weightsLabel(weights);
+      const fig = thumbnail(div, curve, { caption: shortLabel(weights), title: `${label}: take it as a curve` });
+      fig.dataset.weights = JSON.stringify(weights);
+      fig.addEventListener("click", () => take(curve));
+    }
+  }
+  renderSweep();
+}
+
+// An in-between or a neighbour becomes a curve of the drawing (in place of the selected one, else the newest).
+function take(curve) {
+  remember();
+  addCurve(curve.map((p) => p.slice()));
+  curvesChanged();
+}
+
+// The in-betweens one after another and back, as one path whose outline is animated (SVG <animate>, no script).
+function renderSweep() {
+  const svg = $("sweep-preview");
+  svg.replaceChildren();
+  const curves = state.mode === "pair" ? state.strip : state.strip.filter((_, k) => {
+    const w = state.stripWeights[k] || [];
+    return w.length === 3 && w.some((v) => Math.abs(v) < 1e-9);  // triplet: around the triangle's edge
+  });
+  svg.style.display = curves.length < 2 ? "none" : "";
+  if (curves.length < 2) return;
+  const all = curves.flat(), xs = all.map((p) => p[0]), ys = all.map((p) => p[1]);
+  const pad = 10, x0 = Math.min(...xs) - pad, y0 = Math.min(...ys) - pad;
+  const w = Math.max(...xs) - x0 + pad, h = Math.max(...ys) - y0 + pad;
+  svg.setAttribute("viewBox", `${x0} ${-(y0 + h)} ${w} ${h}`);
+  const ds = curves.map((c) => pathOf(c.map(([x, y]) => [x, -y])));
+  const loop = state.mode === "pair" ? [...ds, ...ds.slice(1, -1).reverse(), ds[0]] : [...ds, ds[0]];
+  const path = el("path", { d: ds[0], fill: "none", stroke: MIX_COLOR, "stroke-width": Math.max(w, h) / 60 }, svg);
+  el("animate", { attributeName: "d", dur: `${0.6 * loop.length}s`, repeatCount: "indefinite",
+    values: loop.join(";") }, path);
+}
+
+async function updateNeighbours() {
+  const i = state.selected;
+  if (i === null || !state.curves[i]) { state.neighbours = null; renderNeighbours(); return; }
+  const body = { curves: [state.curves[i]], steps: 3, directions: 2, n_points: 60, refine: refine() };
+  try {
+    const r = await api("/explore", body, $("around-error"), { quiet: true });
+    if (state.selected === i) state.neighbours = { of: i, curves: r.curves, offsets: r.offsets, valid: r.valid };
+  } catch (e) { state.neighbours = null; }
+  renderNeighbours();
+}
+
+function renderNeighbours() {
+  const box = $("neighbours"), n = state.neighbours;
+  $("around").hidden = state.selected === null;
+  box.replaceChildren();
+  if (state.selected === null) return;
+  $("around-title").textContent = `Around ${NAMES[state.selected]}`;
+  if (!n) return;
+  n.curves.forEach((curve, k) => {
+    const [a, b] = n.offsets[k];
+    const middle = a === 0 && b === 0;
+    const fig = thumbnail(box, curve, { color: COLORS[n.of], caption: middle ? "itself" : `${sign(a)} ${sign(b)}`,
+      title: middle ? "the curve as the model reads it" : `${sign(a)}σ along the first direction, ${sign(b)}σ along the second` });
+    if (!n.valid[k]) { fig.classList.add("invalid"); fig.title += " (crosses itself)"; }
+    fig.addEventListener("click", () => {
+      const keep = n.of;
+      take(curve);
+      select(keep);  // still selected: the grid moves on around the curve taken
+    });
+  });
+}
+const sign = (v) => (v > 0 ? `+${v}` : v < 0 ? `−${-v}` : "0");
+
+// The drawing as a list of named curves with their roles, the one file model of every export (files.js).
+function drawing() {
+  const items = state.curves.map((points, i) => ({ name: NAMES[i], role: "input", points }));
+  state.recon.forEach((r, i) => {
+    if (r) items.push({ name: `${NAMES[i]} reconstructed`, role: "reconstruction", of: NAMES[i], points: r.points,
+      ...(r.spline ? { spline: r.spline } : {}) });
+  });
+  if (state.result) {
+    items.push({ name: "mix", role: "interpolant", weights: byName(state.result.weights), points: state.result.points,
+      ...(state.result.spline ? { spline: state.result.spline } : {}) });
+  }
+  state.strip.forEach((points, k) => {
+    const w = state.stripWeights[k];
+    if (w) items.push({ name: weightsLabel(w), role: "interpolant", weights: byName(w), points });
+  });
+  return items;
+}
