@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import re
 import warnings
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
@@ -61,11 +61,11 @@ def as_curves(data: Any, name: str) -> list[np.ndarray]:
     return curves
 
 
-def drawn_curves(found: Iterable[tuple[str, np.ndarray]], name: str, *, kinds: str) -> list[np.ndarray]:
-    """The curves of a drawing (SVG, DXF) from its (label, points) entities: one of fewer than MIN_POINTS points is
+def drawn_curves(found: Iterable[Sequence[Any]], name: str, *, kinds: str) -> list[np.ndarray]:
+    """The curves of a drawing (SVG, DXF) from its (label, points, …) entities: one of fewer than MIN_POINTS points is
     skipped with a warning naming it; a drawing with none left is a CurveFileError saying which `kinds` count."""
     curves = []
-    for label, pts in found:
+    for label, pts, *_ in found:
         if len(pts) < MIN_POINTS:
             warn(f"{name}: {label}: {len(pts)} points, not a curve; skipped")
             continue

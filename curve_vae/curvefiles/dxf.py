@@ -1,9 +1,13 @@
 """DXF in and out (ezdxf). In: the model space's LWPOLYLINE and POLYLINE entities (their vertices; bulges as arcs)
-and SPLINEs (sampled along their parameter), x and y, those of inserted blocks where the INSERT puts them. Out: a
-B-spline as a SPLINE entity with its control points and knots exactly, points as an LWPOLYLINE."""
+and SPLINEs (sampled along their parameter), x and y, those of inserted blocks where the INSERT puts them; an
+entity's role (roles.py) is in its XDATA (application CURVE_VAE: `role=…`, `name=…`, `of=…`, `weights=A=0.75 B=0.25`,
+one string each) or else its layer's first word (`input-A`, `reconstruction-A`, `interpolant-mix`). Out: a B-spline as
+a SPLINE entity with its control points and knots exactly, points as an LWPOLYLINE; given marks, each on the layer
+`<role>-<name>` with that XDATA."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -13,10 +17,16 @@ from ezdxf import path as dxfpath
 from ezdxf.disassemble import recursive_decompose
 
 from curve_vae.curvefiles.common import CurveFileError, drawn_curves
+from curve_vae.curvefiles.roles import ROLES, Found, the_inputs
+from curve_vae.curvefiles.svg import weights_text
 
 KINDS = ("LWPOLYLINE", "POLYLINE", "SPLINE")
 #: Points along a SPLINE per control point (at least 64 in all).
 SAMPLES_PER_CONTROL_POINT = 8
+#: The XDATA application of a curve's role, name and weights.
+APPID = "CURVE_VAE"
+#: What AutoCAD refuses in a layer's name; each is written as `_`.
+NOT_IN_LAYERS = '<>/\\":;?*|,=`'
 
 
 def read_dxf(path: str | Path, name: str) -> list[np.ndarray]:
@@ -26,11 +36,37 @@ def read_dxf(path: str | Path, name: str) -> list[np.ndarray]:
     except (OSError, ezdxf.DXFError) as err:
         raise CurveFileError(f"{name}: not a DXF drawing ({err})") from None
     found = (
-        (f"{e.dxftype()} #{e.dxf.handle}" if e.dxf.handle else f"{e.dxftype()} of a block", _points(e))
+        Found(f"{e.dxftype()} #{e.dxf.handle}" if e.dxf.handle else f"{e.dxftype()} of a block", _points(e), _role(e))
         for e in recursive_decompose(doc.modelspace())  # blocks' entities where they are inserted, transformed
         if e.dxftype() in KINDS
     )
-    return drawn_curves(found, name, kinds="LWPOLYLINE, POLYLINE or SPLINE of 4 points")
+    return drawn_curves(the_inputs(found, name), name, kinds="LWPOLYLINE, POLYLINE or SPLINE of 4 points")
+
+
+def _role(e: Any) -> str | None:
+    """An entity's role: its XDATA's, or its layer's first word."""
+    if e.has_xdata(APPID):
+        marks = dict(str(t.value).partition("=")[::2] for t in e.get_xdata(APPID) if t.code == 1000)
+        if marks.get("role") in ROLES:
+            return marks["role"]
+    word = str(e.dxf.get("layer", "")).split("-", 1)[0]
+    return word if word in ROLES else None
+
+
+def layer_name(mark: Mapping[str, Any]) -> str:
+    """`<role>-<name>`, with what AutoCAD refuses in a layer's name as `_`."""
+    text = f"{mark['role']}-{mark.get('name', '')}"
+    return "".join("_" if c in NOT_IN_LAYERS else c for c in text)
+
+
+def xdata(mark: Mapping[str, Any]) -> list[tuple[int, str]]:
+    """A curve's role, name, input (`of`) and weights, as XDATA strings."""
+    tags = [(1000, f"role={mark['role']}"), (1000, f"name={mark.get('name', '')}")]
+    if mark.get("of") is not None:
+        tags.append((1000, f"of={mark['of']}"))
+    if mark.get("weights"):
+        tags.append((1000, f"weights={weights_text(mark['weights'])}"))
+    return tags
 
 
 def _points(e: Any) -> np.ndarray:
@@ -54,15 +90,31 @@ def _points(e: Any) -> np.ndarray:
     return pts
 
 
-def write_dxf(target: Path, *, splines: list[dict[str, Any]] | None, curves: list[np.ndarray] | None) -> None:
-    """A DXF (R2010) with a SPLINE per B-spline, or else an LWPOLYLINE per curve."""
+def write_dxf(
+    target: Path,
+    *,
+    splines: list[dict[str, Any]] | None,
+    curves: list[np.ndarray] | None,
+    marks: list[Mapping[str, Any]] | None = None,
+) -> None:
+    """A DXF (R2010) with a SPLINE per B-spline, or else an LWPOLYLINE per curve; `marks`, one an entity, put each on
+    its role's layer with its XDATA."""
     doc = ezdxf.new("R2010")
     msp = doc.modelspace()
-    for s in splines or []:
+    entities = [
         msp.add_open_spline(
             [(float(x), float(y), 0.0) for x, y in s["control_points"]], degree=int(s["degree"]), knots=s["knots"]
         )
+        for s in splines or []
+    ]
     if splines is None:
-        for c in curves or []:
-            msp.add_lwpolyline([(float(x), float(y)) for x, y in c], format="xy")
+        entities = [msp.add_lwpolyline([(float(x), float(y)) for x, y in c], format="xy") for c in curves or []]
+    if marks:
+        doc.appids.new(APPID)
+        for e, mark in zip(entities, marks):
+            layer = layer_name(mark)
+            if layer not in doc.layers:
+                doc.layers.add(layer)
+            e.dxf.layer = layer
+            e.set_xdata(APPID, xdata(mark))
     doc.saveas(target)

@@ -1,16 +1,22 @@
 """SVG in and out. In: every path, polyline and polygon of a drawing, its transforms applied (svgelements), each
-subpath a curve; lines keep their vertices, curved segments are sampled. Out: a path per curve, a B-spline as its
-exact cubic Bézier segments. SVG's y points down and curves' y up: a point (x, y) of a curve is (x, −y) in the
-drawing's user units (its viewBox), both ways."""
+subpath a curve; lines keep their vertices, curved segments are sampled; a path's class `input`, `reconstruction` or
+`interpolant` is its role (roles.py). Out: a path per curve, a B-spline as its exact cubic Bézier segments; given
+marks, each path's class is its role and `data-name`, `data-of` and `data-weights` say the rest, drawn as the page
+draws them. SVG's y points down and curves' y up: a point (x, y) of a curve is (x, −y) in the drawing's user units
+(its viewBox), both ways."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path as FilePath
+from typing import Any
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 import svgelements as se
 
 from curve_vae.curvefiles.common import CurveFileError, drawn_curves
+from curve_vae.curvefiles.roles import Found, role_of, the_inputs
 
 #: The longer side of a written drawing, in CSS pixels: its curves keep their own coordinates in the viewBox, and a
 #: browser shows an airfoil of chord 1 at this width, not at one pixel.
@@ -20,6 +26,20 @@ STROKE_PX = 1.5
 
 #: Points per curved segment (cubic, quadratic, arc) of a drawing's path.
 SAMPLES_PER_SEGMENT = 16
+#: The page's colours: each input's (a reconstruction takes its input's), the interpolants', a curve without a role.
+COLOURS = {"A": "#1f77b4", "B": "#2ca02c", "C": "#9467bd"}
+INTERPOLANT, UNMARKED = "#d62728", "#1f77b4"
+#: How a role is drawn: inputs as pale bands under the rest, reconstructions dashed, interpolants solid.
+STYLES = {
+    "input": 'stroke-width="6" stroke-opacity="0.3" stroke-linecap="round" stroke-linejoin="round"',
+    "reconstruction": 'stroke-dasharray="6 4"',
+    "interpolant": "",
+}
+DESC = (
+    "curve-vae: each path is a curve in its own coordinates, y up: its point (x, y) is drawn at (x, -y), SVG's y "
+    "pointing down. A path's class is its role (input, reconstruction, interpolant); data-name names it, data-of "
+    "names a reconstruction's input, data-weights an interpolant's weights by input."
+)
 
 
 def read_svg(path: str | FilePath, name: str) -> list[np.ndarray]:
@@ -30,12 +50,12 @@ def read_svg(path: str | FilePath, name: str) -> list[np.ndarray]:
         raise CurveFileError(f"{name}: not an SVG drawing ({e})") from None
     undo = ~se.Matrix(svg.viewbox_transform) if isinstance(svg, se.SVG) and svg.viewbox_transform else se.Matrix()
     found = (
-        (_label(element), _apply(undo, pts) * [1, -1])
+        Found(_label(element), _apply(undo, pts) * [1, -1], role_of(element.values.get("attributes", {}).get("class")))
         for element in (svg.elements() if isinstance(svg, se.SVG) else [])
         if isinstance(element, se.Path | se.Polyline | se.Polygon)
         for pts in _subpaths(se.Path(element) if not isinstance(element, se.Path) else element)
     )
-    return drawn_curves(found, name, kinds="path, polyline or polygon of 4 points or more")
+    return drawn_curves(the_inputs(found, name), name, kinds="path, polyline or polygon of 4 points or more")
 
 
 def _label(element: se.Shape) -> str:
@@ -83,8 +103,28 @@ def _d_beziers(segments: np.ndarray) -> str:
     return " ".join(d)
 
 
-def svg_text(paths: list[np.ndarray], *, beziers: bool) -> str:
-    """An SVG document with one path per item: points (n, 2), or with `beziers` cubic segments (m, 4, 2)."""
+def weights_text(weights: Mapping[str, float]) -> str:
+    """An interpolant's weights as files write them: `A=0.75 B=0.25`."""
+    return " ".join(f"{k}={float(v)!r}" for k, v in weights.items())
+
+
+def _marked(mark: Mapping[str, Any] | None) -> str:
+    """A path's role, names, weights and stroke, as attributes."""
+    if not mark or mark.get("role") not in STYLES:
+        return f'stroke="{UNMARKED}"'
+    role = mark["role"]
+    attrs = [f'class="{role}"', f"data-name={quoteattr(str(mark.get('name', '')))}"]
+    if mark.get("of") is not None:
+        attrs.append(f"data-of={quoteattr(str(mark['of']))}")
+    if mark.get("weights"):
+        attrs.append(f"data-weights={quoteattr(weights_text(mark['weights']))}")
+    colour = INTERPOLANT if role == "interpolant" else COLOURS.get(str(mark.get("of") or mark.get("name")), UNMARKED)
+    return " ".join([*attrs, f'stroke="{colour}"', STYLES[role]]).strip()
+
+
+def svg_text(paths: list[np.ndarray], *, beziers: bool, marks: list[Mapping[str, Any]] | None = None) -> str:
+    """An SVG document with one path per item: points (n, 2), or with `beziers` cubic segments (m, 4, 2); `marks`,
+    one a path, give each its role, `name`, `of` (a reconstruction's input) and `weights` (an interpolant's)."""
     allpts = np.concatenate([p.reshape(-1, 2) for p in paths])
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     size = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-9))
@@ -95,12 +135,12 @@ def svg_text(paths: list[np.ndarray], *, beziers: bool) -> str:
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{w * px:.0f}px" height="{max(h * px, 1):.0f}px" '
         f'viewBox="{_fmt(x0)} {_fmt(y0)} {_fmt(w)} {_fmt(h)}">',
-        "<desc>curve-vae: each path is a curve in its own coordinates, y up: its point (x, y) is drawn at (x, -y), "
-        "SVG's y pointing down.</desc>",
-        f'<g fill="none" stroke="#1f77b4" stroke-width="{STROKE_PX}">',
+        f"<desc>{DESC}</desc>",
+        f'<g fill="none" stroke-width="{STROKE_PX}">',
     ]
     for i, p in enumerate(paths):
         d = _d_beziers(p) if beziers else _d_points(p)
-        lines.append(f'<path id="curve-{i}" vector-effect="non-scaling-stroke" d="{d}"/>')
+        mark = _marked(marks[i] if marks else None)
+        lines.append(f'<path id="curve-{i}" {mark} vector-effect="non-scaling-stroke" d="{d}"/>')
     lines += ["</g>", "</svg>", ""]
     return "\n".join(lines)

@@ -1,5 +1,6 @@
 """Curves from text: JSON (an API body, a list of curves, one curve, the page's export) and CSV/TSV (x,y rows, a
-header row naming the columns, the page's `curve,role,index,x,y`)."""
+header row naming the columns, the page's `curve,role,of,weights,index,x,y`). Where curves carry roles (a `role`
+field or column), a file's inputs are its curves (roles.py)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from curve_vae.curvefiles.common import CurveFileError, as_curves, number
+from curve_vae.curvefiles.roles import Found, the_inputs
 
 JSON_SHAPES = (
     '[[x, y], …] (one curve), [curve, …], {"curves": [curve, …]} (as the API takes them), '
@@ -36,17 +38,18 @@ def parse_json(text: str, name: str) -> list[np.ndarray]:
         raise CurveFileError(f"{name}: JSON of curves is a list or an object; the shapes read are {JSON_SHAPES}")
     if data and isinstance(data[0], list) and data[0] and not isinstance(data[0][0], list | dict):
         data = [data]  # a single curve
-    return as_curves([_points(c, i, name) for i, c in enumerate(data)], name)
+    return as_curves([f.points for f in the_inputs((_found(c, i, name) for i, c in enumerate(data)), name)], name)
 
 
-def _points(curve: Any, i: int, name: str) -> Any:
-    """A curve of a JSON list: its points, from an object (the page's export) or as they are."""
+def _found(curve: Any, i: int, name: str) -> Found:
+    """A curve of a JSON list: its points and role, from an object (the page's export), or its points as they are."""
     if isinstance(curve, dict):
+        label = f" ({curve['name']})" if "name" in curve else ""
         if "points" not in curve:
-            label = f" ({curve['name']})" if "name" in curve else ""
             raise CurveFileError(f"{name}: curves[{i}]{label} is an object without 'points'")
-        return curve["points"]
-    return curve
+        role = curve.get("role")
+        return Found(f"curves[{i}]{label}", curve["points"], role if isinstance(role, str) and role else None)
+    return Found(f"curves[{i}]", curve)
 
 
 def _delimiter(line: str) -> str | None:
@@ -62,21 +65,22 @@ def _cells(line: str, delimiter: str | None) -> list[str]:
     return [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
 
 
-def _columns(header: list[str], number_line: int, name: str) -> tuple[int, int, int | None]:
-    """Where x, y and the curve's name are, from a header row."""
+def _columns(header: list[str], number_line: int, name: str) -> tuple[int, int, int | None, int | None]:
+    """Where x, y, the curve's name and its role are, from a header row."""
     names = [h.strip().lower() for h in header]
     curve = next((names.index(k) for k in ("curve", "name", "id") if k in names), None)
     if "x" in names and "y" in names:
-        return names.index("x"), names.index("y"), curve
+        return names.index("x"), names.index("y"), curve, names.index("role") if "role" in names else None
     if len(names) == 2:
-        return 0, 1, None
+        return 0, 1, None, None
     raise CurveFileError(f"{name}:{number_line}: a header row needs columns named x and y, got {','.join(header)}")
 
 
 def parse_csv(text: str, name: str) -> list[np.ndarray]:
     """Curves from CSV or TSV: one point a row. Without a header, a row is `x,y` and a blank line starts the next
     curve; with one, the columns named x and y are read and a `curve` (or `name`) column groups the rows, each
-    curve's rows one after another (blank lines between them change nothing)."""
+    curve's rows one after another (blank lines between them change nothing); a `role` column marks roles (a
+    curve's first row says its role)."""
     lines = text.splitlines()
     first = next((i for i, line in enumerate(lines) if line.strip()), None)
     if first is None:
@@ -84,14 +88,16 @@ def parse_csv(text: str, name: str) -> list[np.ndarray]:
     delimiter = _delimiter(lines[first])
     cells = _cells(lines[first], delimiter)
     header = any(number(c) is None for c in cells)
-    x, y, key = _columns(cells, first + 1, name) if header else (0, 1, None)
+    x, y, key, role = _columns(cells, first + 1, name) if header else (0, 1, None, None)
     curves: list[list[tuple[float, float]]] = [[]]
+    roles: list[str | None] = [None]
     last = None
     began: dict[str, int] = {}  # each curve name's first row (1-based)
     for i in range(first + header, len(lines)):
         if not lines[i].strip():
             if key is None:  # a blank line starts the next curve; where a column names the curves, the names do
                 curves.append([])
+                roles.append(None)
             continue
         row = _cells(lines[i], delimiter)
         values = [number(row[j]) if j < len(row) else None for j in (x, y)]
@@ -109,6 +115,10 @@ def parse_csv(text: str, name: str) -> list[np.ndarray]:
                     )
                 began[row[key]] = i + 1
                 curves.append([])
+                roles.append(None)
                 last = row[key]
+        if not curves[-1] and role is not None and role < len(row):
+            roles[-1] = row[role] or None
         curves[-1].append((values[0], values[1]))
-    return as_curves([c for c in curves if c], name)
+    found = [Found(f"row {i}", c, r) for i, (c, r) in enumerate(zip(curves, roles)) if c]
+    return as_curves([f.points for f in the_inputs(found, name)], name)

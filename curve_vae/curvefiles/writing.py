@@ -1,12 +1,14 @@
 """A command's output by the file's extension: .json (the endpoint's answer; the default, and `-` for standard
 output), .csv (the points, `curve,index,x,y`), .npy (the curves as one float32 array), .svg (a path per curve; a
-B-spline as exact cubic Béziers), .dxf (a SPLINE per B-spline, or an LWPOLYLINE per curve). Every file is written
+B-spline as exact cubic Béziers), .dxf (a SPLINE per B-spline, or an LWPOLYLINE per curve). Given marks (each curve's
+role, name, `of` and `weights`: roles.py), CSV, SVG and DXF say them as the page's exports do. Every file is written
 beside its name and renamed over it when complete."""
 
 from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -30,8 +32,11 @@ def _points(payload: dict[str, Any], path: str, array_key: str | None) -> list[A
     return payload[key]
 
 
-def write_output(path: str, payload: dict[str, Any], array_key: str | None = None) -> None:
-    """`payload` (an endpoint's JSON answer) to `path` in the format its extension names."""
+def write_output(
+    path: str, payload: dict[str, Any], array_key: str | None = None, marks: list[Mapping[str, Any]] | None = None
+) -> None:
+    """`payload` (an endpoint's JSON answer) to `path` in the format its extension names; `marks`, one a curve, say
+    each curve's role, name, input (`of`) and weights in CSV, SVG and DXF."""
     suffix = Path(path).suffix.lower() if path != "-" else ".json"
     if suffix == ".npy":
         try:
@@ -41,12 +46,9 @@ def write_output(path: str, payload: dict[str, Any], array_key: str | None = Non
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.save(f, arr)
     elif suffix == ".csv":
-        rows = ["curve,index,x,y"]
-        for i, c in enumerate(_points(payload, path, array_key)):
-            rows += [f"{i},{j},{x!r},{y!r}" for j, (x, y) in enumerate(np.asarray(c, dtype=np.float64).tolist())]
-        atomic_write_text(path, "\n".join(rows) + "\n")
+        atomic_write_text(path, _csv(_points(payload, path, array_key), marks))
     elif suffix in (".svg", ".dxf"):
-        _write_drawing(path, suffix, payload, array_key)
+        _write_drawing(path, suffix, payload, array_key, marks)
     else:
         text = json.dumps(payload, indent=None, separators=(",", ":"), default=_listed) + "\n"
         if path == "-":
@@ -62,7 +64,29 @@ def _listed(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not JSON serialisable")
 
 
-def _write_drawing(path: str, suffix: str, payload: dict[str, Any], array_key: str | None) -> None:
+def _csv(curves: list[Any], marks: list[Mapping[str, Any]] | None) -> str:
+    """`curve,index,x,y` rows, or with marks `curve,role,of,weights,index,x,y` (a curve named by its mark)."""
+    from curve_vae.curvefiles.svg import weights_text
+
+    rows = ["curve,role,of,weights,index,x,y" if marks else "curve,index,x,y"]
+    for i, c in enumerate(curves):
+        key = str(i)
+        if marks:
+            m = marks[i]
+            cells = (str(m.get("name", i)), m["role"], str(m.get("of") or ""), weights_text(m.get("weights") or {}))
+            key = ",".join(_cell(v) for v in cells)
+        rows += [f"{key},{j},{x!r},{y!r}" for j, (x, y) in enumerate(np.asarray(c, dtype=np.float64).tolist())]
+    return "\n".join(rows) + "\n"
+
+
+def _cell(text: str) -> str:
+    """A CSV cell, quoted where it holds a comma or a quote."""
+    return f'"{text.replace(chr(34), chr(34) * 2)}"' if any(c in text for c in ',"') else text
+
+
+def _write_drawing(
+    path: str, suffix: str, payload: dict[str, Any], array_key: str | None, marks: list[Mapping[str, Any]] | None
+) -> None:
     from curve_vae.curvefiles.dxf import write_dxf
     from curve_vae.curvefiles.svg import svg_text
 
@@ -71,10 +95,10 @@ def _write_drawing(path: str, suffix: str, payload: dict[str, Any], array_key: s
     if suffix == ".svg":
         if splines:
             beziers = [spline_beziers(s["control_points"], s["knots"], s["degree"]) for s in splines]
-            text = svg_text(beziers, beziers=True)
+            text = svg_text(beziers, beziers=True, marks=marks)
         else:
-            text = svg_text(curves or [], beziers=False)
+            text = svg_text(curves or [], beziers=False, marks=marks)
         atomic_write_text(path, text)
     else:
         with atomic_path(path) as tmp:
-            write_dxf(tmp, splines=splines, curves=curves)
+            write_dxf(tmp, splines=splines, curves=curves, marks=marks)

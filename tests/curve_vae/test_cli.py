@@ -175,7 +175,9 @@ def test_what_a_reader_skips_is_one_warning_line_and_the_command_goes_on(tmp_pat
     [
         "page-export.json",
         "page-export.csv",
+        "page-export.svg",
         "page-export.dxf",
+        "page-sheet.svg",
         "inkscape_drawing.svg",
         "selig_notes.dat",
         "ezdxf_drawing.dxf",
@@ -188,6 +190,9 @@ def test_reconstruct_gives_one_curve_back_per_curve_in(name, tmp_path, capsys):
     back = json.loads(out.read_text())["curves"]
     assert [len(c) for c in back] == [len(c) for c in given]
     err = capsys.readouterr().err
+    if name.startswith("page-export"):  # the drawing's three inputs, from each of the page's exports
+        assert len(back) == 3
+        assert "warning: " in err and "its 3 input curve(s) read; 14 derived curve(s)" in err
     if name.endswith(".dat"):  # the notes after the coordinates are named, not a reason to refuse the file
         assert "warning: " in err and "selig_notes.dat:72" in err and "Profilbeiwerte" in err
 
@@ -200,13 +205,13 @@ def test_reconstruct_draws_its_splines_as_svg_and_dxf(tmp_path):
     splines = json.loads(spl.read_text())["splines"]
     assert main(["reconstruct", page, "--output-as", "bspline", "-o", str(tmp_path / "out.svg")]) == 0
     paths = [e for e in se.SVG.parse(str(tmp_path / "out.svg")).elements() if isinstance(e, se.Path)]
-    assert len(paths) == 4
+    assert len(paths) == len(splines) == 3  # the drawing's inputs, reconstructed
     for path, s in zip(paths, splines):  # a cubic Bézier per knot span of the spline
         cubics = [seg for seg in path.segments() if isinstance(seg, se.CubicBezier)]
         assert len(cubics) == len(np.unique(s["knots"])) - 1
     assert main(["reconstruct", page, "--output-as", "bspline", "-o", str(tmp_path / "out.dxf")]) == 0
     entities = list(ezdxf.readfile(tmp_path / "out.dxf").modelspace().query("SPLINE"))
-    assert len(entities) == 4
+    assert len(entities) == 3
     for e, s in zip(entities, splines):
         np.testing.assert_allclose(np.asarray(e.control_points)[:, :2], s["control_points"], atol=1e-9)
         np.testing.assert_allclose(e.knots, s["knots"], atol=1e-12)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import BSpline
 
-from curve_vae.curvefiles import CurveFileError, read_curves, write_output
+from curve_vae.curvefiles import CurveFileError, CurveFileWarning, read_curves, write_output
 from tests.helpers import FIXTURES
 
 FILES = FIXTURES / "files"
@@ -27,13 +27,24 @@ def _spline(seed: int, n: int = 31, *, repeated: bool = False) -> dict:
     return {"control_points": rng.normal(size=(n, 2)).tolist(), "knots": knots.tolist(), "degree": 3}
 
 
-def test_the_pages_dxf_export_gives_its_strokes_and_splines():
-    curves = read_curves(FILES / "page-export.dxf")
-    assert len(curves) == 3 + 3 + 1  # the strokes as polylines; the reconstructions and the mix as SPLINEs
-    for got, saved in zip(curves[:3], PAGE[:3]):
+def test_the_pages_dxf_export_gives_its_strokes_and_holds_its_splines_exactly():
+    """The drawn curves as LWPOLYLINEs (read back as they were), the reconstructions and the mix as SPLINEs with their
+    control points and knots exactly, the in-betweens as LWPOLYLINEs: each entity one curve of the drawing."""
+    with pytest.warns(CurveFileWarning, match="its 3 input curve"):
+        curves = read_curves(FILES / "page-export.dxf")
+    assert len(curves) == 3
+    for got, saved in zip(curves, PAGE[:3]):
         np.testing.assert_array_equal(got, saved["points"])
-    mix = PAGE[3]["spline"]  # the export's mix: its spline sampled along its parameter
-    np.testing.assert_allclose(curves[-1][[0, -1]], np.asarray(mix["control_points"])[[0, -1]], atol=1e-9)
+    entities = list(ezdxf.readfile(FILES / "page-export.dxf").modelspace())
+    assert len(entities) == len(PAGE)
+    for e, saved in zip(entities, PAGE):
+        if "spline" in saved:
+            assert e.dxftype() == "SPLINE"
+            np.testing.assert_array_equal(np.asarray(e.control_points)[:, :2], saved["spline"]["control_points"])
+            np.testing.assert_array_equal(list(e.knots), saved["spline"]["knots"])
+        else:
+            assert e.dxftype() == "LWPOLYLINE"
+            np.testing.assert_array_equal(list(e.get_points("xy")), saved["points"])
 
 
 def test_a_dxf_gives_its_polylines_and_spline_and_the_block_it_inserts():

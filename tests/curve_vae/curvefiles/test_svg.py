@@ -32,13 +32,30 @@ def _user(undo: se.Matrix, p: se.Point) -> tuple[float, float]:
     return q.x, -q.y
 
 
-def test_the_pages_svg_export_gives_its_strokes_y_up():
-    """The board's paths, in its viewBox's units with y up: the drawn curves 700 below the API's (the board is 700
-    high and its y points down), to the 3 decimals the page writes."""
-    curves = read_curves(FILES / "page-export.svg")
-    assert len(curves) == 3 + 3 + 1  # the strokes, their dashed reconstructions and the mix
-    for got, saved in zip(curves[:3], PAGE[:3]):
-        np.testing.assert_allclose(got, np.asarray(saved["points"]) - [0, 700], atol=1e-3)
+def test_the_pages_svg_export_gives_its_strokes_where_they_were_drawn():
+    """The page writes SVG as the command line does: a point (x, y) at (x, -y) in user units, 10 digits; its drawn
+    curves (class input) come back in API coordinates."""
+    with pytest.warns(CurveFileWarning, match="its 3 input curve"):
+        curves = read_curves(FILES / "page-export.svg")
+    assert len(curves) == 3
+    for got, saved in zip(curves, PAGE[:3]):
+        np.testing.assert_allclose(got, saved["points"], rtol=1e-9)
+    svg = se.SVG.parse(str(FILES / "page-export.svg"))
+    assert max(svg.width, svg.height) == 800  # px, as the command line draws
+
+
+def test_the_pages_sheet_of_in_betweens_gives_each_at_one_scale():
+    """The sheet holds interpolants only: every one is read, each its curve moved into its cell and scaled alike."""
+    sweep = [c for c in PAGE if c["role"] == "interpolant" and c["name"] != "mix"]
+    curves = read_curves(FILES / "page-sheet.svg")
+    assert len(curves) == len(sweep) > 1
+    scales = []
+    for got, saved in zip(curves, sweep):
+        want = np.asarray(saved["points"])
+        (g, w) = (got - got.mean(axis=0), want - want.mean(axis=0))
+        scales.append(np.linalg.norm(g) / np.linalg.norm(w))
+        np.testing.assert_allclose(g, w * scales[-1], atol=1e-6 * np.abs(g).max())
+    np.testing.assert_allclose(scales, scales[0], rtol=1e-6)
 
 
 def test_an_inkscape_drawing_gives_its_path_polyline_and_polygon_with_their_transforms():

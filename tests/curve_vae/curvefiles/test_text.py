@@ -9,7 +9,7 @@ import json
 import numpy as np
 import pytest
 
-from curve_vae.curvefiles import CurveFileError, parse_csv, parse_json, read_curves
+from curve_vae.curvefiles import CurveFileError, CurveFileWarning, parse_csv, parse_json, read_curves
 from tests.helpers import FIXTURES
 
 FILES = FIXTURES / "files"
@@ -17,18 +17,30 @@ PAGE = json.loads((FILES / "page-export.json").read_text())["curves"]
 SQUARE_WAVE = [[0, 0], [1, 1], [2, 0], [3, 1]]
 
 
-def test_the_pages_json_export_gives_each_of_its_curves():
-    curves = read_curves(FILES / "page-export.json")
-    assert len(curves) == len(PAGE) == 4  # A, B, C and their mix
-    for got, saved in zip(curves, PAGE):
+def test_the_pages_json_export_gives_its_drawn_curves_not_the_derived_ones():
+    with pytest.warns(CurveFileWarning, match=r"page-export\.json: its 3 input curve\(s\) read; 14 derived curve"):
+        curves = read_curves(FILES / "page-export.json")
+    assert len(curves) == 3  # A, B and C; not their reconstructions, the mix or the in-betweens
+    for got, saved in zip(curves, PAGE[:3]):
+        assert saved["role"] == "input"
         np.testing.assert_array_equal(got, saved["points"])
 
 
 def test_the_pages_csv_export_gives_the_same_curves():
-    curves = read_curves(FILES / "page-export.csv")
-    assert [len(c) for c in curves] == [len(c["points"]) for c in PAGE]
+    with pytest.warns(CurveFileWarning, match="14 derived"):
+        curves = read_curves(FILES / "page-export.csv")
+    assert [len(c) for c in curves] == [len(c["points"]) for c in PAGE[:3]]
     for got, saved in zip(curves, PAGE):
         np.testing.assert_array_equal(got, saved["points"])
+
+
+def test_a_csv_of_derived_curves_only_gives_them_all():
+    rows = [(n, i, x, y + k) for k, n in enumerate("AB") for i, (x, y) in enumerate(SQUARE_WAVE)]
+    text = "curve,role,of,weights,index,x,y\n" + "".join(
+        f"{n} reconstructed,reconstruction,{n},,{i},{x},{y}\n" for n, i, x, y in rows
+    )
+    a, b = parse_csv(text, "rec.csv")
+    np.testing.assert_array_equal(b - a, np.ones((4, 2)) * [0, 1])
 
 
 @pytest.mark.parametrize(
