@@ -1,9 +1,15 @@
-// curve-vae's page: curve files in and out, read and written in the browser (nothing is uploaded to read them).
-// In: JSON (an API body, a list of curves, this page's export), CSV/TSV (x,y rows or a header naming x and y; a
-// `curve` column groups rows), airfoil .dat files (Selig or Lednicer, headers, remarks, notes after the
-// coordinates, Fortran exponents) and SVG (paths, polylines, polygons, transforms applied). Out: DXF, points as
-// LWPOLYLINEs and B-splines as SPLINE entities with their knots. The same formats as the command line's reader
-// (curve_vae/curvefiles); curves are in API coordinates, y up.
+// curve-vae's page: curve files in and out, read and written in the browser (nothing is uploaded to read them), with
+// the command line's file model (curve_vae/curvefiles). A drawing is a list of curves in API coordinates (y up), each
+// { name, role, of, weights, points, spline }: role "input" (drawn or opened), "reconstruction" (of the input named
+// by `of`) or "interpolant" (the mix and each in-between, `weights` by input name); a spline where it has one.
+// Out (write): JSON {"curves": [...]}, CSV `curve,role,of,weights,index,x,y`, SVG (a path per curve, its class the
+// role, data-name/-of/-weights; a point (x, y) at (x, -y) in user units) and DXF (an LWPOLYLINE or a SPLINE per
+// curve on the layer `<role>-<name>`, role, name, of and weights as XDATA of the application CURVE_VAE); sheet: the
+// in-betweens as an SVG grid. In (parse): JSON, CSV/TSV, airfoil .dat (Selig or Lednicer, headers, remarks, notes
+// after the coordinates, Fortran exponents), SVG (paths, polylines, polygons, transforms and <use> applied), DXF
+// (LWPOLYLINE, POLYLINE, SPLINE, inserted blocks) and .npy. Where a file marks roles and holds inputs, its inputs are
+// its curves and the others come back as `derived`, with a note; where it marks roles but holds no input, and where
+// it marks none, every curve is a curve.
 "use strict";
 
 (() => {
@@ -18,13 +24,12 @@
   class CurveFileError extends Error {}
 
   const number = (s) => (IS_NUM.test(s.trim()) ? Number(s.trim().replace(/[dD]/, "e")) : null);
+  const isPoints = (c) => Array.isArray(c) && c.every((p) => Array.isArray(p) && p.length === 2 && p.every(Number.isFinite));
 
   function checked(curves, name) {
     const out = curves.filter((c) => c.length);
     out.forEach((c, i) => {
-      if (!Array.isArray(c) || c.some((p) => !Array.isArray(p) || p.length !== 2 || !p.every(Number.isFinite))) {
-        throw new CurveFileError(`${name}: curve ${i + 1} must be a list of [x, y] pairs of numbers`);
-      }
+      if (!isPoints(c)) throw new CurveFileError(`${name}: curve ${i + 1} must be a list of [x, y] pairs of numbers`);
       if (c.length < MIN_POINTS) {
         throw new CurveFileError(`${name}: curve ${i + 1} has ${c.length} points; a curve needs at least ${MIN_POINTS}`);
       }
@@ -33,27 +38,103 @@
     return out;
   }
 
+  // ---------------------------------------------------------------------------------------------- roles
+
+  const ROLES = ["input", "reconstruction", "interpolant"];
+  const roleOf = (marks) => (marks || "").split(/\s+/).find((w) => ROLES.includes(w)) || null;
+  const weightsText = (w) => Object.entries(w || {}).map(([k, v]) => `${k}=${v}`).join(" ");
+  function weightsOf(text) {
+    const out = {};
+    for (const [k, v] of (text || "").split(/\s+/).map((t) => t.split("="))) if (k && v !== undefined && number(v) !== null) out[k] = number(v);
+    return Object.keys(out).length ? out : undefined;
+  }
+
+  // A curve of a file as the page keeps it: { name, role, of, weights, points, spline }, the fields it has.
+  function item(f) {
+    const out = { name: f.name, role: f.role };
+    if (f.of !== undefined && f.of !== null && f.of !== "") out.of = String(f.of);
+    if (f.weights && Object.keys(f.weights).length) out.weights = f.weights;
+    out.points = f.points;
+    if (f.spline) out.spline = f.spline;
+    return out;
+  }
+
+  // The file's curves by the rule above: { picked (those read as curves), derived (items), notes }.
+  function chosen(found, name, notes = []) {
+    const inputs = found.filter((f) => f.role === "input");
+    if (!inputs.length) return { picked: found, derived: [], notes };
+    const others = found.filter((f) => f.role !== "input");
+    if (others.length) {
+      notes.push(`${name}: its ${inputs.length} input curve(s) read; ${others.length} derived curve(s) ` +
+        "(reconstructions, interpolants) not read as inputs");
+    }
+    const derived = others.filter((f) => ROLES.includes(f.role) && isPoints(f.points) && f.points.length > 1).map(item);
+    return { picked: inputs, derived, notes };
+  }
+
+  // A list's curves (JSON, CSV): the rule, then each curve checked.
+  function listed(found, name) {
+    const { picked, derived, notes } = chosen(found, name);
+    return { curves: checked(picked.map((f) => f.points), name), derived, notes };
+  }
+
+  // A drawing's curves (SVG, DXF): the rule, then one of fewer than MIN_POINTS points skipped with a note naming it.
+  function drawn(found, name, kinds, notes = []) {
+    const { picked, derived } = chosen(found, name, notes);
+    const curves = [];
+    for (const f of picked) {
+      if (f.points.length < MIN_POINTS) notes.push(`${name}: ${f.label}: ${f.points.length} points, not a curve; skipped`);
+      else curves.push(f.points);
+    }
+    if (!curves.length) throw new CurveFileError(`${name}: no curve in this drawing (no ${kinds})`);
+    return { curves, derived, notes };
+  }
+
+  // ---------------------------------------------------------------------------------------------- JSON, CSV
+
+  function marked(c, points) {
+    const f = { name: typeof c.name === "string" ? c.name : undefined, role: typeof c.role === "string" && c.role ? c.role : null, points };
+    if (c.of !== undefined && c.of !== null) f.of = String(c.of);
+    if (c.weights && typeof c.weights === "object") f.weights = c.weights;
+    if (c.spline && typeof c.spline === "object" && Array.isArray(c.spline.control_points)) f.spline = c.spline;
+    return f;
+  }
+
   function fromJson(text, name) {
     let data;
     try { data = JSON.parse(text); } catch (e) { throw new CurveFileError(`${name}: not JSON (${e.message})`); }
     if (data && !Array.isArray(data) && typeof data === "object") {
       if (Array.isArray(data.curves)) data = data.curves;
       else if (data.curve) data = [data.curve];
+      else if (data.points) data = [data];
       else throw new CurveFileError(`${name}: a JSON object needs a "curves" list`);
     }
     if (!Array.isArray(data)) throw new CurveFileError(`${name}: JSON of curves is a list or an object`);
     if (data.length && Array.isArray(data[0]) && typeof data[0][0] === "number") data = [data];  // one curve
-    return checked(data.map((c, i) => {
+    return listed(data.map((c, i) => {
       if (c && !Array.isArray(c) && typeof c === "object") {
         if (!Array.isArray(c.points)) throw new CurveFileError(`${name}: curves[${i}] is an object without "points"`);
-        return c.points;
+        return marked(c, c.points);
       }
-      return c;
+      return { role: null, points: c };
     }), name);
   }
 
+  // A row's cells: apart by the delimiter (a cell in double quotes may hold it), or by spaces.
   function cells(line, delimiter) {
-    return delimiter ? line.split(delimiter).map((c) => c.trim().replace(/^"(.*)"$/, "$1")) : line.trim().split(/\s+/);
+    if (!delimiter) return line.trim().split(/\s+/);
+    const out = [];
+    let cell = "", quoted = false;
+    for (let i = 0; i < line.length; i++) {
+      const ch = line[i];
+      if (quoted) {
+        if (ch !== '"') cell += ch;
+        else if (line[i + 1] === '"') { cell += '"'; i++; } else quoted = false;
+      } else if (ch === '"' && !cell) quoted = true;
+      else if (ch === delimiter) { out.push(cell.trim()); cell = ""; } else cell += ch;
+    }
+    out.push(cell.trim());
+    return out;
   }
 
   function fromCsv(text, name) {
@@ -65,18 +146,20 @@
     const header = head.some((c) => number(c) === null);
     const names = head.map((c) => c.toLowerCase());
     let [x, y, key] = [0, 1, -1];
-    if (header && names.includes("x") && names.includes("y")) {
+    const named = header && names.includes("x") && names.includes("y");
+    if (named) {
       [x, y] = [names.indexOf("x"), names.indexOf("y")];
       key = ["curve", "name", "id"].map((k) => names.indexOf(k)).find((i) => i >= 0) ?? -1;
     } else if (header && names.length !== 2) {
       throw new CurveFileError(`${name}:${first + 1}: a header row needs columns named x and y`);
     }
-    const curves = [[]];
+    const [role, of, weights] = ["role", "of", "weights"].map((k) => (named ? names.indexOf(k) : -1));
+    const found = [{ role: null, points: [] }];
     let last = null;
     const began = new Map();  // each curve name's first row (1-based)
     for (let i = first + (header ? 1 : 0); i < lines.length; i++) {
       if (!lines[i].trim()) {  // a blank line starts the next curve; where a column names the curves, the names do
-        if (key < 0) curves.push([]);
+        if (key < 0) found.push({ role: null, points: [] });
         continue;
       }
       const row = cells(lines[i], delimiter);
@@ -93,14 +176,22 @@
               `${began.get(row[key])}): list each curve's rows one after another, or name the pieces apart`);
           }
           began.set(row[key], i + 1);
-          curves.push([]);
+          found.push({ name: row[key], role: null, points: [] });
           last = row[key];
         }
       }
-      curves[curves.length - 1].push([px, py]);
+      const f = found[found.length - 1];
+      if (!f.points.length) {
+        if (role >= 0) f.role = row[role] || null;
+        if (of >= 0 && row[of]) f.of = row[of];
+        if (weights >= 0) f.weights = weightsOf(row[weights]);
+      }
+      f.points.push([px, py]);
     }
-    return checked(curves, name);
+    return listed(found.filter((f) => f.points.length), name);
   }
+
+  // ---------------------------------------------------------------------------------------------- airfoil .dat
 
   // One airfoil in Selig order, and what was skipped, as notes.
   function fromDat(text, name) {
@@ -133,106 +224,498 @@
       const same = Math.hypot(lo[0][0] - up[0][0], lo[0][1] - up[0][1]) < 1e-9;
       pts = [...up.reverse(), ...(same ? lo.slice(1) : lo)];
     }
-    return { curves: checked([pts], name), notes };
+    return { curves: checked([pts], name), derived: [], notes };
   }
 
-  const SAMPLES = 120;  // points along a drawing's curved path (straight ones, polylines and polygons keep their vertices)
+  // ---------------------------------------------------------------------------------------------- SVG in
 
-  // The vertices of a path of straight segments only (M, L, H, V, Z), or null where it has curved ones.
-  function vertices(d) {
-    const tokens = d.match(/[A-Za-z]|[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/g) || [];
-    if (tokens.some((t) => /[CcSsQqTtAa]/.test(t))) return null;
-    const pts = [];
-    let cmd = "M", x = 0, y = 0, start = [0, 0];
-    for (let i = 0; i < tokens.length;) {
-      if (/[A-Za-z]/.test(tokens[i])) {
-        cmd = tokens[i++];
-        if (cmd === "Z" || cmd === "z") { [x, y] = start; pts.push([x, y]); continue; }
-      }
-      const rel = cmd === cmd.toLowerCase(), c = cmd.toUpperCase();
-      const a = Number(tokens[i++]);
-      if (c === "H") x = rel ? x + a : a;
-      else if (c === "V") y = rel ? y + a : a;
+  const SEGMENT_SAMPLES = 16;  // points along a curved segment (cubic, quadratic, arc), as the command line samples them
+  const SVG_NUM = /[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/y;
+  const mul = (m, n) => [m[0] * n[0] + m[2] * n[1], m[1] * n[0] + m[3] * n[1], m[0] * n[2] + m[2] * n[3],
+    m[1] * n[2] + m[3] * n[3], m[0] * n[4] + m[2] * n[5] + m[4], m[1] * n[4] + m[3] * n[5] + m[5]];
+  const ID = [1, 0, 0, 1, 0, 0];
+
+  // An SVG transform attribute as [a, b, c, d, e, f].
+  function transformOf(text) {
+    let m = ID;
+    for (const [, kind, args] of (text || "").matchAll(/(matrix|translate|scale|rotate|skewX|skewY)\s*\(([^)]*)\)/g)) {
+      const v = (args.match(/[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/g) || []).map(Number);
+      const r = ((v[0] || 0) * Math.PI) / 180;
+      let t;
+      if (kind === "matrix") t = v.length === 6 ? v : ID;
+      else if (kind === "translate") t = [1, 0, 0, 1, v[0] || 0, v[1] || 0];
+      else if (kind === "scale") t = [v[0] ?? 1, 0, 0, v[1] ?? v[0] ?? 1, 0, 0];
+      else if (kind === "skewX") t = [1, 0, Math.tan(r), 1, 0, 0];
+      else if (kind === "skewY") t = [1, Math.tan(r), 0, 1, 0, 0];
       else {
-        const b = Number(tokens[i++]);
-        [x, y] = rel ? [x + a, y + b] : [a, b];
+        const [cx, cy] = [v[1] || 0, v[2] || 0];
+        t = mul(mul([1, 0, 0, 1, cx, cy], [Math.cos(r), Math.sin(r), -Math.sin(r), Math.cos(r), 0, 0]), [1, 0, 0, 1, -cx, -cy]);
       }
-      if (c === "M") { start = [x, y]; cmd = rel ? "l" : "L"; }  // pairs after a move are lines
-      pts.push([x, y]);
+      m = mul(m, t);
     }
-    return pts.map(([px, py]) => ({ x: px, y: py }));
+    return m;
   }
 
-  // The drawing's paths, polylines and polygons in its viewBox's units, y up from the viewBox's bottom (the page's
-  // own SVG export comes back where it was drawn). Of the page's own export, its drawn strokes (class "input").
+  function arcPoints([x1, y1], rx, ry, phiDeg, large, sweep, [x2, y2]) {
+    if (x1 === x2 && y1 === y2) return [];
+    if (!rx || !ry) return [[x2, y2]];
+    [rx, ry] = [Math.abs(rx), Math.abs(ry)];
+    const phi = (phiDeg * Math.PI) / 180, cos = Math.cos(phi), sin = Math.sin(phi);
+    const dx = (x1 - x2) / 2, dy = (y1 - y2) / 2;
+    const xp = cos * dx + sin * dy, yp = -sin * dx + cos * dy;
+    const lambda = (xp * xp) / (rx * rx) + (yp * yp) / (ry * ry);
+    if (lambda > 1) [rx, ry] = [rx * Math.sqrt(lambda), ry * Math.sqrt(lambda)];
+    const num = rx * rx * ry * ry - rx * rx * yp * yp - ry * ry * xp * xp;
+    const coef = (large !== sweep ? 1 : -1) * Math.sqrt(Math.max(0, num / (rx * rx * yp * yp + ry * ry * xp * xp)));
+    const cxp = (coef * rx * yp) / ry, cyp = (-coef * ry * xp) / rx;
+    const cx = cos * cxp - sin * cyp + (x1 + x2) / 2, cy = sin * cxp + cos * cyp + (y1 + y2) / 2;
+    const angle = (ux, uy, vx, vy) => Math.atan2(ux * vy - uy * vx, ux * vx + uy * vy);
+    const t1 = angle(1, 0, (xp - cxp) / rx, (yp - cyp) / ry);
+    let dt = angle((xp - cxp) / rx, (yp - cyp) / ry, (-xp - cxp) / rx, (-yp - cyp) / ry);
+    if (!sweep && dt > 0) dt -= 2 * Math.PI;
+    if (sweep && dt < 0) dt += 2 * Math.PI;
+    return Array.from({ length: SEGMENT_SAMPLES }, (_, k) => {
+      const t = t1 + (dt * (k + 1)) / SEGMENT_SAMPLES;
+      return k === SEGMENT_SAMPLES - 1 ? [x2, y2]
+        : [cx + rx * cos * Math.cos(t) - ry * sin * Math.sin(t), cy + rx * sin * Math.cos(t) + ry * cos * Math.sin(t)];
+    });
+  }
+
+  function bezierPoints(p) {  // p: 3 or 4 control points
+    return Array.from({ length: SEGMENT_SAMPLES }, (_, k) => {
+      const s = (k + 1) / SEGMENT_SAMPLES, u = 1 - s;
+      const w = p.length === 4 ? [u * u * u, 3 * s * u * u, 3 * s * s * u, s * s * s] : [u * u, 2 * s * u, s * s];
+      return [0, 1].map((j) => w.reduce((acc, wi, i) => acc + wi * p[i][j], 0));
+    });
+  }
+
+  // Each subpath's points of a path's d: the vertices of lines, samples of curved segments.
+  function subpaths(d) {
+    const out = [];
+    let i = 0, cmd = null, cur = [0, 0], start = [0, 0], ctrl = null, prev = "";
+    const skip = () => { while (i < d.length && /[\s,]/.test(d[i])) i++; };
+    const num = () => {
+      skip();
+      SVG_NUM.lastIndex = i;
+      const m = SVG_NUM.exec(d);
+      if (!m) throw new Error("bad path");
+      i += m[0].length;
+      return Number(m[0]);
+    };
+    const flag = () => { skip(); if (d[i] !== "0" && d[i] !== "1") throw new Error("bad flag"); return d[i++] === "1"; };
+    const add = (pts) => { if (out.length) out[out.length - 1].push(...pts); };
+    try {
+      for (skip(); i < d.length; skip()) {
+        if (/[A-Za-z]/.test(d[i])) cmd = d[i++];
+        else if (!cmd) break;
+        const c = cmd.toUpperCase(), rel = cmd !== c;
+        const pt = () => { const [x, y] = [num(), num()]; return rel ? [cur[0] + x, cur[1] + y] : [x, y]; };
+        if (c === "Z") {
+          add([start]);
+          cur = start;
+          cmd = null;
+        } else if (c === "M") {
+          cur = start = pt();
+          out.push([cur]);
+          cmd = rel ? "l" : "L";  // pairs after a move are lines
+        } else if (c === "L") {
+          cur = pt();
+          add([cur]);
+        } else if (c === "H" || c === "V") {
+          const v = num();
+          cur = c === "H" ? [rel ? cur[0] + v : v, cur[1]] : [cur[0], rel ? cur[1] + v : v];
+          add([cur]);
+        } else if (c === "C" || c === "S") {
+          const c1 = c === "C" ? pt() : (ctrl && "CS".includes(prev) ? [2 * cur[0] - ctrl[0], 2 * cur[1] - ctrl[1]] : cur);
+          const c2 = pt(), end = pt();
+          add(bezierPoints([cur, c1, c2, end]));
+          [ctrl, cur] = [c2, end];
+        } else if (c === "Q" || c === "T") {
+          const c1 = c === "Q" ? pt() : (ctrl && "QT".includes(prev) ? [2 * cur[0] - ctrl[0], 2 * cur[1] - ctrl[1]] : cur);
+          const end = pt();
+          add(bezierPoints([cur, c1, end]));
+          [ctrl, cur] = [c1, end];
+        } else if (c === "A") {
+          const [rx, ry, phi, large, sweep] = [num(), num(), num(), flag(), flag()];
+          const end = pt();
+          add(arcPoints(cur, rx, ry, phi, large, sweep, end));
+          cur = end;
+        } else break;
+        prev = c;
+      }
+    } catch (e) { /* a path draws up to its first error, as browsers draw it */ }
+    // a point again where it already is (a close onto the last point) adds nothing
+    return out.map((pts) => pts.filter((p, k) => !k || p[0] !== pts[k - 1][0] || p[1] !== pts[k - 1][1]));
+  }
+
+  const NOT_DRAWN = new Set(["defs", "clipPath", "mask", "marker", "pattern", "symbol", "metadata", "title", "desc",
+    "style", "script", "text", "foreignObject"]);
+
+  // The drawing's paths, polylines and polygons in its user units (the root's viewBox), a point (x, y) of the file
+  // read as (x, -y): the command line's convention, so the page's own SVG opens where it was drawn.
   function fromSvg(text, name) {
-    const parsed = new DOMParser().parseFromString(text, "image/svg+xml");
-    if (parsed.querySelector("parsererror") || parsed.documentElement.localName !== "svg") {
+    const doc = new DOMParser().parseFromString(text, "image/svg+xml");
+    if (doc.querySelector("parsererror") || doc.documentElement.localName !== "svg") {
       throw new CurveFileError(`${name}: not an SVG drawing`);
     }
-    const holder = document.createElement("div");
-    holder.style.cssText = "position:absolute;left:-10000px;top:0;width:100px;height:100px;visibility:hidden";
-    const svg = document.importNode(parsed.documentElement, true);
-    holder.appendChild(svg);
-    document.body.appendChild(holder);
-    try {
-      let shapes = [...svg.querySelectorAll("path, polyline, polygon")];
-      if (shapes.some((s) => s.classList.contains("input"))) shapes = shapes.filter((s) => s.classList.contains("input"));
-      const vb = svg.viewBox && svg.viewBox.baseVal;
-      const bottom = vb && vb.height ? vb.y + vb.height : 0;
-      const toRoot = svg.getScreenCTM().inverse();
-      return checked(shapes.map((s) => {
-        const m = toRoot.multiply(s.getScreenCTM());
-        let pts;
-        if (s.localName === "path") {
-          const length = s.getTotalLength();
-          pts = vertices(s.getAttribute("d") || "")
-            || Array.from({ length: SAMPLES }, (_, i) => s.getPointAtLength((length * i) / (SAMPLES - 1)));
-        } else {
-          pts = [...s.points];
-          if (s.localName === "polygon" && pts.length) pts.push(pts[0]);
+    const found = [];
+    const walk = (el, m, depth) => {
+      const tag = el.localName;
+      if (NOT_DRAWN.has(tag) || depth > 32) return;
+      m = mul(m, transformOf(el.getAttribute("transform")));
+      if (tag === "use") {
+        const ref = (el.getAttribute("href") || el.getAttributeNS("http://www.w3.org/1999/xlink", "href") || "").slice(1);
+        const target = ref && [...doc.getElementsByTagName("*")].find((e) => e.getAttribute("id") === ref);
+        const at = [1, 0, 0, 1, Number(el.getAttribute("x")) || 0, Number(el.getAttribute("y")) || 0];
+        if (target) (target.localName === "symbol" ? [...target.children] : [target]).forEach((t) => walk(t, mul(m, at), depth + 1));
+        return;
+      }
+      if (tag === "path" || tag === "polyline" || tag === "polygon") {
+        let paths;
+        if (tag === "path") paths = subpaths(el.getAttribute("d") || "");
+        else {
+          const v = (el.getAttribute("points") || "").match(/[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?/g) || [];
+          const pts = Array.from({ length: Math.floor(v.length / 2) }, (_, k) => [Number(v[2 * k]), Number(v[2 * k + 1])]);
+          if (tag === "polygon" && pts.length) pts.push(pts[0]);
+          paths = [pts.filter((p, k) => !k || p[0] !== pts[k - 1][0] || p[1] !== pts[k - 1][1])];
         }
-        return pts.map((p) => new DOMPoint(p.x, p.y).matrixTransform(m)).map((p) => [p.x, bottom - p.y]);
-      }), name);
-    } finally {
-      holder.remove();
+        const id = el.getAttribute("id");
+        for (const pts of paths) {
+          found.push({
+            label: id ? `${tag}#${id}` : tag, name: el.getAttribute("data-name") ?? undefined,
+            role: roleOf(el.getAttribute("class")), of: el.getAttribute("data-of") ?? undefined,
+            weights: weightsOf(el.getAttribute("data-weights")),
+            points: pts.map(([x, y]) => [m[0] * x + m[2] * y + m[4], -(m[1] * x + m[3] * y + m[5])]),
+          });
+        }
+        return;
+      }
+      for (const child of el.children) walk(child, m, depth);
+    };
+    for (const child of doc.documentElement.children) walk(child, ID, 0);
+    return drawn(found, name, "path, polyline or polygon of 4 points or more");
+  }
+
+  // ---------------------------------------------------------------------------------------------- DXF in
+
+  const APPID = "CURVE_VAE";
+  const SAMPLES_PER_CONTROL_POINT = 8;  // points along a SPLINE per control point, at least 64: as the command line
+
+  // A point of a B-spline (homogeneous control points [x*w, y*w, w]) at t, by de Boor's algorithm.
+  function deBoor(t, p, knots, ctrl) {
+    let k = p;
+    while (k < ctrl.length - 1 && t >= knots[k + 1]) k++;
+    const d = Array.from({ length: p + 1 }, (_, j) => ctrl[j + k - p].slice());
+    for (let r = 1; r <= p; r++) {
+      for (let j = p; j >= r; j--) {
+        const lo = knots[j + k - p], span = knots[j + 1 + k - r] - lo;
+        const a = span ? (t - lo) / span : 0;
+        d[j] = d[j].map((v, c) => (1 - a) * d[j - 1][c] + a * v);
+      }
     }
+    return d[p];
   }
 
-  // { curves, notes } of a file's text, by its extension (anything else is read as JSON).
-  function parse(name, text) {
+  // Points along a spline {degree, knots, control_points, weights?}, evenly in its parameter.
+  function splinePoints({ degree: p, knots, control_points: cp, weights }) {
+    const n = Math.max(64, SAMPLES_PER_CONTROL_POINT * cp.length);
+    const ctrl = cp.map(([x, y], i) => { const w = weights && weights.length === cp.length ? weights[i] : 1; return [x * w, y * w, w]; });
+    const [t0, t1] = [knots[p], knots[cp.length]];
+    return Array.from({ length: n }, (_, i) => {
+      const [x, y, w] = deBoor(t0 + ((t1 - t0) * i) / (n - 1), p, knots, ctrl);
+      return [x / w, y / w];
+    });
+  }
+
+  function dxfEntities(tags) {  // a section's tags, as entities: { type, tags (before XDATA), xdata }
+    const out = [];
+    for (const [code, value] of tags) {
+      if (code === 0) out.push({ type: value, tags: [], xdata: [] });
+      else if (out.length) (code >= 1000 || out[out.length - 1].xdata.length ? out[out.length - 1].xdata : out[out.length - 1].tags).push([code, value]);
+    }
+    return out;
+  }
+
+  // A closed polyline (flag 1) is a loop: it ends where it starts.
+  const closed = (pts, flags) => ((Number(flags) & 1) && pts.length && (pts[0][0] !== pts[pts.length - 1][0] ||
+    pts[0][1] !== pts[pts.length - 1][1]) ? [...pts, pts[0]] : pts);
+
+  function fromDxf(text, name) {
+    if (text.startsWith("AutoCAD Binary DXF")) throw new CurveFileError(`${name}: a binary DXF; save it as an ASCII DXF to open it here`);
+    const lines = text.split(/\r?\n/);
+    const tags = [];
+    for (let i = 0; i + 1 < lines.length; i += 2) {
+      const code = lines[i].trim();
+      if (!/^-?\d+$/.test(code)) throw new CurveFileError(`${name}:${i + 1}: not a DXF drawing (a group code, got "${code}")`);
+      tags.push([Number(code), lines[i + 1].trim()]);
+    }
+    const sections = {};
+    for (let i = 0; i < tags.length; i++) {
+      if (tags[i][0] === 0 && tags[i][1] === "SECTION" && tags[i + 1] && tags[i + 1][0] === 2) {
+        const end = tags.findIndex((t, j) => j > i && t[0] === 0 && t[1] === "ENDSEC");
+        sections[tags[i + 1][1]] = tags.slice(i + 2, end < 0 ? tags.length : end);
+      }
+    }
+    if (!sections.ENTITIES) throw new CurveFileError(`${name}: not a DXF drawing (no ENTITIES section)`);
+    const blocks = {};
+    let block = null;
+    for (const e of dxfEntities(sections.BLOCKS || [])) {
+      if (e.type === "BLOCK") {
+        const get = (c) => (e.tags.find((t) => t[0] === c) || [0, "0"])[1];
+        block = { entities: [], base: [Number(get(10)), Number(get(20))] };
+        blocks[get(2)] = block;
+      } else if (e.type === "ENDBLK") block = null;
+      else if (block) block.entities.push(e);
+    }
+    const found = [], notes = [];
+    const visit = (entities, m, depth, inBlock) => {
+      for (let i = 0; i < entities.length; i++) {
+        const e = entities[i];
+        const all = (c) => e.tags.filter((t) => t[0] === c).map((t) => t[1]);
+        const one = (c, dflt) => { const v = all(c); return v.length ? v[0] : dflt; };
+        if (one(67, "0") === "1") continue;  // paper space
+        const at = ([x, y]) => [m[0] * x + m[2] * y + m[4], m[1] * x + m[3] * y + m[5]];
+        const xy = (cx, cy) => all(cx).map((x, k) => [Number(x), Number(all(cy)[k])]);
+        const label = inBlock ? `${e.type} of a block` : `${e.type} #${one(5, "")}`;
+        let points = null, spline;
+        if (e.type === "INSERT") {
+          const b = blocks[one(2, "")];
+          if (!b || depth > 16) continue;
+          const r = (Number(one(50, "0")) * Math.PI) / 180;
+          const [sx, sy] = [Number(one(41, "1")), Number(one(42, "1"))];
+          const t = mul(mul([1, 0, 0, 1, Number(one(10, "0")), Number(one(20, "0"))],
+            [Math.cos(r) * sx, Math.sin(r) * sx, -Math.sin(r) * sy, Math.cos(r) * sy, 0, 0]), [1, 0, 0, 1, -b.base[0], -b.base[1]]);
+          visit(b.entities, mul(m, t), depth + 1, true);
+          continue;
+        } else if (e.type === "LWPOLYLINE") {
+          points = closed(xy(10, 20), one(70, "0"));
+          if (all(42).some((b) => Number(b))) notes.push(`${name}: ${label}: its arcs (bulges) read as straight lines`);
+        } else if (e.type === "POLYLINE") {
+          points = [];
+          while (entities[i + 1] && entities[i + 1].type === "VERTEX") {
+            const v = entities[++i].tags;
+            points.push([10, 20].map((c) => Number((v.find((t) => t[0] === c) || [0, "0"])[1])));
+          }
+          points = closed(points, one(70, "0"));
+        } else if (e.type === "SPLINE") {
+          const ctrl = xy(10, 20);
+          if (!ctrl.length) { notes.push(`${name}: ${label}: a spline by fit points only; skipped`); continue; }
+          const s = { degree: Number(one(71, "3")), knots: all(40).map(Number), control_points: ctrl.map(at) };
+          const w = all(41).map(Number);
+          points = splinePoints({ ...s, weights: w });
+          if (!w.length) spline = s;
+        } else continue;
+        if (e.type !== "SPLINE") points = points.map(at);
+        const marks = {};
+        let ours = false;
+        for (const [code, value] of e.xdata) {
+          if (code === 1001) ours = value === APPID;
+          else if (ours && code === 1000) { const k = value.indexOf("="); if (k > 0) marks[value.slice(0, k)] = value.slice(k + 1); }
+        }
+        const layer = one(8, "0");
+        const role = ROLES.includes(marks.role) ? marks.role : (ROLES.includes(layer.split("-")[0]) ? layer.split("-")[0] : null);
+        const fromLayer = layer.includes("-") ? layer.slice(layer.indexOf("-") + 1) : undefined;
+        found.push({ label, name: marks.name ?? fromLayer, role, of: marks.of, weights: weightsOf(marks.weights), points, spline });
+      }
+    };
+    visit(dxfEntities(sections.ENTITIES), ID, 0, false);
+    return drawn(found, name, "LWPOLYLINE, POLYLINE or SPLINE of 4 points", notes);
+  }
+
+  // ---------------------------------------------------------------------------------------------- .npy in
+
+  // An .npy array (n, 2) or (N, n, 2) of floats or integers (format versions 1 to 3), as curves.
+  function fromNpy(data, name) {
+    if (typeof data === "string") throw new CurveFileError(`${name}: a numpy file is read as bytes (an ArrayBuffer), not as text`);
+    const bytes = new Uint8Array(data.buffer ? data.buffer.slice(data.byteOffset, data.byteOffset + data.byteLength) : data);
+    const view = new DataView(bytes.buffer);
+    const magic = String.fromCharCode(...bytes.slice(0, 6));
+    if (magic !== "\x93NUMPY" || bytes.length < 10) throw new CurveFileError(`${name}: not a numpy file (no .npy header)`);
+    const major = bytes[6];
+    if (major < 1 || major > 3) throw new CurveFileError(`${name}: a numpy file of format version ${major}; the page reads versions 1 to 3`);
+    const long = major >= 2;
+    const size = long ? view.getUint32(8, true) : view.getUint16(8, true);
+    const at = (long ? 12 : 10) + size;
+    const header = new TextDecoder(major === 3 ? "utf-8" : "latin1").decode(bytes.slice(long ? 12 : 10, at));
+    const descr = (header.match(/'descr'\s*:\s*'([^']*)'/) || [])[1];
+    const fortran = /'fortran_order'\s*:\s*True/.test(header);
+    const shapeText = (header.match(/'shape'\s*:\s*\(([^)]*)\)/) || [])[1];
+    if (descr === undefined || shapeText === undefined) throw new CurveFileError(`${name}: not a numpy file (its header has no descr or shape)`);
+    const shape = shapeText.split(",").map((s) => s.trim()).filter(Boolean).map(Number);
+    const shown = `(${shape.join(", ")}${shape.length === 1 ? "," : ""})`;
+    const m = descr.match(/^([<>|=]?)([fiu])(\d+)$/);
+    const readers = { f4: "getFloat32", f8: "getFloat64", i1: "getInt8", i2: "getInt16", i4: "getInt32", i8: "getBigInt64",
+      u1: "getUint8", u2: "getUint16", u4: "getUint32", u8: "getBigUint64" };
+    const reader = m && readers[m[2] + m[3]];
+    if (!reader) throw new CurveFileError(`${name}: an array of ${descr}; curves are numbers (float32, float64 or integers)`);
+    if (!(shape.length === 2 || shape.length === 3) || shape[shape.length - 1] !== 2) {
+      throw new CurveFileError(`${name}: an array of shape ${shown}; curves are (n, 2) or (N, n, 2)`);
+    }
+    const [count, n] = shape.length === 2 ? [1, shape[0]] : shape;
+    const width = Number(m[3]), little = m[1] !== ">";
+    if (bytes.length < at + count * n * 2 * width) throw new CurveFileError(`${name}: the file ends before its ${shown} array does`);
+    const value = (k, j, c) => {  // element [k, j, c] in C order, or Fortran's
+      const flat = fortran ? k + count * (j + n * c) : (k * n + j) * 2 + c;
+      return Number(view[reader](at + flat * width, little));
+    };
+    const curves = Array.from({ length: count }, (_, k) => Array.from({ length: n }, (_, j) => [value(k, j, 0), value(k, j, 1)]));
+    return { curves: checked(curves, name), derived: [], notes: [] };
+  }
+
+  // { curves (the inputs' points), derived (items), notes } of a file: its text, or for .npy an ArrayBuffer, by its
+  // extension (anything else is read as JSON).
+  function parse(name, data) {
     const ext = (name.match(/\.([^.]+)$/) || ["", ""])[1].toLowerCase();
+    if (ext === "npz") {
+      throw new CurveFileError(`${name}: the page opens .npy, not .npz: save the curves as one array with numpy.save("curves.npy", ` +
+        `curves), or read the .npz with the command line (curve-vae reconstruct ${name})`);
+    }
+    if (ext === "npy") return fromNpy(data, name);
+    const text = typeof data === "string" ? data : new TextDecoder().decode(data);
     if (ext === "dat" || ext === "txt") return fromDat(text, name);
-    if (ext === "svg") return { curves: fromSvg(text, name), notes: [] };
-    if (ext === "csv" || ext === "tsv") return { curves: fromCsv(text, name), notes: [] };
-    return { curves: fromJson(text, name), notes: [] };
+    if (ext === "svg") return fromSvg(text, name);
+    if (ext === "dxf") return fromDxf(text, name);
+    if (ext === "csv" || ext === "tsv") return fromCsv(text, name);
+    return fromJson(text, name);
   }
 
-  // A DXF (AutoCAD 2000, ASCII) of the items: {layer, points} as an LWPOLYLINE, {layer, spline} as a SPLINE with
-  // the spline's degree, knots and control points exactly. API coordinates: DXF's y points up too.
-  function dxf(items) {
-    const out = ["0", "SECTION", "2", "HEADER", "9", "$ACADVER", "1", "AC1015", "0", "ENDSEC",
-      "0", "SECTION", "2", "ENTITIES"];
+  // ---------------------------------------------------------------------------------------------- out
+
+  const item0 = (c) => item({ ...c, role: c.role || "input" });
+  const csvCell = (s) => (/[",\n]/.test(s) ? `"${s.replace(/"/g, '""')}"` : s);
+
+  function toCsv(drawing) {
+    const rows = ["curve,role,of,weights,index,x,y"];
+    for (const c of drawing.map(item0)) {
+      const key = [c.name ?? "", c.role, c.of ?? "", weightsText(c.weights)].map((s) => csvCell(String(s))).join(",");
+      c.points.forEach(([x, y], i) => rows.push(`${key},${i},${x},${y}`));
+    }
+    return rows.join("\n") + "\n";
+  }
+
+  // SVG as the command line writes it (curve_vae/curvefiles/svg.py): the curves' own coordinates in the viewBox, a
+  // point (x, y) at (x, -y), DISPLAY_PX on the longer side, a STROKE_PX stroke at any scale.
+  const DISPLAY_PX = 800, STROKE_PX = 1.5;
+  const COLOURS = { A: "#1f77b4", B: "#2ca02c", C: "#9467bd" }, INTERPOLANT = "#d62728", UNMARKED = "#1f77b4";
+  const STYLES = {
+    input: 'stroke-width="6" stroke-opacity="0.3" stroke-linecap="round" stroke-linejoin="round"',
+    reconstruction: 'stroke-dasharray="6 4"',
+    interpolant: "",
+  };
+  const DESC = "curve-vae: each path is a curve in its own coordinates, y up: its point (x, y) is drawn at (x, -y), SVG's y " +
+    "pointing down. A path's class is its role (input, reconstruction, interpolant); data-name names it, data-of " +
+    "names a reconstruction's input, data-weights an interpolant's weights by input.";
+  const fmt = (v) => String(Number(v.toPrecision(10)));
+  const esc = (s) => String(s).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;").replace(/"/g, "&quot;");
+  const rank = (c) => { const r = ROLES.indexOf(c.role); return r < 0 ? ROLES.length : r; };
+
+  function pathOf(c, id) {
+    const attrs = [`id="${id}"`, `class="${esc(c.role)}"`, `data-name="${esc(c.name ?? "")}"`];
+    if (c.of !== undefined) attrs.push(`data-of="${esc(c.of)}"`);
+    if (c.weights) attrs.push(`data-weights="${esc(weightsText(c.weights))}"`);
+    const colour = c.role === "interpolant" ? INTERPOLANT : COLOURS[c.of ?? c.name] || UNMARKED;
+    attrs.push(`stroke="${colour}"`, STYLES[c.role] ?? "", 'vector-effect="non-scaling-stroke"');
+    const d = "M" + c.points.map(([x, y]) => `${fmt(x)},${fmt(-y)}`).join(" L");
+    return `<path ${attrs.filter(Boolean).join(" ")} d="${d}"/>`;
+  }
+
+  function toSvg(drawing) {
+    const items = drawing.map(item0).map((c, i) => [c, i]).sort((a, b) => rank(a[0]) - rank(b[0]) || a[1] - b[1]);
+    const all = items.flatMap(([c]) => c.points);
+    const xs = all.map((p) => p[0]), ys = all.map((p) => p[1]);
+    const [lx, hx, ly, hy] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+    const pad = 0.05 * Math.max(hx - lx, hy - ly, 1e-9);
+    const [x0, y0, w, h] = [lx - pad, -hy - pad, hx - lx + 2 * pad, hy - ly + 2 * pad];
+    const px = DISPLAY_PX / Math.max(w, h);
+    return ['<?xml version="1.0" encoding="UTF-8"?>',
+      `<svg xmlns="http://www.w3.org/2000/svg" width="${Math.round(w * px)}px" height="${Math.max(Math.round(h * px), 1)}px" ` +
+      `viewBox="${fmt(x0)} ${fmt(y0)} ${fmt(w)} ${fmt(h)}">`,
+      `<desc>${DESC}</desc>`,
+      `<g fill="none" stroke-width="${STROKE_PX}">`,
+      ...items.map(([c, i]) => pathOf(c, `curve-${i}`)),
+      "</g>", "</svg>", ""].join("\n");
+  }
+
+  // The in-betweens (interpolants) as a sheet: each in its cell of a grid at one scale, its weights written under it.
+  function sheet(drawing) {
+    const items = drawing.map(item0).filter((c) => c.role === "interpolant");
+    if (!items.length) throw new CurveFileError("no in-between to put on a sheet");
+    const CELL = 200, LABEL = 28, cols = Math.ceil(Math.sqrt(items.length)), rows = Math.ceil(items.length / cols);
+    const boxes = items.map((c) => {
+      const xs = c.points.map((p) => p[0]), ys = c.points.map((p) => p[1]);
+      return [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+    });
+    const s = (0.85 * (CELL - LABEL)) / Math.max(...boxes.map(([a, b, c, d]) => Math.max(b - a, d - c)), 1e-9);
+    const words = (w) => Object.entries(w || {}).map(([k, v]) => `${Number(v.toFixed(3))} ${k}`).join(" + ");
+    const cells = items.map((c, i) => {
+      const [a, b, lo, hi] = boxes[i], [cx, cy] = [(i % cols + 0.5) * CELL, Math.floor(i / cols) * CELL + (CELL - LABEL) / 2];
+      return [`<g transform="translate(${fmt(cx)},${fmt(cy)}) scale(${fmt(s)}) translate(${fmt(-(a + b) / 2)},${fmt((lo + hi) / 2)})">`,
+        pathOf(c, `in-between-${i}`), "</g>",
+        `<text x="${fmt(cx)}" y="${fmt(Math.floor(i / cols) * CELL + CELL - LABEL / 2)}" text-anchor="middle" ` +
+        `font-family="sans-serif" font-size="13" fill="#333">${esc(words(c.weights) || c.name || "")}</text>`].join("\n");
+    });
+    return ['<?xml version="1.0" encoding="UTF-8"?>',
+      `<svg xmlns="http://www.w3.org/2000/svg" width="${cols * CELL}px" height="${rows * CELL}px" viewBox="0 0 ${cols * CELL} ${rows * CELL}">`,
+      `<desc>${DESC} A sheet of in-betweens: one a cell, all at one scale, each with its weights under it.</desc>`,
+      `<g fill="none" stroke-width="${STROKE_PX}">`, ...cells, "</g>", "</svg>", ""].join("\n");
+  }
+
+  // DXF (AutoCAD 2000, ASCII): a SPLINE per curve with a spline (its degree, knots and control points exactly), an
+  // LWPOLYLINE per other curve, each on the layer `<role>-<name>` (what AutoCAD refuses in a layer's name as "_")
+  // with its role, name, input and weights as XDATA strings of the application CURVE_VAE. DXF's y points up too.
+  const NOT_IN_LAYERS = /[<>/\\":;?*|,=`]/g;
+  const LAYER_COLOURS = { A: 5, B: 3, C: 6 };
+  const layerName = (c) => `${c.role}-${c.name ?? ""}`.replace(NOT_IN_LAYERS, "_");
+
+  function toDxf(drawing) {
+    const items = drawing.map(item0);
     let handle = 0x100;
-    const head = (type, layer, subclass) => out.push("0", type, "5", (handle++).toString(16).toUpperCase(),
-      "100", "AcDbEntity", "8", layer, "100", subclass);
-    for (const item of items) {
-      if (item.spline) {
-        const { control_points: ctrl, knots, degree } = item.spline;
-        head("SPLINE", item.layer, "AcDbSpline");
+    const next = () => (handle++).toString(16).toUpperCase();
+    const out = ["0", "SECTION", "2", "HEADER", "9", "$ACADVER", "1", "AC1015", "0", "ENDSEC", "0", "SECTION", "2", "TABLES"];
+    const table = (type, names, entry) => {
+      const own = next();
+      out.push("0", "TABLE", "2", type, "5", own, "330", "0", "100", "AcDbSymbolTable", "70", String(names.length));
+      for (const n of names) out.push("0", type, "5", next(), "330", own, "100", "AcDbSymbolTableRecord", ...entry(n));
+      out.push("0", "ENDTAB");
+    };
+    table("APPID", ["ACAD", APPID], (n) => ["100", "AcDbRegAppTableRecord", "2", n, "70", "0"]);
+    const layers = [...new Set(["0", ...items.map(layerName)])];
+    const colour = (layer) => {
+      const c = items.find((i) => layerName(i) === layer);
+      return !c ? 7 : c.role === "interpolant" ? 1 : LAYER_COLOURS[c.of ?? c.name] || 7;
+    };
+    table("LAYER", layers, (n) => ["100", "AcDbLayerTableRecord", "2", n, "70", "0", "62", String(colour(n)), "6", "Continuous"]);
+    out.push("0", "ENDSEC", "0", "SECTION", "2", "ENTITIES");
+    for (const c of items) {
+      const head = (type, subclass) => out.push("0", type, "5", next(), "100", "AcDbEntity", "8", layerName(c), "100", subclass);
+      if (c.spline) {
+        const { control_points: ctrl, knots, degree } = c.spline;
+        head("SPLINE", "AcDbSpline");
         out.push("210", "0", "220", "0", "230", "1", "70", "8", "71", String(degree), "72", String(knots.length),
           "73", String(ctrl.length), "74", "0");
         for (const k of knots) out.push("40", String(k));
         for (const [x, y] of ctrl) out.push("10", String(x), "20", String(y), "30", "0");
       } else {
-        head("LWPOLYLINE", item.layer, "AcDbPolyline");
-        out.push("90", String(item.points.length), "70", "0");
-        for (const [x, y] of item.points) out.push("10", String(x), "20", String(y));
+        head("LWPOLYLINE", "AcDbPolyline");
+        out.push("90", String(c.points.length), "70", "0");
+        for (const [x, y] of c.points) out.push("10", String(x), "20", String(y));
       }
+      out.push("1001", APPID, "1000", `role=${c.role}`, "1000", `name=${c.name ?? ""}`);
+      if (c.of !== undefined) out.push("1000", `of=${c.of}`);
+      if (c.weights) out.push("1000", `weights=${weightsText(c.weights)}`);
     }
     out.push("0", "ENDSEC", "0", "EOF");
     return out.join("\n") + "\n";
   }
 
-  window.curveFiles = { parse, dxf, CurveFileError };
+  // A drawing as a file's text: "json", "csv", "svg" or "dxf".
+  function write(format, drawing) {
+    if (format === "json") return JSON.stringify({ curves: drawing.map(item0) }, null, 1) + "\n";
+    if (format === "csv") return toCsv(drawing);
+    if (format === "svg") return toSvg(drawing);
+    if (format === "dxf") return toDxf(drawing);
+    throw new CurveFileError(`no writer for ${format}: json, csv, svg or dxf`);
+  }
+
+  window.curveFiles = { parse, write, sheet, CurveFileError, ROLES };
 })();
