@@ -59,6 +59,7 @@ class LiveServer:
         base = list(command) if command is not None else [sys.executable, "-m", "curve_vae.service.server"]
         self.cmd = [*base, "--port", str(self.port), "--log-level", log_level, *args]
         out = subprocess.PIPE if capture else None
+        self._printed: str | None = None
         self.proc = subprocess.Popen(
             self.cmd,
             cwd=cwd,
@@ -81,9 +82,17 @@ class LiveServer:
 
     def output(self) -> str:
         """What the server printed (a stopped server's, when captured)."""
-        if self.proc.stdout is None or self.proc.poll() is None:
-            return ""
-        return self.proc.stdout.read()
+        if self._printed is None and self.proc.stdout is not None and self.proc.poll() is not None:
+            self._collect()
+        return self._printed or ""
+
+    def _collect(self) -> None:
+        """Read what an exited server printed and close the pipe (an open one is a leaked file); a pipe that a
+        leftover child still holds is left to it."""
+        try:
+            self._printed = self.proc.communicate(timeout=5)[0] or ""
+        except subprocess.TimeoutExpired:
+            self._printed = ""
 
     def wait_ready(self, timeout: float = 60.0, *, listeners: int = 1) -> None:
         """Poll /ready until 200 and until `listeners` sockets listen on the port (each worker its own: a client
@@ -148,4 +157,6 @@ class LiveServer:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
+        if self._printed is None and self.proc.stdout is not None:
+            self._collect()
         return self.proc.returncode

@@ -1,0 +1,182 @@
+"""The page as a drawing tool, in Chromium against the shipped model: undo and redo (keys and buttons), the drawing kept
+across a reload and Clear starting afresh, a curve selected to delete or redraw, an in-between taken as a curve, the
+neighbours of a selected curve (POST /explore) taken in its place, the sweep animated and as a sheet, a legend, the
+vase never stale, and a layout that keeps the files and the vase in view."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import httpx
+import numpy as np
+import pytest
+
+from tests.e2e.test_page import arc, browser, draw, open_page, server, state  # noqa: F401 - fixtures
+
+pytestmark = pytest.mark.integration
+
+BOWL = arc(300, 380, 150, 1.05 * np.pi, 1.95 * np.pi)
+HUMP = arc(680, 330, 170, 0.1 * np.pi, 0.9 * np.pi)
+
+
+def _two(page) -> dict:
+    draw(page, BOWL)
+    draw(page, HUMP)
+    page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 5")
+    return state(page)
+
+
+def _settled(page, count: int) -> dict:
+    page.wait_for_function(
+        f"window.curveVae.curves.length === {count} && window.curveVae.recon.every((r) => r)"
+        f" && ({count} < 2 || (window.curveVae.result !== null && window.curveVae.strip.length === 5))"
+    )
+    return state(page)
+
+
+def _click_board(page, point: tuple[float, float]) -> None:
+    box = page.locator("#board").bounding_box()
+    page.mouse.click(box["x"] + point[0] / 1000 * box["width"], box["y"] + point[1] / 700 * box["height"])
+
+
+def _json_export(page) -> dict:
+    button = page.get_by_role("button", name="JSON", exact=True)
+    assert button.inner_text() == "JSON"
+    with page.expect_download() as download:
+        button.click()
+    return json.loads(Path(download.value.path()).read_text())
+
+
+def test_undo_redo_and_a_reload_keep_the_drawing(browser, server):  # noqa: F811
+    page, errors = open_page(browser, server.url + "/", width=1440, height=1000)
+    drawn = _two(page)["curves"]
+    inputs = [c for c in _json_export(page)["curves"] if c["role"] == "input"]
+    assert [c["name"] for c in inputs] == ["A", "B"]  # two strokes, two curves
+    np.testing.assert_allclose([c["points"] for c in inputs][1], drawn[1])
+
+    page.keyboard.press("Control+z")
+    assert len(_settled(page, 1)["curves"]) == 1 and page.locator("#redo").is_enabled()
+    page.keyboard.press("Control+Shift+z")
+    np.testing.assert_allclose(_settled(page, 2)["curves"], drawn)
+    page.keyboard.press("Control+z")
+    _settled(page, 1)
+    page.keyboard.press("Control+y")
+    _settled(page, 2)
+    page.click("#undo")
+    _settled(page, 1)
+    page.click("#redo")
+    _settled(page, 2)
+
+    page.locator("#weight").fill("0.25")
+    page.wait_for_function("window.curveVae.result.weights[1] === 0.25")
+    page.reload()
+    kept = _settled(page, 2)
+    np.testing.assert_allclose(kept["curves"], drawn)
+    assert kept["weight"] == 0.25 and page.locator("#weight-value").inner_text() == "0.25"
+
+    page.click("#clear")  # starts afresh: nothing kept for the next visit
+    assert state(page)["curves"] == [] and state(page)["vase"] is None
+    page.reload()
+    assert state(page)["curves"] == [] and "Draw a curve here" in page.locator("#board").text_content()
+    assert errors == []
+
+
+def test_a_selected_curve_is_deleted_or_redrawn(browser, server):  # noqa: F811
+    page, errors = open_page(browser, server.url + "/")
+    before = _two(page)["curves"]
+    _click_board(page, HUMP[12])  # a click on B selects it
+    page.wait_for_function("window.curveVae.selected === 1")
+    assert page.locator("path.input.selected").get_attribute("data-name") == "B"
+    page.keyboard.press("Delete")
+    after = _settled(page, 1)
+    np.testing.assert_allclose(after["curves"][0], before[0])  # A stays
+    page.keyboard.press("Control+z")
+    _settled(page, 2)
+    _click_board(page, BOWL[15])  # select A, then draw: the stroke redraws A, B stays
+    page.wait_for_function("window.curveVae.selected === 0")
+    draw(page, arc(300, 300, 120, 0.2 * np.pi, 0.8 * np.pi))
+    page.wait_for_function("window.curveVae.selected === null")
+    redrawn = _settled(page, 2)["curves"]
+    np.testing.assert_allclose(redrawn[1], before[1])
+    assert not np.allclose(np.array(redrawn[0]).mean(axis=0), np.array(before[0]).mean(axis=0), atol=10)
+    _click_board(page, (950, 50))  # a click on nothing selects nothing
+    assert state(page)["selected"] is None and page.locator("#board-error").inner_text() == ""
+    assert errors == []
+
+
+def test_an_in_between_is_taken_as_a_curve_with_its_weights_shown(browser, server):  # noqa: F811
+    page, errors = open_page(browser, server.url + "/")
+    s = _two(page)
+    thumbs = page.locator("#strip .thumb")
+    assert [thumbs.nth(i).locator(".caption").inner_text() for i in range(5)] == [
+        "A1",
+        "A.75 B.25",
+        "A.5 B.5",
+        "A.25 B.75",
+        "B1",
+    ]
+    thumbs.nth(2).click()  # the middle in-between: the newest curve now, the oldest (A) gone
+    taken = _settled(page, 2)
+    np.testing.assert_allclose(taken["curves"][0], s["curves"][1])
+    np.testing.assert_allclose(taken["curves"][1], s["strip"][2])
+    page.keyboard.press("Control+z")
+    np.testing.assert_allclose(_settled(page, 2)["curves"], s["curves"])
+    # the sweep on the page: one path whose outline runs through the five in-betweens and back
+    values = page.locator("#sweep-preview animate").get_attribute("values")
+    assert values is not None and len(values.split(";")) == 9
+    with page.expect_download() as download:
+        page.click("#download-sheet")
+    sheet = Path(download.value.path()).read_text()
+    assert sheet.count('class="interpolant"') == 5 and "0.75 A + 0.25 B" in sheet
+    assert errors == []
+
+
+def test_the_neighbours_of_a_selected_curve_are_the_services_and_one_is_taken(browser, server):  # noqa: F811
+    page, errors = open_page(browser, server.url + "/")
+    s = _two(page)
+    assert page.locator("#around").is_hidden()
+    _click_board(page, BOWL[15])
+    page.wait_for_function("window.curveVae.neighbours !== null && window.curveVae.neighbours.of === 0")
+    assert page.locator("#around").is_visible() and page.locator("#around-title").inner_text() == "Around A"
+    grid = page.locator("#neighbours .thumb")
+    assert grid.count() == 9 and grid.nth(4).locator(".caption").inner_text() == "itself"
+    body = {"curves": [s["curves"][0]], "steps": 3, "directions": 2, "n_points": 60, "refine": 0}
+    answer = httpx.post(server.url + "/explore", json=body, timeout=30).json()
+    np.testing.assert_allclose(state(page)["neighbours"]["curves"], answer["curves"], atol=1e-9)
+    grid.nth(8).click()  # +1σ along both directions: in A's place, A still selected, its grid moved on
+    page.wait_for_function(
+        "window.curveVae.recon.every((r) => r) && window.curveVae.neighbours && window.curveVae.selected === 0"
+    )
+    taken = state(page)
+    np.testing.assert_allclose(taken["curves"][0], answer["curves"][8])
+    np.testing.assert_allclose(taken["curves"][1], s["curves"][1])
+    page.keyboard.press("Escape")
+    assert page.locator("#around").is_hidden()
+    assert errors == []
+
+
+def test_a_legend_says_what_is_shown_and_the_vase_is_never_stale(browser, server):  # noqa: F811
+    page, errors = open_page(browser, server.url + "/", width=1440, height=900)
+    legend = page.locator("[aria-label=legend]").inner_text()
+    assert "reconstruction" in legend and "mix" in legend and "control polygon" in legend
+    assert page.locator("#vase-view").is_hidden()  # no empty box before a vase
+    _two(page)
+    labels = page.locator("#board text.label")
+    assert labels.all_text_contents() == ["A", "B", "mix"]
+    on_board = [c for c in state(page)["curves"] + [state(page)["result"]["points"]]]
+    for i in range(3):  # each name sits off every curve, not on one
+        x, y = (float(labels.nth(i).get_attribute(k)) for k in ("x", "y"))
+        gap = min(np.hypot(np.array(c)[:, 0] - x, 700 - np.array(c)[:, 1] - y).min() for c in on_board)
+        assert gap >= 12, (labels.nth(i).text_content(), gap)
+    page.click("#vase")
+    page.wait_for_function("window.curveVae.vase !== null")
+    assert page.locator("#vase-view").is_visible()
+    for selector in ("#download-json", "#download-dxf", "#vase-view", "#download-stl"):  # in view at 1440×900
+        box = page.locator(selector).bounding_box()
+        assert box is not None and box["y"] + box["height"] <= 900, (selector, box)
+    assert page.locator("#curl").is_hidden()  # the curl command on demand
+    page.check("#mode-triplet")  # the vase was the pair's mix: gone with it
+    page.wait_for_function("window.curveVae.vase === null")
+    assert page.locator("#vase-view").is_hidden()
+    assert errors == []
