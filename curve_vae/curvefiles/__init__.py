@@ -5,6 +5,7 @@ and DXF in; JSON, CSV, NPY, SVG and DXF out (`writing.py`). A file with no curve
 from __future__ import annotations
 
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +39,7 @@ def _arrays(path: Path, name: str) -> list[np.ndarray]:
     """An .npy array (n, 2) or (N, n, 2); of an .npz, its `curves` or else every array of that shape, by name."""
     try:
         loaded = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as e:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as e:  # a .npy that starts like a zip is opened as one
         raise CurveFileError(f"{name}: not a numpy file ({e})") from None
     if isinstance(loaded, np.ndarray):
         arrays = [("", loaded)]

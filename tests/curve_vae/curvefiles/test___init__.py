@@ -67,6 +67,8 @@ def test_an_npz_without_curves_gives_every_array_of_their_shape_by_name(tmp_path
                      r"c\.npy: an array of shape \(5, 3\); curves are \(n, 2\) or \(N, n, 2\)", id="npy-shape"),
         pytest.param("c.npy", lambda p: p.write_text("[[0, 0]]"), r"c\.npy: not a numpy file", id="npy-text"),
         pytest.param("c.npz", lambda p: p.write_bytes(b"PK but not a zip"), r"c\.npz: not a numpy file", id="npz-junk"),
+        pytest.param("c.npy", lambda p: p.write_bytes(b"PK\x03\x04 a broken zip"), r"c\.npy: not a numpy file",
+                     id="zip-junk"),
         pytest.param("gone.json", None, r"gone\.json: no such file", id="missing"),
         pytest.param("drawings", lambda p: p.mkdir(), r"drawings: a folder; this command reads one curve file",
                      id="folder"),
