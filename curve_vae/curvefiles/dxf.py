@@ -15,6 +15,7 @@ import ezdxf
 import numpy as np
 from ezdxf import path as dxfpath
 from ezdxf.disassemble import recursive_decompose
+from ezdxf.entities import DXFGraphic
 
 from curve_vae.curvefiles.common import CurveFileError, drawn_curves
 from curve_vae.curvefiles.roles import ROLES, Found, the_inputs
@@ -101,7 +102,7 @@ def write_dxf(
     its role's layer with its XDATA."""
     doc = ezdxf.new("R2010")
     msp = doc.modelspace()
-    entities = [
+    entities: list[DXFGraphic] = [
         msp.add_open_spline(
             [(float(x), float(y), 0.0) for x, y in s["control_points"]], degree=int(s["degree"]), knots=s["knots"]
         )

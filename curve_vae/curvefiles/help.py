@@ -9,7 +9,7 @@ OUTPUT_SUFFIXES = (".json", ".csv", ".npy", ".svg", ".dxf")
 
 INPUT_HELP = (
     "curves: .json (point arrays, {curves: …}, the page's export), .csv/.tsv, .npy/.npz, airfoil .dat, .svg, .dxf, "
-    "or - (JSON on stdin)"
+    "or - (JSON on stdin); of a file that marks roles (the page's exports), its inputs"
 )
 OUTPUT_HELP = (
     "output: .json (as the endpoint answers), .csv (points), .npy (points, float32), .svg (a path per curve, "
