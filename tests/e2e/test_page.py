@@ -172,20 +172,25 @@ def _check_triplet(page: Page, url: str) -> dict:
 
 
 def _check_downloads(page: Page, s: dict, url: str) -> None:
-    """The JSON, CSV and SVG downloads hold the three curves and the mix; the curl command is the request's."""
+    """The JSON, CSV and SVG downloads hold the three curves, their reconstructions, the mix and the in-betweens, each
+    named with its role; the curl command is the request's."""
     with page.expect_download() as download:
         page.click("#download-json")
-    saved = json.loads(Path(download.value.path()).read_text())
-    assert [c["name"] for c in saved["curves"]] == ["A", "B", "C", "mix"]
-    np.testing.assert_allclose(saved["curves"][3]["points"], s["result"]["points"])
+    saved = {c["name"]: c for c in json.loads(Path(download.value.path()).read_text())["curves"]}
+    roles = [c["role"] for c in saved.values()]
+    assert [n for n, c in saved.items() if c["role"] == "input"] == ["A", "B", "C"]
+    assert roles.count("reconstruction") == 3 and roles.count("interpolant") == 1 + 10  # the mix, the grid
+    np.testing.assert_allclose(saved["mix"]["points"], s["result"]["points"])
+    assert saved["A reconstructed"]["of"] == "A" and saved["1 A"]["weights"] == {"A": 1, "B": 0, "C": 0}
     with page.expect_download() as download:
         page.click("#download-csv")
     rows = Path(download.value.path()).read_text().splitlines()
-    assert rows[0] == "curve,role,index,x,y" and len(rows) == 1 + sum(len(c["points"]) for c in saved["curves"])
+    assert rows[0].startswith("curve,role,") and len(rows) == 1 + sum(len(c["points"]) for c in saved.values())
     with page.expect_download() as download:
         page.click("#download-svg")
     assert "<path" in Path(download.value.path()).read_text()
 
+    page.click("#curl-box summary")  # the curl command on demand
     page.click("#copy-curl")
     curl = page.locator("#curl").inner_text()
     assert curl.startswith(f"curl -s {url}/interpolate")
@@ -207,7 +212,7 @@ def test_errors_appear_next_to_their_cause(browser, server_factory, model_dir):
     api = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--max-curves", "1")
     api.wait_ready()
     page, errors = open_page(browser, api.url + "/")
-    draw(page, [(100, 100), (101, 100), (102, 101)])  # a dab, not a stroke
+    draw(page, [(100, 100), (112, 100)])  # a dab of three points, not a stroke (a click of one or two selects)
     assert "Too short" in page.locator("#board-error").inner_text()
     page.click("#sample")  # two curves, but this server takes one per request
     page.wait_for_function("document.getElementById('board-error').textContent.includes('at most 1')")
