@@ -111,24 +111,25 @@ function renderMetrics() {
   dl.replaceChildren();
   const rows = [];
   // how close each reconstruction came, relative to its curve's size (the answer's closeness)
+  // [key, shown name, value]: each curve's row says which curve it is about
   state.recon.forEach((r, i) => {
     if (!r || !r.closeness) return;
     const c = r.closeness, pct = (v) => (v === null ? "–" : `${(100 * v).toFixed(2)}%`);
-    rows.push([`${NAMES[i]} reconstructed within`,
+    rows.push([`${NAMES[i]} reconstructed within`, `${NAMES[i]} within`,
       `RMS ${pct(c.rms)}, worst ${pct(c.max)} of its size${r.repaired ? " (untangled)" : ""}`]);
   });
   const m = state.result && state.result.metrics;
   if (m) {
+    const ctrl = state.result.spline ? state.result.spline.control_points.length : "–";
     rows.push(
-      ["mix roughness", `${m.smoothness.roughness.toFixed(3)}°`],
-      ["mix sharpest turn", `${m.smoothness.max_turn.toFixed(1)}°`],
-      ["mix self-intersects", m.self_intersects ? "yes" : "no"],
-      ["mix control points", state.result.spline ? state.result.spline.control_points.length : "–"],
+      ["mix roughness", "mix roughness", `${m.smoothness.roughness.toFixed(3)}°`],
+      ["mix sharpest turn", "sharpest turn", `${m.smoothness.max_turn.toFixed(1)}°`],
+      ["mix shape", "shape", `${m.self_intersects ? "crosses itself" : "no self-crossing"}, ${ctrl} control points`],
     );
   }
-  for (const [k, v] of rows) {
-    const dt = document.createElement("dt"); dt.textContent = k; dl.appendChild(dt);
-    const dd = document.createElement("dd"); dd.textContent = v; dd.dataset.metric = k; dl.appendChild(dd);
+  for (const [key, name, value] of rows) {
+    const dt = document.createElement("dt"); dt.textContent = name; dl.appendChild(dt);
+    const dd = document.createElement("dd"); dd.textContent = value; dd.dataset.metric = key; dl.appendChild(dd);
   }
 }
 

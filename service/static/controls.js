@@ -84,7 +84,7 @@ function renderTriangle() {
   svg.replaceChildren();
   el("path", { d: pathOf(TRI) + " Z", fill: "#f4f6fb", stroke: "#889" }, svg);
   TRI.forEach(([x, y], i) => {
-    el("text", { x: x + (i === 1 ? -10 : i === 2 ? 2 : 6), y: y + (i ? 12 : 2), fill: COLORS[i], "font-size": 14 }, svg)
+    el("text", { x: x + [8, -12, -8][i], y: y + (i ? 15 : 8), fill: COLORS[i], "font-size": 22, "font-weight": 600 }, svg)
       .textContent = NAMES[i];
   });
   const [x, y] = [0, 1].map((k) => state.bary.reduce((s, w, i) => s + w * TRI[i][k], 0));

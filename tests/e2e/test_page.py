@@ -150,6 +150,7 @@ def _check_pair(page: Page, url: str) -> None:
     page.check("#show-ctrl")
     assert page.locator(".control-polygon").count() == 3  # two reconstructions and the mix
     assert len(s["result"]["spline"]["control_points"]) == 31
+    assert page.locator("dd[data-metric='mix shape']").inner_text() == "no self-crossing, 31 control points"
 
 
 def _check_triplet(page: Page, url: str) -> dict:

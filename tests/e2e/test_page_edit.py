@@ -179,4 +179,11 @@ def test_a_legend_says_what_is_shown_and_the_vase_is_never_stale(browser, server
     page.check("#mode-triplet")  # the vase was the pair's mix: gone with it
     page.wait_for_function("window.curveVae.vase === null")
     assert page.locator("#vase-view").is_hidden()
+    draw(page, arc(480, 560, 100, 0.1 * np.pi, 0.9 * np.pi))  # a third curve: the triangle and its grid
+    page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 10")
+    page.click("#vase")
+    page.wait_for_function("window.curveVae.vase !== null")
+    for selector in ("#download-sheet", "#vase-view", "#strip .thumb >> nth=9"):  # still in view with the grid
+        box = page.locator(selector).bounding_box()
+        assert box is not None and box["y"] + box["height"] <= 900, (selector, box)
     assert errors == []

@@ -1,0 +1,82 @@
+"""docs/figures/page.png: the page as it is, in Chromium at 1440×900 against `curve-vae serve` on the shipped model.
+
+Three curves drawn in triplet mode, the mix near B, curve A selected with its neighbours, the vase revolved.
+Needs Debian's chromium (`apt-get install chromium`) and the test extra (Playwright).
+
+    .venv/bin/python scripts/page_figure.py                # writes docs/figures/page.png
+    .venv/bin/python scripts/page_figure.py --out /tmp/p.png
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+from playwright.sync_api import Page, sync_playwright
+
+from curve_vae.files import atomic_path
+from curve_vae.service.live import LiveServer
+
+ROOT = Path(__file__).resolve().parents[1]
+ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking"]
+
+
+def arc(cx: float, cy: float, r: float, a0: float, a1: float, n: int = 30) -> list[tuple[float, float]]:
+    t = np.linspace(a0, a1, n)
+    return list(zip(cx + r * np.cos(t), cy + r * np.sin(t)))
+
+
+def draw(page: Page, points: list[tuple[float, float]]) -> None:
+    """A stroke, points in board units (1000 × 700)."""
+    box = page.locator("#board").bounding_box()
+    assert box is not None
+    at = [(box["x"] + x / 1000 * box["width"], box["y"] + y / 700 * box["height"]) for x, y in points]
+    page.mouse.move(*at[0])
+    page.mouse.down()
+    for p in at[1:]:
+        page.mouse.move(*p, steps=2)
+    page.mouse.up()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=Path, default=ROOT / "docs" / "figures" / "page.png")
+    args = parser.parse_args()
+    chromium = shutil.which("chromium") or "/usr/bin/chromium"
+    with LiveServer("--model-dir", str(ROOT / "models"), "--providers", "cpu", "--workers", "1", cwd=ROOT) as server:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=chromium, args=ARGS)
+            page = browser.new_context(viewport={"width": 1440, "height": 900}).new_page()
+            page.goto(server.url + "/")
+            page.check("#mode-triplet")
+            draw(page, arc(250, 420, 160, 1.05 * np.pi, 1.95 * np.pi))  # a bowl
+            t = np.linspace(0, 1, 40)
+            draw(page, list(zip(560 + 330 * t, 330 - 110 * np.sin(np.pi * t) + 60 * t)))  # a wave
+            draw(page, arc(480, 520, 120, 0.05 * np.pi, 0.95 * np.pi))  # a hump
+            page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 10")
+            box = page.locator("#triangle").bounding_box()
+            assert box is not None
+            page.mouse.click(box["x"] + 80 / 220 * box["width"], box["y"] + 130 / 200 * box["height"])
+            page.wait_for_timeout(500)
+            page.click("#vase")
+            page.wait_for_function("window.curveVae.vase !== null")
+            page.wait_for_function("window.curveVae.recon.every((r) => r)")
+            page.check("#show-ctrl")
+            bowl = arc(250, 420, 160, 1.05 * np.pi, 1.95 * np.pi)[15]
+            board = page.locator("#board").bounding_box()
+            assert board is not None
+            page.mouse.click(board["x"] + bowl[0] / 1000 * board["width"], board["y"] + bowl[1] / 700 * board["height"])
+            page.wait_for_function("window.curveVae.neighbours !== null")
+            page.mouse.move(0, 0)
+            with atomic_path(args.out) as tmp:
+                page.screenshot(path=str(tmp) + ".png")
+                os.replace(str(tmp) + ".png", tmp)
+            browser.close()
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
