@@ -22,9 +22,10 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
 from curve_vae.errors import InvalidInput
-from curve_vae.geometry.bspline import basis_and_slope
+from curve_vae.geometry.bspline import clamped_uniform_knots
 from curve_vae.geometry.frame import CLOSED, arc_fractions
 from curve_vae.geometry.metrics import turning_angles
+from curve_vae.geometry.natural_kernel import fit_start, lm_steps
 
 #: Control points of the spline whose parameters `natural_params` finds: the paper's curves have 10.
 NATURAL_CTRL = 10
@@ -197,61 +198,30 @@ def _keeps_arc(pts: np.ndarray) -> bool:
 
 class _BatchFit:
     """K Levenberg–Marquardt fits at once, one per row of polylines (K, n, 2) and starting parameters (K, n): each
-    a clamped uniform cubic B-spline (n_ctrl control points) and its points' parameters."""
+    a clamped uniform cubic B-spline (n_ctrl control points) and its points' parameters. The steps run compiled,
+    without the GIL (geometry.natural_kernel); each step, per row:
+
+    the parameters' block of the normal equations is diagonal (one tangent per point, |t|²(1 + λ)), so it is
+    eliminated and the control points' 2·n_ctrl system is its Schur complement, Bᵀ·diag(w)·B block by block with the
+    damping λ·ΣB² on its diagonal; the parameters follow from the control points' step, kept within [0, 1] and never
+    falling, the ends at 0 and 1; a step is kept only where it brings the spline closer (λ ÷ 3), else λ × 4, and a
+    row whose λ passes 1e8 has stopped."""
 
     def __init__(self, pts: np.ndarray, u: np.ndarray, n_ctrl: int) -> None:
-        self.pts, self.n_ctrl = pts, n_ctrl
-        self.u = u.copy()
-        self.basis, self.slope = self._basis(self.u)
-        btb = self.basis.transpose(0, 2, 1) @ self.basis + 1e-12 * np.eye(n_ctrl)
-        self.ctrl = np.linalg.solve(btb, self.basis.transpose(0, 2, 1) @ pts)  # (K, n_ctrl, 2): least squares
-        self.r = self.basis @ self.ctrl - pts
-        self.cost = (self.r**2).sum((1, 2))
+        self.knots = clamped_uniform_knots(n_ctrl)
+        self.pts = np.ascontiguousarray(pts, np.float64)
+        self.u = np.array(u, np.float64)
+        self.ctrl = np.zeros((len(u), n_ctrl, 2))
+        self.cost = np.zeros(len(u))
+        fit_start(self.knots, self.pts, self.u, self.ctrl, self.cost)  # least squares at the starting parameters
         self.damping = np.full(len(u), 1e-3)
 
-    def _basis(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        b, s = basis_and_slope(u.ravel(), self.n_ctrl)
-        return b.reshape(*u.shape, self.n_ctrl), s.reshape(*u.shape, self.n_ctrl)
-
     def keep(self, rows: list[int]) -> None:
-        for name in ("pts", "u", "basis", "slope", "ctrl", "r", "cost", "damping"):
-            setattr(self, name, getattr(self, name)[rows])
+        for name in ("pts", "u", "ctrl", "cost", "damping"):
+            setattr(self, name, np.ascontiguousarray(getattr(self, name)[rows]))
 
     def run(self, steps: int) -> None:
-        k, nc = len(self.u), self.n_ctrl
-        eye = np.eye(nc)
-        for _ in range(steps):
-            live = self.damping <= 1e8
-            if not live.any():
-                return
-            b, r, lam = self.basis, self.r, self.damping
-            tangent = self.slope @ self.ctrl
-            tangent[:, [0, -1]] = 0.0  # the ends stay where they are
-            uu = (tangent**2).sum(-1) * (1 + lam[:, None]) + 1e-12  # the parameters' block: diagonal, one per point
-            # the control points' system after eliminating the parameters (the Schur complement), block by block:
-            # Bᵀ·diag(w)·B for x with x, y with y and x with y, the damping on the x and y blocks' diagonals
-            tx, ty = tangent[..., 0], tangent[..., 1]
-            bt = b.transpose(0, 2, 1)
-            damp = (lam[:, None] * (b * b).sum(1))[:, :, None] * eye
-            xx = bt @ (b * (1.0 - tx * tx / uu)[..., None]) + damp
-            yy = bt @ (b * (1.0 - ty * ty / uu)[..., None]) + damp
-            xy = bt @ (b * (-tx * ty / uu)[..., None])
-            schur = np.block([[xx, xy], [xy, yy]]) + 1e-14 * np.eye(2 * nc)
-            gu = (tangent * r).sum(-1)
-            rhs = (bt @ (r - tangent * (gu / uu)[..., None])).transpose(0, 2, 1).reshape(k, 2 * nc)
-            try:
-                dc = np.linalg.solve(schur, rhs[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                return
-            dctrl = dc.reshape(k, 2, nc).transpose(0, 2, 1)  # (k, nc, 2)
-            du = (gu - ((b @ dctrl) * tangent).sum(-1)) / uu
-            u = np.maximum.accumulate(np.clip(self.u - du, 0.0, 1.0), axis=1)
-            u[:, 0], u[:, -1] = 0.0, 1.0
-            ctrl = self.ctrl - dctrl
-            basis, slope = self._basis(u)
-            res = basis @ ctrl - self.pts
-            cost = (res**2).sum((1, 2))
-            ok = live & (cost < self.cost)  # a step is kept only where it brings its spline closer
-            self.u[ok], self.ctrl[ok], self.basis[ok], self.slope[ok] = u[ok], ctrl[ok], basis[ok], slope[ok]
-            self.r[ok], self.cost[ok] = res[ok], cost[ok]
-            self.damping = np.where(ok, np.maximum(lam / 3, 1e-9), lam * 4)
+        try:
+            lm_steps(self.knots, self.pts, self.u, self.ctrl, self.cost, self.damping, steps)
+        except np.linalg.LinAlgError:  # a singular step: every row keeps its last accepted one
+            return

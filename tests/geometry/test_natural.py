@@ -216,3 +216,19 @@ def test_with_arc_reading_loops_and_corners_a_smooth_open_curve_gets_the_closest
             np.testing.assert_array_equal(r, s)
     with pytest.raises(ValueError, match="arc_reading"):
         natural_readings_of(curves, guess=guess, arc_reading="never")
+
+
+def test_the_compiled_fits_basis_is_scipys_at_every_parameter_knots_and_ends_included():
+    from curve_vae.geometry.bspline import basis_and_slope, clamped_uniform_knots
+    from curve_vae.geometry.natural_kernel import weights_at
+
+    for n_ctrl in (4, 7, 10, 31):
+        t = clamped_uniform_knots(n_ctrl)
+        u = np.concatenate([np.random.default_rng(n_ctrl).random(500), t, [0.0, 1.0, 1e-17, 1 - 1e-16]])
+        spans, b, s = weights_at(t, u, n_ctrl)
+        dense_b, dense_s = np.zeros((len(u), n_ctrl)), np.zeros((len(u), n_ctrl))
+        for i, l in enumerate(spans):
+            dense_b[i, l - 3 : l + 1], dense_s[i, l - 3 : l + 1] = b[i], s[i]
+        basis, slope = basis_and_slope(u, n_ctrl)
+        np.testing.assert_allclose(dense_b, basis, atol=1e-13)
+        np.testing.assert_allclose(dense_s, slope, atol=1e-10 * n_ctrl)

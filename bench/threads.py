@@ -1,0 +1,69 @@
+"""How a process's threads share its cores: requests a second from one thread and from two, each thread reading its own
+requests through one runtime (no cache, one intra-op thread per graph run, numpy's BLAS on one thread, as the
+service runs them). Two threads reach 2× one only where the reading releases the GIL.
+
+    .venv/bin/python -m bench.threads                      # single-curve default requests
+    .venv/bin/python -m bench.threads --curves 128 --seconds 10
+    .venv/bin/python -m bench.threads --reading one-pass
+"""
+
+from __future__ import annotations
+
+import argparse
+import threading
+import time
+from pathlib import Path
+
+from bench import ceiling
+from curve_vae.inference.cpus import limit_blas_threads
+from curve_vae.inference.reading import Reading
+from curve_vae.inference.runtime import CurveRuntime
+from curve_vae.inference.sessions import SessionConfig
+
+ROOT = Path(__file__).resolve().parents[1]
+READINGS = {"default": Reading(), "one-pass": Reading(pose="canonical", spacing="parameter")}
+
+
+def rate(rt: CurveRuntime, requests: list[list], reading: Reading, threads: int, seconds: float) -> float:
+    """Requests a second that `threads` threads answer together, each going through `requests` in turn."""
+    done = [0] * threads
+    stop = time.perf_counter() + seconds
+
+    def work(k: int) -> None:
+        i = k
+        while time.perf_counter() < stop:
+            rt.reconstruct(requests[i % len(requests)], reading)
+            done[k] += 1
+            i += threads
+
+    pool = [threading.Thread(target=work, args=(k,)) for k in range(threads)]
+    t0 = time.perf_counter()
+    for t in pool:
+        t.start()
+    for t in pool:
+        t.join()
+    return sum(done) / (time.perf_counter() - t0)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--reading", choices=READINGS, default="default")
+    p.add_argument("--curves", type=int, default=1, help="curves a request")
+    p.add_argument("--seconds", type=float, default=8.0)
+    p.add_argument("--model-dir", type=Path, default=ROOT / "models")
+    args = p.parse_args()
+    limit_blas_threads(1)
+    rt = CurveRuntime.load(args.model_dir, sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
+    plane = ceiling.curves(64 * args.curves, seed=3)
+    callers = list(ceiling.callers_curves(plane, seed=3))
+    requests = [callers[i : i + args.curves] for i in range(0, len(callers), args.curves)]
+    reading = READINGS[args.reading]
+    rt.reconstruct(requests[0], reading)  # warm: graphs, compiled code
+    one = rate(rt, requests, reading, 1, args.seconds)
+    two = rate(rt, requests, reading, 2, args.seconds)
+    unit = "requests" if args.curves == 1 else f"{args.curves}-curve requests"
+    print(f"{args.reading} reading, {unit} a second: one thread {one:.1f}, two threads {two:.1f} ({two / one:.2f}×)")
+
+
+if __name__ == "__main__":
+    main()

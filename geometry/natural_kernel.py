@@ -1,0 +1,248 @@
+"""The natural-spacing fit's Levenberg–Marquardt (geometry.natural) as compiled code that releases the GIL (numba,
+`nogil=True`): the same steps as the batched numpy fit, row by row, with each point's basis as its knot span and the
+four cubic weights there (a dense basis row is 10 numbers of which 6 are zero), so a step's normal equations are
+built from 4×4 blocks. Two threads each fitting their own request's curves run on two cores at once.
+
+Compiled on first use (about 10 s) and cached beside this file, or in NUMBA_CACHE_DIR (the Docker images set it to
+/tmp/numba-cache); where no cache can be written, each process compiles afresh.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numba as nb
+import numpy as np
+
+
+def _compiled(**options: Any) -> Callable[[Callable[..., Any]], Any]:
+    """numba.njit without the GIL, cached where a cache can be written (numba refuses `cache=True` where none can)."""
+
+    def compile_(fn: Callable[..., Any]) -> Any:
+        try:
+            return nb.njit(nogil=True, cache=True, **options)(fn)
+        except RuntimeError:  # "cannot cache function ...: no locator available"
+            return nb.njit(nogil=True, **options)(fn)
+
+    return compile_
+
+
+@_compiled()
+def _span(t: np.ndarray, u: float, nc: int) -> int:
+    """The knot span l (3 ≤ l ≤ nc − 1) with t[l] ≤ u < t[l + 1]; u = 1 in the last."""
+    lo, hi = 3, nc - 1
+    if u >= t[nc]:
+        return hi
+    while lo < hi:  # the last l with t[l] <= u
+        mid = (lo + hi + 1) // 2
+        if t[mid] <= u:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+@_compiled(inline="always")
+def _weights(t: np.ndarray, u: float, sp: int, b: np.ndarray, s: np.ndarray) -> None:
+    """The four cubic basis values at u in span sp (control points sp − 3 … sp) into b, their slopes in u into s
+    (Cox–de Boor written out for degree 3; the slopes from the quadratic basis)."""
+    l1, l2, l3 = u - t[sp], u - t[sp - 1], u - t[sp - 2]  # left[1..3]
+    r1, r2, r3 = t[sp + 1] - u, t[sp + 2] - u, t[sp + 3] - u  # right[1..3]
+    # degree 1
+    tmp = 1.0 / (r1 + l1)
+    a0 = r1 * tmp
+    a1 = l1 * tmp
+    # degree 2
+    tmp = a0 / (r1 + l2)
+    q0 = r1 * tmp
+    saved = l2 * tmp
+    tmp = a1 / (r2 + l1)
+    q1 = saved + r2 * tmp
+    q2 = l1 * tmp
+    # degree 3
+    tmp = q0 / (r1 + l3)
+    b[0] = r1 * tmp
+    saved = l3 * tmp
+    tmp = q1 / (r2 + l2)
+    b[1] = saved + r2 * tmp
+    saved = l2 * tmp
+    tmp = q2 / (r3 + l1)
+    b[2] = saved + r3 * tmp
+    b[3] = l1 * tmp
+    # N'_{i,3} = 3 N_{i,2} / (t[i+3] − t[i]) − 3 N_{i+1,2} / (t[i+4] − t[i+1]), i = sp − 3 + a; N_{sp−3,2} = 0
+    d1 = t[sp + 1] - t[sp - 2]
+    d2 = t[sp + 2] - t[sp - 1]
+    d3 = t[sp + 3] - t[sp]
+    g0 = 3.0 * q0 / d1 if d1 > 0 else 0.0
+    g1 = 3.0 * q1 / d2 if d2 > 0 else 0.0
+    g2 = 3.0 * q2 / d3 if d3 > 0 else 0.0
+    s[0] = -g0
+    s[1] = g0 - g1
+    s[2] = g1 - g2
+    s[3] = g2
+
+
+@_compiled()
+def _evaluate(t, u, ctrl, pts, spans, b, s, r) -> float:
+    """Each point's span, weights and slopes at u, its residual r = spline(u) − point; the cost Σ r²."""
+    nc = len(ctrl)
+    cost = 0.0
+    for i in range(len(u)):
+        ui = min(max(u[i], 0.0), 1.0)
+        spans[i] = _span(t, ui, nc)
+        _weights(t, ui, spans[i], b[i], s[i])
+        x = 0.0
+        y = 0.0
+        for a in range(4):
+            x += b[i, a] * ctrl[spans[i] - 3 + a, 0]
+            y += b[i, a] * ctrl[spans[i] - 3 + a, 1]
+        r[i, 0] = x - pts[i, 0]
+        r[i, 1] = y - pts[i, 1]
+        cost += r[i, 0] ** 2 + r[i, 1] ** 2
+    return cost
+
+
+@_compiled()
+def fit_start(t: np.ndarray, pts: np.ndarray, u: np.ndarray, ctrl: np.ndarray, cost: np.ndarray) -> None:
+    """Each row's least-squares control points (K, nc, 2) at its parameters u (K, n) and their cost (K,)."""
+    k_rows, n = u.shape
+    nc = ctrl.shape[1]
+    spans = np.empty(n, np.int64)
+    b = np.empty((n, 4))
+    s = np.empty((n, 4))
+    r = np.empty((n, 2))
+    for k in range(k_rows):
+        btb = 1e-12 * np.eye(nc)
+        rhs = np.zeros((nc, 2))
+        for i in range(n):
+            spans[i] = _span(t, min(max(u[k, i], 0.0), 1.0), nc)
+            _weights(t, min(max(u[k, i], 0.0), 1.0), spans[i], b[i], s[i])
+            o = spans[i] - 3
+            for a in range(4):
+                rhs[o + a, 0] += b[i, a] * pts[k, i, 0]
+                rhs[o + a, 1] += b[i, a] * pts[k, i, 1]
+                for c in range(4):
+                    btb[o + a, o + c] += b[i, a] * b[i, c]
+        ctrl[k] = np.linalg.solve(btb, rhs)
+        cost[k] = _evaluate(t, u[k], ctrl[k], pts[k], spans, b, s, r)
+
+
+@_compiled()
+def lm_steps(
+    t: np.ndarray,
+    pts: np.ndarray,
+    u: np.ndarray,
+    ctrl: np.ndarray,
+    cost: np.ndarray,
+    damping: np.ndarray,
+    steps: int,
+) -> None:
+    """`steps` Levenberg–Marquardt steps on every row, in place: parameters u (K, n), control points (K, nc, 2),
+    cost (K,), damping (K,). A row whose damping passed 1e8 has stopped; a step is kept only where it brings the
+    spline closer (geometry.natural._BatchFit.run says each term)."""
+    k_rows, n = u.shape
+    nc = ctrl.shape[1]
+    spans = np.empty(n, np.int64)
+    b = np.empty((n, 4))
+    s = np.empty((n, 4))
+    r = np.empty((n, 2))
+    spans2 = np.empty(n, np.int64)
+    b2 = np.empty((n, 4))
+    s2 = np.empty((n, 4))
+    r2 = np.empty((n, 2))
+    tan = np.empty((n, 2))
+    uu = np.empty(n)
+    gu = np.empty(n)
+    u2 = np.empty(n)
+    schur = np.empty((2 * nc, 2 * nc))
+    rhs = np.empty(2 * nc)
+    diag = np.empty(nc)
+    ctrl2 = np.empty((nc, 2))
+    for k in range(k_rows):
+        _evaluate(t, u[k], ctrl[k], pts[k], spans, b, s, r)
+        for _ in range(steps):
+            lam = damping[k]
+            if lam > 1e8:
+                break
+            schur[:] = 0.0
+            rhs[:] = 0.0
+            diag[:] = 0.0
+            for i in range(n):
+                o = spans[i] - 3
+                tx = 0.0
+                ty = 0.0
+                if 0 < i < n - 1:  # the ends stay where they are
+                    for a in range(4):
+                        tx += s[i, a] * ctrl[k, o + a, 0]
+                        ty += s[i, a] * ctrl[k, o + a, 1]
+                tan[i, 0], tan[i, 1] = tx, ty
+                uu[i] = (tx * tx + ty * ty) * (1.0 + lam) + 1e-12
+                gu[i] = tx * r[i, 0] + ty * r[i, 1]
+                wxx = 1.0 - tx * tx / uu[i]
+                wyy = 1.0 - ty * ty / uu[i]
+                wxy = -tx * ty / uu[i]
+                ex = r[i, 0] - tx * gu[i] / uu[i]
+                ey = r[i, 1] - ty * gu[i] / uu[i]
+                for a in range(4):
+                    ja = o + a
+                    diag[ja] += b[i, a] * b[i, a]
+                    rhs[ja] += b[i, a] * ex
+                    rhs[nc + ja] += b[i, a] * ey
+                    for c in range(4):
+                        bb = b[i, a] * b[i, c]
+                        jc = o + c
+                        schur[ja, jc] += bb * wxx
+                        schur[nc + ja, nc + jc] += bb * wyy
+                        schur[ja, nc + jc] += bb * wxy
+                        schur[nc + ja, jc] += bb * wxy
+            for j in range(nc):
+                schur[j, j] += lam * diag[j]
+                schur[nc + j, nc + j] += lam * diag[j]
+            for j in range(2 * nc):
+                schur[j, j] += 1e-14
+            dc = np.linalg.solve(schur, rhs)
+            for j in range(nc):
+                ctrl2[j, 0] = ctrl[k, j, 0] - dc[j]
+                ctrl2[j, 1] = ctrl[k, j, 1] - dc[nc + j]
+            top = 0.0
+            for i in range(n):
+                o = spans[i] - 3
+                dx = 0.0
+                dy = 0.0
+                for a in range(4):
+                    dx += b[i, a] * dc[o + a]
+                    dy += b[i, a] * dc[nc + o + a]
+                v = u[k, i] - (gu[i] - (dx * tan[i, 0] + dy * tan[i, 1])) / uu[i]
+                v = min(max(v, 0.0), 1.0)
+                if i > 0 and v < top:  # never falling
+                    v = top
+                top = v
+                u2[i] = v
+            u2[0] = 0.0
+            u2[n - 1] = 1.0
+            cost2 = _evaluate(t, u2, ctrl2, pts[k], spans2, b2, s2, r2)
+            if cost2 < cost[k]:
+                u[k, :] = u2
+                ctrl[k, :, :] = ctrl2
+                cost[k] = cost2
+                spans[:] = spans2
+                b[:] = b2
+                s[:] = s2
+                r[:] = r2
+                damping[k] = max(lam / 3.0, 1e-9)
+            else:
+                damping[k] = lam * 4.0
+
+
+@_compiled()
+def weights_at(t: np.ndarray, u: np.ndarray, nc: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each parameter's knot span (m,), its four basis values and slopes (m, 4): the kernel's basis, for checks."""
+    spans = np.empty(len(u), np.int64)
+    b = np.empty((len(u), 4))
+    s = np.empty((len(u), 4))
+    for i in range(len(u)):
+        ui = min(max(u[i], 0.0), 1.0)
+        spans[i] = _span(t, ui, nc)
+        _weights(t, ui, spans[i], b[i], s[i])
+    return spans, b, s
