@@ -36,6 +36,8 @@ CROSS_FIELD_RULES = {
     "metrics and output only with format json": r"(metrics|output): only",
     "coordinates the model's frame cannot hold": r"(too small or too large|beyond float32 range|non-finite|float64)",
     "a profile must stay on one side of the axis": r"axis",
+    "a prior the server has loaded (GET /model: priors)": r"prior: no prior named",
+    "explore: steps**directions ≤ 256 curves": r"steps\*\*directions curves would be \d+; at most 256",
 }
 #: The same for the Open Inference Protocol (/v2), which answers a request that does not fit the model's tensors
 #: with the protocol's 400 and `{"error": ...}` instead of a 422.
