@@ -113,13 +113,8 @@ def spline_values(
     c = np.asarray(control_points, np.float64)
     u = np.clip(np.asarray(params, np.float64), 0.0, 1.0)
     who = np.zeros(len(u), np.int64) if owner is None else np.asarray(owner, np.int64)
-    coef = _span_polynomials(c.shape[-2], degree)  # (spans, degree + 1 functions, degree + 1 powers)
-    spans = len(coef)
-    window = np.arange(spans)[:, None] + np.arange(degree + 1)  # span s: control points s … s + degree
-    near = c.reshape(-1, c.shape[-2], 2)[:, window]  # (B, spans, functions, 2)
-    # per span one matrix product over all the splines: (spans, powers, functions) @ (spans, functions, B·2)
-    poly = coef.transpose(0, 2, 1) @ near.transpose(1, 2, 0, 3).reshape(spans, degree + 1, -1)
-    poly = poly.reshape(spans, degree + 1, -1, 2).transpose(2, 0, 1, 3)  # (B, spans, powers, 2)
+    poly = span_polynomials_of(c.reshape(-1, c.shape[-2], 2), degree)
+    spans = poly.shape[1]
     span = np.minimum((u * spans).astype(np.int64), spans - 1)
     x = (u * spans - span)[:, None]  # place in the span, [0, 1]
     mine = np.ascontiguousarray(poly).reshape(-1, degree + 1, 2)[who * spans + span]  # (N, powers, 2): its own
@@ -135,6 +130,20 @@ def spline_values(
     n_ctrl = c.shape[-2]
     out[0][at_end] = c.reshape(-1, 2)[who[at_end] * n_ctrl + np.where(u[at_end] >= 1.0, n_ctrl - 1, 0)]
     return out
+
+
+def span_polynomials_of(control_points: np.ndarray, degree: int = 3) -> np.ndarray:
+    """(B, spans, degree + 1 powers, 2): on knot span s of each clamped uniform B-spline (B, n_ctrl, 2), the curve as
+    Σ_k poly[b, s, k]·x^k, x ∈ [0, 1] the place in the span (`_span_polynomials`' basis times the span's control
+    points), per span one matrix product over all the splines."""
+    c = np.asarray(control_points, np.float64)
+    coef = _span_polynomials(c.shape[-2], degree)  # (spans, degree + 1 functions, degree + 1 powers)
+    spans = len(coef)
+    window = np.arange(spans)[:, None] + np.arange(degree + 1)  # span s: control points s … s + degree
+    near = c[:, window]  # (B, spans, functions, 2)
+    # (spans, powers, functions) @ (spans, functions, B·2)
+    poly = coef.transpose(0, 2, 1) @ near.transpose(1, 2, 0, 3).reshape(spans, degree + 1, -1)
+    return np.ascontiguousarray(poly.reshape(spans, degree + 1, -1, 2).transpose(2, 0, 1, 3))
 
 
 #: k!/(k - d)! for d (rows) and k (columns) up to degree 7: the factor of x^(k - d) in the d-th derivative of x^k

@@ -72,14 +72,14 @@ def _reconstructed_like(count: int, seed: int) -> tuple[np.ndarray, list[np.ndar
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_the_quick_match_is_the_order_keeping_programme(seed):
-    """Nearest samples where they run in order, the dynamic programme elsewhere: the same sample for every point."""
-    from curve_vae.geometry.matching import DENSE, _match, _ordered_nearest, _padded
-
+    """Nearest samples where they run in order, the dynamic programme elsewhere: the same placement as the programme
+    run on every curve."""
     ctrl, pts = _reconstructed_like(24, seed)
-    samples = sample_bspline(ctrl, DENSE).astype(np.float32)
-    lengths = np.array([len(p) for p in pts])
-    padded = np.stack([_padded(p, lengths.max()) for p in pts])
-    np.testing.assert_array_equal(_ordered_nearest(padded, samples, lengths), _match(padded, samples, lengths))
+    quick, d_quick = ordered_closest_params(ctrl, pts)
+    every, d_every = ordered_closest_params(ctrl, pts, programme=True)
+    for a, b in zip(quick, every):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(d_quick, d_every)
 
 
 def test_a_curve_is_placed_alike_alone_and_in_batches_of_any_size():

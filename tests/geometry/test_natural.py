@@ -227,8 +227,8 @@ def test_the_compiled_fits_basis_is_scipys_at_every_parameter_knots_and_ends_inc
         u = np.concatenate([np.random.default_rng(n_ctrl).random(500), t, [0.0, 1.0, 1e-17, 1 - 1e-16]])
         spans, b, s = weights_at(t, u, n_ctrl)
         dense_b, dense_s = np.zeros((len(u), n_ctrl)), np.zeros((len(u), n_ctrl))
-        for i, l in enumerate(spans):
-            dense_b[i, l - 3 : l + 1], dense_s[i, l - 3 : l + 1] = b[i], s[i]
+        for i, sp in enumerate(spans):
+            dense_b[i, sp - 3 : sp + 1], dense_s[i, sp - 3 : sp + 1] = b[i], s[i]
         basis, slope = basis_and_slope(u, n_ctrl)
         np.testing.assert_allclose(dense_b, basis, atol=1e-13)
         np.testing.assert_allclose(dense_s, slope, atol=1e-10 * n_ctrl)
