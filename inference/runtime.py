@@ -137,11 +137,7 @@ class CurveRuntime:
             cache_bytes=cache_bytes,
             priors_dir=priors_dir,
         )
-        runtime = cls(**parts)
-        if warm_up:  # the reading's compiled kernels loaded (or compiled, ~10 s once) before the first request
-            t = np.linspace(0.0, np.pi, 40)
-            runtime.reconstruct([np.c_[np.cos(t), np.sin(t)]])
-        return runtime
+        return cls(**parts)
 
     # ----------------------------------------------------------------------- what the model is
 
