@@ -11,9 +11,11 @@ the standard prior N(0, I) every direction varies alike; the latent's first axes
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from curve_vae.geometry.validity import crosses
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.results import Spline
 
@@ -64,3 +66,17 @@ class Explored:
     valid: np.ndarray
     directions: Directions
     prior: str
+
+
+def explore(rt: Any, curve: np.ndarray, reading: Any, *, steps: int, spread: float, directions: int,
+            prior: str | None, n_points: int | None) -> Explored:  # fmt: skip
+    """CurveRuntime.explore's work: the grid around `curve` in its own frame (see there)."""
+    chosen = rt.sampler.resolve(prior)
+    named = rt.priors.get(chosen)
+    mixture = named.mixture if named is not None else (rt.prior if chosen == "learned" else None)
+    axes = principal_directions(mixture, rt.latent_dim, directions)
+    enc = rt.encode([curve], reading)
+    offsets = grid_offsets(steps, spread, directions)
+    z = neighbour_latents(enc.mean[0].astype(np.float64), axes, offsets)
+    made = rt.decode(z, n_points=n_points or len(curve), frames=[f for f in enc.frames if f] * len(z) or None)
+    return Explored(made.curves, made.splines, offsets, ~crosses(list(made.curves)), axes, chosen)

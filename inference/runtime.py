@@ -27,12 +27,11 @@ from typing import TypeVar
 import numpy as np
 
 from curve_vae.geometry import Frame
-from curve_vae.geometry.validity import crosses
 from curve_vae.inference.augmenting import AugmentPlan, augmented, neighbour_pools
 from curve_vae.inference.cache import DEFAULT_CACHE_BYTES, EncodingCache
 from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.exploring import Explored, grid_offsets, neighbour_latents, principal_directions
+from curve_vae.inference.exploring import Explored, explore
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.manifest import Manifest, ModelLoadError  # noqa: F401  (ModelLoadError: part of its API)
@@ -354,15 +353,8 @@ class CurveRuntime:
         """Curves around `curve`: its latent mean moved along the `directions` principal directions of a latent
         distribution (inference.exploring), a grid of `steps` offsets per direction from −spread to spread standard
         deviations, decoded in the curve's own frame. The middle of the grid is the curve's own reconstruction."""
-        chosen = self.sampler.resolve(prior)
-        named = self.priors.get(chosen)
-        mixture = named.mixture if named is not None else (self.prior if chosen == "learned" else None)
-        axes = principal_directions(mixture, self.latent_dim, directions)
-        enc = self.encode([curve], reading)
-        offsets = grid_offsets(steps, spread, directions)
-        z = neighbour_latents(enc.mean[0].astype(np.float64), axes, offsets)
-        made = self.decode(z, n_points=n_points or len(curve), frames=[f for f in enc.frames if f] * len(z) or None)
-        return Explored(made.curves, made.splines, offsets, ~crosses(list(made.curves)), axes, chosen)
+        return explore(self, curve, reading, steps=steps, spread=spread, directions=directions, prior=prior,
+                       n_points=n_points)  # fmt: skip
 
     def plan_augment(
         self,
