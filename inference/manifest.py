@@ -89,7 +89,7 @@ class RankerEntry(_Part):
     """The reading ranker (inference.ranker): which of the search's candidate readings the model brings back
     closest, predicted from their points, so that only the best two are encoded (reading pose "learned")."""
 
-    file: str = "ranker.npz"
+    file: str = "ranker.onnx"
     kind: str
 
 
@@ -97,7 +97,7 @@ class SpacerEntry(_Part):
     """The spacing guesser (inference.spacer): where each point of a curve would sit on one of the paper's splines,
     guessed from its shape, so that reading pose "learned" starts its natural fit there."""
 
-    file: str = "spacer.npz"
+    file: str = "spacer.onnx"
     kind: str
 
 

@@ -5,6 +5,7 @@ and what to fix. `CurveRuntime.load` is the way in; this is what it is made of."
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -16,7 +17,7 @@ from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.named_priors import load_priors
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
-from curve_vae.inference.sessions import SessionConfig
+from curve_vae.inference.sessions import SessionConfig, resolve_providers
 from curve_vae.inference.spacer import Spacer
 
 T = TypeVar("T")
@@ -46,8 +47,21 @@ def open_model(
             f"graphs do not match the manifest: the prior has {prior.latent_dim} latent dimensions, "
             f"the model {manifest.latent_dim}"
         )
-    ranker = _load_part(root, manifest.ranker, "reading ranker", Ranker.load)
-    spacer = _load_part(root, manifest.spacer, "spacing guesser", Spacer.load)
+    # the learned parts run where the graphs do, each one session that every inference thread shares
+    provider_list = resolve_providers(providers)
+    part_sessions = replace(sessions, sessions=1)
+    ranker = _load_part(
+        root,
+        manifest.ranker,
+        "reading ranker",
+        lambda p: Ranker.load(p, n_points=manifest.n_points, providers=provider_list, sessions=part_sessions),
+    )
+    spacer = _load_part(
+        root,
+        manifest.spacer,
+        "spacing guesser",
+        lambda p: Spacer.load(p, providers=provider_list, sessions=part_sessions),
+    )
     graphs = ModelGraphs.open(
         root, manifest, providers=providers, sessions=sessions, batch_size=batch_size, warm_up=warm_up
     )

@@ -1,6 +1,7 @@
-"""The reading ranker in numpy: from each candidate reading's model-plane points, the natural log of the relative
-RMSE the model would bring it back at (trained by training/ranker.py against the frozen graphs; the service has no
-torch). Reading pose "learned" encodes only the two candidates it ranks first (inference.reader).
+"""The reading ranker: from each candidate reading's model-plane points, the natural log of the relative RMSE the model
+would bring it back at (trained by training/ranker.py against the frozen graphs, run as the ONNX graph it exports:
+the service has no torch, and onnxruntime releases the GIL while it runs). Reading pose "learned" encodes only the
+two candidates it ranks first (inference.reader).
 
 The network: the points centred on the plane and their steps along the curve (4 channels), three convolutions of
 kernel 5 and stride 2 with ReLU, the mean and the maximum over the curve, a hidden layer, one output.
@@ -11,11 +12,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from numpy.lib.stride_tricks import as_strided
 
-from curve_vae.errors import InvalidInput
 from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.inference.weights import read_weights
+from curve_vae.inference.learned import PartGraph
+from curve_vae.inference.sessions import SessionConfig
 
 RANKER_KIND = "conv1d-3x5s2-meanmax-v1"
 #: Readings pose "learned" encodes per curve: the ranker's first two.
@@ -23,8 +23,7 @@ RANKED_READS = 2
 #: Scale of the plane (half its side) and of a step between neighbouring points in the ranker's inputs.
 PLANE_HALF = 64.0
 STEP_SCALE = 20.0
-#: Candidates the ranker scores at once (in one process, 2,300 candidates: 270 and 160 ms at once, 115–135 in chunks
-#: of 128).
+#: Candidates the ranker scores at once.
 SCORE_CHUNK = 128
 
 
@@ -38,51 +37,20 @@ def ranker_inputs(points: np.ndarray) -> np.ndarray:
 
 
 class Ranker:
-    """The ranker's weights (ranker.npz) and its forward pass."""
+    """The ranker's graph (ranker.onnx, exported from training/ranker.py's RankerNet) and the scores it gives."""
 
-    def __init__(self, weights: dict[str, np.ndarray]) -> None:
-        self.convs: list[tuple[np.ndarray, np.ndarray, int]] = []  # (taps·in, out) weights, bias, taps
-        i = 0
-        while f"conv{i}_w" in weights:
-            w = weights[f"conv{i}_w"].astype(np.float32)  # (out, in, taps)
-            # as (taps·in, out): a window of the input's rows (channels last), flattened, times it is the convolution
-            flat = np.ascontiguousarray(w.transpose(2, 1, 0).reshape(-1, len(w)))
-            self.convs.append((flat, weights[f"conv{i}_b"].astype(np.float32), w.shape[2]))
-            i += 1
-        self.dense = []
-        i = 0
-        while f"dense{i}_w" in weights:
-            self.dense.append((weights[f"dense{i}_w"].astype(np.float32), weights[f"dense{i}_b"].astype(np.float32)))
-            i += 1
-        if not self.convs or len(self.dense) != 2:
-            raise InvalidInput("not a reading ranker: expected conv0… and dense0, dense1 weights")
+    def __init__(self, graph: PartGraph) -> None:
+        self.graph = graph
 
     @classmethod
-    def load(cls, path: str | Path) -> Ranker:
-        return cls(read_weights(path, RANKER_KIND, "a ranker"))
+    def load(cls, path: str | Path, *, n_points: int, providers: list[str], sessions: SessionConfig) -> Ranker:
+        return cls(PartGraph.open(path, shape=(4, n_points), providers=providers, sessions=sessions))
 
     def scores(self, points: np.ndarray) -> np.ndarray:
         """(k, n, 2) model-plane points -> (k,) predicted natural log of each reading's relative RMSE; SCORE_CHUNK
-        candidates at a time (a chunk's windows stay in cache: all ~2,300 candidates of a 128-curve request at once
-        spend more time faulting in fresh pages than multiplying)."""
+        candidates at a time (a chunk's activations stay in cache)."""
         if len(points) == 0:
             return np.zeros(0)
-        return np.concatenate([self._scores(points[i : i + SCORE_CHUNK]) for i in range(0, len(points), SCORE_CHUNK)])
-
-    def _scores(self, points: np.ndarray) -> np.ndarray:
-        h = ranker_inputs(points).transpose(0, 2, 1)  # (k, n, c): each step one matrix product
-        for w, b, taps in self.convs:
-            k, n, c = h.shape
-            pad = taps // 2
-            padded = np.zeros((k, n + 2 * pad, c), np.float32)
-            padded[:, pad : pad + n] = h
-            n_out = (n + 2 * pad - taps) // 2 + 1
-            # stride 2: window j is rows 2j … 2j + taps - 1 of the padded input, taps·c floats in a row in memory, so
-            # the windows' copy into one matrix is a copy of contiguous runs (a 5-element gather per channel is not)
-            s0, s1, s2 = padded.strides
-            windows = as_strided(padded, (k, n_out, taps * c), (s0, 2 * s1, s2), writeable=False)
-            h = np.maximum(windows.reshape(k * n_out, taps * c) @ w + b, 0.0).reshape(k, n_out, len(b))
-        z = np.concatenate([h.mean(1), h.max(1)], axis=1)
-        (w0, b0), (w1, b1) = self.dense
-        z = np.maximum(z @ w0.T + b0, 0.0)
-        return (z @ w1.T + b1)[:, 0].astype(np.float64)
+        return np.concatenate(
+            [self.graph.run(ranker_inputs(points[i : i + SCORE_CHUNK])) for i in range(0, len(points), SCORE_CHUNK)]
+        ).astype(np.float64)

@@ -22,15 +22,16 @@ import numpy as np  # noqa: E402
 
 from curve_vae.geometry import arc_length_params, natural_readings_of, random_control_points  # noqa: E402
 from curve_vae.geometry.bspline import evaluate_bspline  # noqa: E402
-from curve_vae.inference.spacer import Spacer  # noqa: E402
+from curve_vae.inference.runtime import CurveRuntime  # noqa: E402
 
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--model-dir", default="models", help="the model whose spacer.npz guesses (default: models)")
+    p.add_argument("--model-dir", default="models", help="the model whose guesser guesses (default: models)")
     p.add_argument("--count", type=int, default=200, help="curves (default: 200)")
     a = p.parse_args()
-    spacer = Spacer.load(os.path.join(a.model_dir, "spacer.npz"))
+    spacer = CurveRuntime.load(a.model_dir, providers="cpu", intra_op_threads=1, cache_bytes=0).reader.spacer
+    assert spacer is not None, f"{a.model_dir} has no spacing guesser"
     ctrl = random_control_points(np.random.default_rng(77), a.count)
     own = [arc_length_params(c, 161) for c in ctrl]
     drawn = [evaluate_bspline(c, u) for c, u in zip(ctrl, own)]

@@ -105,9 +105,9 @@ def test_readme_cli_commands_run_as_written(tmp_path):
         "priors/mine.npz",
         "mine_samples.json",
         "runs/ranker/ranker-best.pt",
-        "model-copy/ranker.npz",
+        "model-copy/ranker.onnx",
         "runs/spacer/spacer-best.pt",
-        "model-copy/spacer.npz",
+        "model-copy/spacer.onnx",
     ]:
         assert (tmp_path / made).is_file(), made
     now = {f.name: hashlib.sha256(f.read_bytes()).hexdigest() for f in (ROOT / "models").glob("*") if f.is_file()}

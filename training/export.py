@@ -104,7 +104,9 @@ def _quiet_exporter() -> Iterator[None]:
         registry.setLevel(level)
 
 
-def _export(module: nn.Module, example: torch.Tensor, path: Path, in_name: str, out_names: list[str]) -> None:
+def export_graph(module: nn.Module, example: torch.Tensor, path: Path, in_name: str, out_names: list[str]) -> None:
+    """`module` (in eval mode) as an ONNX graph at `path`, written atomically: one input of `example`'s shape with
+    any batch, the outputs named `out_names`."""
     batch = torch.export.Dim("batch", min=1, max=1 << 20)
     module = module.eval()  # inference graphs: BatchNorm on its running statistics
     with atomic_path(path) as tmp, _quiet_exporter():
@@ -135,7 +137,7 @@ def model_size_of(curves: np.ndarray) -> float:
 def _export_graphs(model: VAE, out: Path) -> list[str]:
     """encoder.onnx and decoder.onnx (with control_points from a B-spline head); their file names."""
     cfg = model.cfg
-    _export(
+    export_graph(
         _EncoderGraph(model),
         torch.zeros(2, cfg.n_points, 2) + 64.0,
         out / "encoder.onnx",
@@ -143,7 +145,7 @@ def _export_graphs(model: VAE, out: Path) -> list[str]:
         list(ENCODER_OUTPUTS),
     )
     dec_outputs = decoder_outputs(bool(cfg.spline_ctrl), bool(cfg.spline_params))
-    _export(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", DECODER_INPUT, dec_outputs)
+    export_graph(_DecoderGraph(model), torch.zeros(2, cfg.latent_dim), out / "decoder.onnx", DECODER_INPUT, dec_outputs)
     return ["encoder.onnx", "decoder.onnx"]
 
 

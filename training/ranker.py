@@ -10,11 +10,13 @@ softmax over each curve's candidates learns which one is closest (learned canoni
 as equiadapt trains its canonicalisers with a prior on the labels).
 
 Training is time-budgeted and resumable (`ranker-last.pt`, written atomically each epoch); `export_ranker` writes
-the weights as ranker.npz beside the model's graphs, which inference.ranker runs in numpy (the service has no torch).
+the net as ranker.onnx beside the model's graphs, which inference.ranker runs in onnxruntime (the service has no
+torch).
 """
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -26,7 +28,7 @@ from torch import nn
 
 from curve_vae.inference.ranker import RANKER_KIND, ranker_inputs
 from curve_vae.training.checkpoint import atomic_save
-from curve_vae.training.parts import write_part
+from curve_vae.training.parts import read_weights, write_part
 
 #: Channels of the three strided convolutions (kernel 5, stride 2) and the hidden layer of the head.
 CHANNELS = (32, 64, 96)
@@ -56,21 +58,20 @@ class RankerNet(nn.Module):
         h = self.convs(x)
         return self.head(torch.cat([h.mean(-1), h.amax(-1)], dim=1))[:, 0]
 
-    def weights(self) -> dict[str, np.ndarray]:
-        """The weights as inference.ranker reads them."""
-        out: dict[str, np.ndarray] = {}
-        convs = [m for m in self.convs if isinstance(m, nn.Conv1d)]
-        for i, m in enumerate(convs):
-            out[f"conv{i}_w"], out[f"conv{i}_b"] = _np(m.weight), _np(m.bias)
-        lin = [m for m in self.head if isinstance(m, nn.Linear)]
-        for i, d in enumerate(lin):
-            out[f"dense{i}_w"], out[f"dense{i}_b"] = _np(d.weight), _np(d.bias)
-        return out
-
-
-def _np(t: torch.Tensor | None) -> np.ndarray:
-    assert t is not None
-    return t.detach().cpu().numpy().astype(np.float32)
+    @classmethod
+    def from_weights(cls, weights: dict[str, np.ndarray]) -> RankerNet:
+        """The net of a ranker.npz's weights (conv0…2_w/_b, dense0…1_w/_b: the numpy form models before 0.14.0
+        shipped), so that an old model's ranker converts to ONNX without its checkpoint."""
+        net = cls()
+        layers = [m for m in net.convs if isinstance(m, nn.Conv1d)] + [m for m in net.head if isinstance(m, nn.Linear)]
+        names = [f"conv{i}" for i in range(len(CHANNELS))] + ["dense0", "dense1"]
+        state = {}
+        for name, m in zip(names, layers):
+            key = next(k for k, v in net.named_modules() if v is m)
+            state[f"{key}.weight"] = torch.from_numpy(weights[f"{name}_w"])
+            state[f"{key}.bias"] = torch.from_numpy(weights[f"{name}_b"])
+        net.load_state_dict(state)
+        return net
 
 
 # ----------------------------------------------------------------------------------------------- the labels
@@ -256,15 +257,26 @@ def export_ranker(
     default: bool = True,
     version: str | None = None,
 ) -> Path:
-    """Write the checkpoint's weights as `ranker.npz` in `model_dir` and name it in the manifest with how it was
-    trained and how it measured (both written atomically). `default`: the model's reading becomes pose "learned"
-    (else it stays as it was and "learned" is there to ask for); `version`: the model's new version. Returns the
-    weights' path."""
-    ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
-    net = RankerNet()
-    net.load_state_dict(ck["model"])
+    """Write the checkpoint's net as `ranker.onnx` in `model_dir` (taking the model's points, any number of
+    candidates) and name it in the manifest with how it was trained and how it measured (both written atomically).
+    `default`: the model's reading becomes pose "learned" (else it stays as it was and "learned" is there to ask
+    for); `version`: the model's new version. A `ranker.npz` in place of the checkpoint (the numpy weights models
+    before 0.14.0 shipped) is converted: what the manifest said of it is kept, and its reading. Returns the graph's
+    path."""
+    root = Path(model_dir)
+    manifest = json.loads((root / "manifest.json").read_text())
+    if Path(checkpoint).suffix == ".npz":
+        net = RankerNet.from_weights(read_weights(checkpoint, RANKER_KIND, "a reading ranker"))
+        kept = {k: v for k, v in (manifest.get("ranker") or {}).items() if k not in ("file", "kind")}
+        entry = {**kept, **(meta or {})}
+        default = False
+    else:
+        ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
+        net = RankerNet()
+        net.load_state_dict(ck["model"])
+        entry = {**(meta or {}), "held_out": ck.get("ratios"), "trained": ck.get("trained")}
     changes: dict[str, Any] = {"reading": {"pose": "learned", "spacing": "search"}} if default else {}
     if version is not None:
         changes["version"] = version
-    entry = {**(meta or {}), "held_out": ck.get("ratios"), "trained": ck.get("trained")}
-    return write_part(model_dir, "ranker", RANKER_KIND, net.weights(), entry, changes=changes)
+    example = torch.zeros(2, 4, int(manifest["n_points"]))
+    return write_part(root, "ranker", RANKER_KIND, net, example, entry, changes=changes)

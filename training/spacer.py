@@ -1,6 +1,6 @@
 """The spacing guesser: a small network that tells, from a curve's shape alone, the parameter each of its points would
 have on one of the paper's splines, so that the natural fit (geometry.natural) starts there and needs a few steps
-from one guess where it otherwise scouts nine starts (reading pose "learned"; inference.spacer runs it in numpy).
+from one guess where it otherwise scouts nine starts (reading pose "learned"; inference.spacer runs it in onnxruntime).
 
     paper curve as a caller's polyline --by arc length--> (GRID, 2) --spacer_inputs--> the net --> (GRID,) parameters
         loss: L1 against the generator's own parameters at those points (known exactly: nothing to label)
@@ -8,12 +8,13 @@ from one guess where it otherwise scouts nine starts (reading pose "learned"; in
 The curves are drawn afresh for every step from `seed` and the step's number, mirrored and reversed at random, so
 a resumed run sees what an unbroken one would; a fixed held-out set (its own seed) measures each checkpoint.
 Training is time-budgeted and resumable (`spacer-last.pt`, written atomically every EVAL_EVERY steps, with the
-time spent); `spacer-best.pt` keeps the step whose held-out error was least. `export_spacer` writes the weights as
-spacer.npz beside the model's graphs and names them in the manifest.
+time spent); `spacer-best.pt` keeps the step whose held-out error was least. `export_spacer` writes the net as
+spacer.onnx beside the model's graphs and names it in the manifest.
 """
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -23,12 +24,13 @@ import numpy as np
 import torch
 from torch import nn
 
+from curve_vae.errors import InvalidInput
 from curve_vae.geometry import random_control_points, sample_bspline
 from curve_vae.geometry.frame import arc_fractions
 from curve_vae.inference.spacer import GRID, SPACER_KIND, on_grid, spacer_inputs
 from curve_vae.training.checkpoint import atomic_save
 from curve_vae.training.families import warp
-from curve_vae.training.parts import write_part
+from curve_vae.training.parts import read_weights, write_part
 
 #: Channels of the residual blocks; each block's dilation (two sweeps that together see the whole grid).
 CHANNELS = 32
@@ -64,16 +66,22 @@ class SpacerNet(nn.Module):
         step = torch.softmax(self.out(torch.relu(h))[:, 0], dim=1)
         return torch.cat([torch.zeros_like(step[:, :1]), torch.cumsum(step, dim=1)], dim=1)
 
-    def weights(self) -> dict[str, np.ndarray]:
-        """The weights as inference.spacer reads them."""
-        out = {"dilations": np.array(DILATIONS), "mix_after": np.array(MIX_AFTER)}
+    @classmethod
+    def from_weights(cls, weights: dict[str, np.ndarray]) -> SpacerNet:
+        """The net of a spacer.npz's weights (inp_w, block0_a_w, …, mix_b, out_b: the numpy form models before
+        0.14.0 shipped), so that an old model's guesser converts to ONNX without its checkpoint."""
+        if tuple(int(d) for d in weights["dilations"]) != DILATIONS or int(weights["mix_after"]) != MIX_AFTER:
+            raise InvalidInput(f"a spacing guesser of dilations {list(weights['dilations'])}; this one has {DILATIONS}")
+        net = cls()
         layers = {"inp": "inp", "mix": "mix", "out": "out"}
         for i in range(len(DILATIONS)):
             layers[f"a.{i}"], layers[f"b.{i}"] = f"block{i}_a", f"block{i}_b"
-        for key, t in self.state_dict().items():  # "a.3.weight" -> block3_a_w
+        state = {}
+        for key in net.state_dict():  # "a.3.weight" <- block3_a_w
             layer, kind = key.rsplit(".", 1)
-            out[f"{layers[layer]}_{kind[0]}"] = t.detach().cpu().numpy().astype(np.float32)
-        return out
+            state[key] = torch.from_numpy(weights[f"{layers[layer]}_{kind[0]}"])
+        net.load_state_dict(state)
+        return net
 
 
 def paper_examples(rng: np.random.Generator, count: int) -> tuple[np.ndarray, np.ndarray]:
@@ -168,11 +176,20 @@ def train_spacer(
 def export_spacer(
     checkpoint: str | Path, model_dir: str | Path, *, meta: dict[str, Any] | None = None, version: str | None = None
 ) -> Path:
-    """Write the checkpoint's weights as `spacer.npz` in `model_dir` and name it in the manifest with how it was
-    trained and how it measured (both written atomically); `version`: the model's new version. Returns its path."""
-    ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
-    net = SpacerNet()
-    net.load_state_dict(ck["model"])
-    entry = {**(meta or {}), "held_out": ck.get("held_out"), "trained": ck.get("trained")}
+    """Write the checkpoint's net as `spacer.onnx` in `model_dir` and name it in the manifest with how it was
+    trained and how it measured (both written atomically); `version`: the model's new version. A `spacer.npz` in place
+    of the checkpoint (the numpy weights models before 0.14.0 shipped) is converted, keeping what the manifest said
+    of it. Returns the graph's path."""
+    root = Path(model_dir)
+    if Path(checkpoint).suffix == ".npz":
+        net = SpacerNet.from_weights(read_weights(checkpoint, SPACER_KIND, "a spacing guesser"))
+        manifest = json.loads((root / "manifest.json").read_text())
+        kept = {k: v for k, v in (manifest.get("spacer") or {}).items() if k not in ("file", "kind")}
+        entry = {**kept, **(meta or {})}
+    else:
+        ck = torch.load(checkpoint, map_location="cpu", weights_only=False)
+        net = SpacerNet()
+        net.load_state_dict(ck["model"])
+        entry = {**(meta or {}), "held_out": ck.get("held_out"), "trained": ck.get("trained")}
     changes = {"version": version} if version is not None else {}
-    return write_part(model_dir, "spacer", SPACER_KIND, net.weights(), entry, changes=changes)
+    return write_part(root, "spacer", SPACER_KIND, net, torch.zeros(2, 3, GRID), entry, changes=changes)

@@ -44,10 +44,15 @@ def cmd_export(a: argparse.Namespace) -> int:
     from curve_vae.files import refuse_overwrite
     from curve_vae.training.ranker import export_ranker
 
-    refuse_overwrite(Path(a.model_dir) / "ranker.npz", a.force, flag="--model-dir")
+    refuse_overwrite(Path(a.model_dir) / "ranker.onnx", a.force, flag="--model-dir")
     meta = {"note": a.note} if a.note else None
     path = export_ranker(a.checkpoint, a.model_dir, meta=meta, default=not a.not_default, version=a.version or None)
-    reading = 'pose "learned" is there to ask for' if a.not_default else 'the model\'s reading is now pose "learned"'
+    if a.checkpoint.endswith(".npz"):
+        reading = "converted from its numpy weights, the model's reading as it was"
+    elif a.not_default:
+        reading = 'pose "learned" is there to ask for'
+    else:
+        reading = 'the model\'s reading is now pose "learned"'
     print(f"wrote {path}; {reading} (the manifest names it)")
     return 0
 
@@ -97,7 +102,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.set_defaults(func=cmd_train)
 
     s = stages.add_parser("export", help='write the ranker into a model directory; its reading becomes "learned"')
-    s.add_argument("checkpoint", help="a ranker checkpoint (RUN_DIR/ranker-best.pt)")
+    s.add_argument(
+        "checkpoint", help="a ranker checkpoint (RUN_DIR/ranker-best.pt), or an older model's ranker.npz to convert"
+    )
     s.add_argument("--model-dir", required=True, help="the model directory whose graphs it was trained against")
     s.add_argument("--not-default", action="store_true", help='keep the model\'s reading; "learned" only on request')
     s.add_argument("--version", default="", help="the model's new version (default: unchanged)")

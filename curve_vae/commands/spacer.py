@@ -23,7 +23,7 @@ def cmd_export(a: argparse.Namespace) -> int:
     from curve_vae.files import refuse_overwrite
     from curve_vae.training.spacer import export_spacer
 
-    refuse_overwrite(Path(a.model_dir) / "spacer.npz", a.force, flag="--model-dir")
+    refuse_overwrite(Path(a.model_dir) / "spacer.onnx", a.force, flag="--model-dir")
     path = export_spacer(
         a.checkpoint, a.model_dir, meta={"note": a.note} if a.note else None, version=a.version or None
     )
@@ -46,7 +46,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.set_defaults(func=cmd_train)
 
     s = stages.add_parser("export", help="write the guesser into a model directory")
-    s.add_argument("checkpoint", help="a spacer checkpoint (RUN_DIR/spacer-best.pt)")
+    s.add_argument(
+        "checkpoint", help="a spacer checkpoint (RUN_DIR/spacer-best.pt), or an older model's spacer.npz to convert"
+    )
     s.add_argument("--model-dir", required=True, help="the model directory whose reading it serves")
     s.add_argument("--version", default="", help="the model's new version (default: unchanged)")
     s.add_argument("--note", default="", help="how the guesser was trained, in words, kept in the manifest")

@@ -1,5 +1,5 @@
-"""Reading pose "learned": the ranker's numpy forward pass, its file, and the reading it drives (only the ranked
-candidates encoded; a curve moved comes back moved)."""
+"""Reading pose "learned": the ranker's graph, its file, and the reading it drives (only the ranked candidates encoded;
+a curve moved comes back moved)."""
 
 from __future__ import annotations
 
@@ -13,40 +13,17 @@ import pytest
 from curve_vae.inference.candidates import model_points
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
-from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, Ranker, ranker_inputs
+from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, ranker_inputs
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from tests.helpers import bspline_curves
-
-
-def random_weights(seed: int = 0) -> dict[str, np.ndarray]:
-    """Weights of the ranker's shape (training/ranker.py's RankerNet), drawn at random."""
-    rng = np.random.default_rng(seed)
-    shapes = {"conv0_w": (32, 4, 5), "conv1_w": (64, 32, 5), "conv2_w": (96, 64, 5), "dense0_w": (96, 192)}
-    shapes["dense1_w"] = (1, 96)
-    out = {}
-    for name, shape in shapes.items():
-        out[name] = (rng.normal(size=shape) / np.sqrt(np.prod(shape[1:]))).astype(np.float32)
-        out[name.replace("_w", "_b")] = (0.1 * rng.normal(size=shape[0])).astype(np.float32)
-    return out
-
-
-def with_ranker(src: Path, out: Path, weights: dict[str, np.ndarray]) -> Path:
-    """A copy of a model directory with a ranker and the reading "learned" in its manifest."""
-    shutil.copytree(src, out, dirs_exist_ok=True)
-    np.savez(out / "ranker.npz", kind=RANKER_KIND, **weights)
-    manifest = json.loads((out / "manifest.json").read_text())
-    manifest["files"]["ranker.npz"] = file_entry(out / "ranker.npz").model_dump()
-    manifest["ranker"] = {"file": "ranker.npz", "kind": RANKER_KIND}
-    manifest["reading"] = {"pose": "learned", "spacing": "search"}
-    (out / "manifest.json").write_text(json.dumps(manifest))
-    return out
+from tests.parts import ranker_weights, save_npz, with_ranker
 
 
 @pytest.fixture(scope="module")
 def ranked_dir(closest_model_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The untrained model placed closest (where the search keeps the candidate closest at the caller's points)."""
-    return with_ranker(closest_model_dir, tmp_path_factory.mktemp("ranked"), random_weights())
+    return with_ranker(closest_model_dir, tmp_path_factory.mktemp("ranked"), ranker_weights())
 
 
 @pytest.fixture(scope="module")
@@ -63,12 +40,11 @@ def test_inputs_are_the_points_about_the_centre_and_their_steps():
     assert np.all(x[0, 3] == 0)
 
 
-@pytest.mark.parametrize("n_points", [161, 50])
-def test_the_forward_pass_is_a_convolution_stack(n_points):
-    """Against a direct loop: conv (kernel 5, stride 2, padding 2) + ReLU three times, mean and max, two layers; at
-    an odd and an even number of points (the last window of an even row ends in the padding)."""
-    w = random_weights(3)
-    pts = np.random.default_rng(1).uniform(20, 108, (3, n_points, 2)).astype(np.float32)
+def test_the_graph_is_a_convolution_stack(ranked: CurveRuntime):
+    """Against a direct loop over the weights it was made of: conv (kernel 5, stride 2, padding 2) + ReLU three
+    times, mean and max, two layers."""
+    w = ranker_weights()
+    pts = np.random.default_rng(1).uniform(20, 108, (3, 161, 2)).astype(np.float32)
     h = ranker_inputs(pts).astype(np.float64)
     for i in range(3):
         k, b = w[f"conv{i}_w"], w[f"conv{i}_b"]
@@ -78,22 +54,36 @@ def test_the_forward_pass_is_a_convolution_stack(n_points):
         h = np.maximum(h + b[None, :, None], 0)
     z = np.concatenate([h.mean(2), h.max(2)], axis=1)
     z = np.maximum(z @ w["dense0_w"].T + w["dense0_b"], 0) @ w["dense1_w"].T + w["dense1_b"]
-    np.testing.assert_allclose(Ranker(w).scores(pts), z[:, 0], rtol=1e-4, atol=1e-5)
+    assert ranked.reader.ranker is not None
+    np.testing.assert_allclose(ranked.reader.ranker.scores(pts), z[:, 0], rtol=1e-4, atol=1e-5)
+    assert ranked.reader.ranker.scores(np.zeros((0, 161, 2))).shape == (0,)
 
 
-def test_a_file_of_another_kind_is_refused(tmp_path):
-    np.savez(tmp_path / "r.npz", kind="something-else", **random_weights())
-    with pytest.raises(ValueError, match="this runtime reads"):
-        Ranker.load(tmp_path / "r.npz")
+def test_a_graph_of_another_shape_or_numpy_weights_are_refused_with_what_to_do(ranked_dir: Path, tmp_path: Path):
+    model = tmp_path / "model"
+    shutil.copytree(ranked_dir, model)
+    manifest = json.loads((model / "manifest.json").read_text())
+    manifest["ranker"]["file"] = "encoder.onnx"  # a graph, but not of the ranker's shape
+    (model / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(
+        ModelLoadError, match=r"encoder.onnx: not a usable reading ranker .*this part takes \(any, 4, 161\)"
+    ):
+        CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
+    save_npz(model / "ranker.npz", RANKER_KIND, ranker_weights())
+    manifest["ranker"]["file"] = "ranker.npz"
+    manifest["files"]["ranker.npz"] = file_entry(model / "ranker.npz").model_dump()
+    (model / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ModelLoadError, match=f"convert them to ONNX with `curve-vae ranker export {model}/ranker.npz"):
+        CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
 
 
 def test_the_manifest_names_the_ranker_and_checks_its_bytes(ranked_dir: Path, tmp_path: Path):
     m = Manifest.read(ranked_dir)
-    assert m.ranker is not None and m.ranker.file == "ranker.npz" and m.reading.pose == "learned"
-    assert "ranker.npz" in m.checked_files()
-    broken = with_ranker(ranked_dir, tmp_path / "broken", random_weights())
-    (broken / "ranker.npz").write_bytes(b"not the ranker")
-    with pytest.raises(ModelLoadError, match="ranker.npz"):
+    assert m.ranker is not None and m.ranker.file == "ranker.onnx" and m.reading.pose == "learned"
+    assert "ranker.onnx" in m.checked_files()
+    broken = with_ranker(ranked_dir, tmp_path / "broken", ranker_weights())
+    (broken / "ranker.onnx").write_bytes(b"not the ranker")
+    with pytest.raises(ModelLoadError, match="ranker.onnx"):
         CurveRuntime.load(broken, providers="cpu", intra_op_threads=1, cache_bytes=0)
 
 

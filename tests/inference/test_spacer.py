@@ -1,4 +1,4 @@
-"""The spacing guesser in numpy: its inputs, its guesses, its file, and the reading it starts (pose "learned" fits
+"""The spacing guesser: its inputs, its guesses, its file, and the reading it starts (pose "learned" fits
 natural spacings from its guess in GUESSED_NATURAL_STEPS)."""
 
 from __future__ import annotations
@@ -13,42 +13,27 @@ from curve_vae.geometry import arc_length_params, random_control_points, sample_
 from curve_vae.geometry.bspline import evaluate_bspline
 from curve_vae.inference import reader as reader_module
 from curve_vae.inference.reading import Reading
-from curve_vae.inference.spacer import GRID, SPACER_KIND, Spacer, _conv, on_grid, spacer_inputs
+from curve_vae.inference.runtime import CurveRuntime
+from curve_vae.inference.sessions import SessionConfig
+from curve_vae.inference.spacer import GRID, SPACER_KIND, Spacer, on_grid, spacer_inputs
 from tests.helpers import natural_fits_asked
+from tests.parts import save_npz, spacer_weights, with_spacer
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
-def random_weights(seed: int = 0, channels: int = 8) -> dict[str, np.ndarray]:
-    """Weights of the guesser's shape (training/spacer.py's SpacerNet, narrower), drawn at random."""
-    rng = np.random.default_rng(seed)
-    dilations = (1, 2, 4, 1)
-    shapes = {"inp": (channels, 3, 5), "mix": (channels, channels), "out": (1, channels, 2)}
-    for i, _ in enumerate(dilations):
-        shapes[f"block{i}_a"], shapes[f"block{i}_b"] = (channels, channels, 3), (channels, channels, 1)
-    out = {"dilations": np.array(dilations), "mix_after": np.array(1)}
-    for name, shape in shapes.items():
-        out[f"{name}_w"] = (rng.normal(size=shape) / np.sqrt(np.prod(shape[1:]))).astype(np.float32)
-        out[f"{name}_b"] = (0.1 * rng.normal(size=shape[0])).astype(np.float32)
-    return out
+@pytest.fixture(scope="module")
+def spacer(closest_model_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Spacer:
+    """A guesser of random weights, as the graph the runtime opens."""
+    model = with_spacer(closest_model_dir, tmp_path_factory.mktemp("spaced"), spacer_weights())
+    runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
+    assert runtime.reader.spacer is not None
+    return runtime.reader.spacer
 
 
 def _turned(c: np.ndarray, angle: float, scale: float, shift: tuple[float, float]) -> np.ndarray:
     rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
     return c @ rot.T * scale + np.asarray(shift)
-
-
-@pytest.mark.parametrize(("taps", "dilation"), [(3, 1), (3, 4), (5, 1), (3, 40), (5, 9)])
-def test_a_convolution_is_the_zero_padded_one(taps, dilation):
-    """Against a direct loop over a zero-padded input (torch's Conv1d with padding dilation·(taps - 1) / 2),
-    including dilations whose outer taps reach past the whole row."""
-    rng = np.random.default_rng(taps * 100 + dilation)
-    h = rng.normal(size=(3, 17, 4)).astype(np.float32)
-    w, b = rng.normal(size=(6, 4, taps)).astype(np.float32), rng.normal(size=6).astype(np.float32)
-    pad = dilation * (taps - 1) // 2
-    padded = np.pad(h.astype(np.float64), ((0, 0), (pad, pad), (0, 0)))
-    expected = np.stack(
-        [sum(padded[:, j + t * dilation] @ w[:, :, t].T for t in range(taps)) + b for j in range(17)], axis=1
-    )
-    np.testing.assert_allclose(_conv(h, w, b, dilation=dilation), expected, rtol=1e-5, atol=1e-5)
 
 
 def test_the_inputs_are_the_shapes_turning_along_its_length_whatever_its_pose():
@@ -65,8 +50,7 @@ def test_the_inputs_are_the_shapes_turning_along_its_length_whatever_its_pose():
     assert not line[:, :2].any()  # a straight line does not turn
 
 
-def test_guesses_rise_from_0_to_1_at_each_curves_own_points_and_follow_the_shape():
-    spacer = Spacer(random_weights())
+def test_guesses_rise_from_0_to_1_at_each_curves_own_points_and_follow_the_shape(spacer: Spacer):
     rng = np.random.default_rng(2)
     curves = [sample_bspline(random_control_points(rng, 1), n)[0] for n in (20, 161, 777)]
     guesses = spacer.guesses(curves)
@@ -81,14 +65,15 @@ def test_guesses_rise_from_0_to_1_at_each_curves_own_points_and_follow_the_shape
         np.testing.assert_array_equal(v, u)
 
 
-def test_a_file_of_another_kind_or_without_its_weights_is_refused(tmp_path: Path):
-    np.savez(tmp_path / "other.npz", kind="something-else", **random_weights())
-    with pytest.raises(InvalidInput, match="a spacing guesser of kind 'something-else'"):
-        Spacer.load(tmp_path / "other.npz")
-    partial = {k: v for k, v in random_weights().items() if k != "mix_w"}
-    np.savez(tmp_path / "partial.npz", kind=SPACER_KIND, **partial)
-    with pytest.raises(InvalidInput, match="not a spacing guesser: no mix_w weights"):
-        Spacer.load(tmp_path / "partial.npz")
+def test_a_graph_of_another_shape_or_numpy_weights_are_refused(tmp_path: Path):
+    with pytest.raises(InvalidInput, match=r"its graph takes \(any, 161, 2\); this part takes \(any, 3, 128\)"):
+        Spacer.load(MODELS / "encoder.onnx", providers=["CPUExecutionProvider"], sessions=SessionConfig())
+    old = save_npz(tmp_path / "spacer.npz", SPACER_KIND, spacer_weights())
+    with pytest.raises(InvalidInput, match=f"curve-vae spacer export {old} --model-dir {tmp_path} --force"):
+        Spacer.load(old, providers=["CPUExecutionProvider"], sessions=SessionConfig())
+    (tmp_path / "broken.onnx").write_bytes(b"not a graph")
+    with pytest.raises(InvalidInput, match="onnxruntime cannot open it"):
+        Spacer.load(tmp_path / "broken.onnx", providers=["CPUExecutionProvider"], sessions=SessionConfig())
 
 
 def test_the_shipped_guesser_puts_the_papers_curves_drawn_by_arc_length_near_their_own_parameters(shipped_runtime):

@@ -1,5 +1,6 @@
-"""training/ranker.py: the reading ranker against a real (untrained, committed) model: the numpy ranker is the torch
-net, training resumes where it stopped, the export is read back by the runtime as the model's reading."""
+"""training/ranker.py: the reading ranker against a real (untrained, committed) model: the exported graph is the torch
+net, an old model's numpy weights convert, training resumes where it stopped, the export is read back by the runtime
+as the model's reading."""
 
 from __future__ import annotations
 
@@ -11,13 +12,14 @@ import numpy as np
 import pytest
 import torch
 
-from curve_vae.inference.manifest import Manifest
-from curve_vae.inference.ranker import RANKED_READS, Ranker, ranker_inputs
+from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
+from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, ranker_inputs
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.ranker import RankerNet, export_ranker, pick_ratios, train_ranker
 from curve_vae.training.ranker_labels import label_curves
 from tests.helpers import bspline_curves
+from tests.parts import ranker_weights, save_npz
 
 
 @pytest.fixture(scope="module")
@@ -27,13 +29,38 @@ def labels(closest_model_dir: Path, tmp_path_factory: pytest.TempPathFactory) ->
     return out
 
 
-def test_the_numpy_ranker_is_the_torch_net():
+def test_the_exported_graph_is_the_torch_net(tmp_path: Path, closest_model_dir: Path):
     torch.manual_seed(1)
     net = RankerNet().eval()
+    model = tmp_path / "model"
+    shutil.copytree(closest_model_dir, model)
+    npz = save_npz(tmp_path / "ranker.npz", RANKER_KIND, ranker_weights(4))
+    net = RankerNet.from_weights(ranker_weights(4)).eval()
     pts = np.asarray(bspline_curves(5, seed=2), np.float32)
     with torch.no_grad():
         expected = net(torch.from_numpy(ranker_inputs(pts))).numpy()
-    np.testing.assert_allclose(Ranker(net.weights()).scores(pts), expected, rtol=1e-4, atol=1e-5)
+    export_ranker(npz, model)  # numpy weights of before 0.14.0, converted
+    runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
+    assert runtime.reader.ranker is not None
+    np.testing.assert_allclose(runtime.reader.ranker.scores(pts), expected, rtol=1e-4, atol=1e-5)
+
+
+def test_an_old_models_numpy_ranker_converts_keeping_what_its_manifest_said(tmp_path: Path, closest_model_dir: Path):
+    model = tmp_path / "model"
+    shutil.copytree(closest_model_dir, model)
+    npz = save_npz(model / "ranker.npz", RANKER_KIND, ranker_weights())
+    manifest = json.loads((model / "manifest.json").read_text())
+    manifest["files"]["ranker.npz"] = file_entry(npz).model_dump()
+    manifest["ranker"] = {"file": "ranker.npz", "kind": RANKER_KIND, "note": "trained so", "held_out": {"first": 1.1}}
+    (model / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(ModelLoadError, match="numpy weights"):
+        CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
+    path = export_ranker(npz, model)
+    after = json.loads((model / "manifest.json").read_text())
+    assert path == model / "ranker.onnx" and "ranker.npz" not in after["files"] and "ranker.onnx" in after["files"]
+    assert after["ranker"] == {**manifest["ranker"], "file": "ranker.onnx"}
+    assert after["reading"] == manifest["reading"]  # a conversion leaves the model's reading as it was
+    assert CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0).reader.ranker is not None
 
 
 def test_pick_ratios_measure_against_the_best():

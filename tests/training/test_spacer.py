@@ -1,5 +1,6 @@
-"""training/spacer.py: the spacing guesser — the numpy guesser is the torch net, its examples are the generator's
-own parameters, training resumes where it stopped, and the export is read back by the runtime."""
+"""training/spacer.py: the spacing guesser — an old model's numpy guesser converts to a graph of the same guesses, its
+examples are the generator's own parameters, training resumes where it stopped, and the export is read back by the
+runtime."""
 
 from __future__ import annotations
 
@@ -11,19 +12,35 @@ import numpy as np
 import pytest
 import torch
 
-from curve_vae.inference.manifest import Manifest, ModelLoadError
+from curve_vae.errors import InvalidInput
+from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.inference.spacer import GRID, Spacer
+from curve_vae.inference.spacer import GRID, SPACER_KIND
 from curve_vae.training.spacer import SpacerNet, export_spacer, paper_examples, train_spacer
+from tests.parts import save_npz, spacer_weights
 
 
-def test_the_numpy_guesser_is_the_torch_net():
-    torch.manual_seed(1)
-    net = SpacerNet().eval()
+def test_an_old_models_numpy_guesser_converts_to_a_graph_of_the_same_guesses(tmp_path: Path, closest_model_dir: Path):
+    model = tmp_path / "model"
+    shutil.copytree(closest_model_dir, model)
+    weights = spacer_weights(2)
+    npz = save_npz(model / "spacer.npz", SPACER_KIND, weights)
+    manifest = json.loads((model / "manifest.json").read_text())
+    manifest["files"]["spacer.npz"] = file_entry(npz).model_dump()
+    manifest["spacer"] = {"file": "spacer.npz", "kind": SPACER_KIND, "note": "trained so"}
+    (model / "manifest.json").write_text(json.dumps(manifest))
+    assert export_spacer(npz, model) == model / "spacer.onnx"
+    after = json.loads((model / "manifest.json").read_text())
+    assert after["spacer"] == {**manifest["spacer"], "file": "spacer.onnx"} and "spacer.npz" not in after["files"]
     x, _ = paper_examples(np.random.default_rng(2), 6)
     with torch.no_grad():
-        expected = net(torch.from_numpy(x)).numpy()
-    np.testing.assert_allclose(Spacer(net.weights()).grid_params(x), expected, atol=2e-6)
+        expected = SpacerNet.from_weights(weights).eval()(torch.from_numpy(x)).numpy()
+    spacer = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0).reader.spacer
+    assert spacer is not None
+    np.testing.assert_allclose(spacer.grid_params(x), expected, atol=2e-6)
+    narrower = {**weights, "dilations": np.array([1, 2])}
+    with pytest.raises(InvalidInput, match="dilations"):
+        SpacerNet.from_weights(narrower)
 
 
 def test_the_examples_are_the_papers_curves_at_their_own_parameters_reversed_and_mirrored_alike():
@@ -60,6 +77,6 @@ def test_training_resumes_where_it_stopped_and_the_export_is_the_models_guesser(
     runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
     assert runtime.reader.spacer is not None
 
-    (model / "spacer.npz").write_bytes((model / "spacer.npz").read_bytes()[:-10])  # damaged after export
-    with pytest.raises(ModelLoadError, match="spacer.npz"):
+    (model / "spacer.onnx").write_bytes((model / "spacer.onnx").read_bytes()[:-10])  # damaged after export
+    with pytest.raises(ModelLoadError, match="spacer.onnx"):
         CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)

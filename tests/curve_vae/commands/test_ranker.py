@@ -54,9 +54,9 @@ def test_the_command_line_keeps_a_models_ranker_unless_forced(
     model = tmp_path / "model"
     shutil.copytree(closest_model_dir, model)
     assert main(["ranker", "export", str(best), "--model-dir", str(model)]) == 0
-    kept = (model / "ranker.npz").read_bytes(), (model / "manifest.json").read_text()
+    kept = (model / "ranker.onnx").read_bytes(), (model / "manifest.json").read_text()
     assert main(["ranker", "export", str(best), "--model-dir", str(model), "--version", "2.0.0"]) == 2
-    assert ((model / "ranker.npz").read_bytes(), (model / "manifest.json").read_text()) == kept
+    assert ((model / "ranker.onnx").read_bytes(), (model / "manifest.json").read_text()) == kept
     assert main(["ranker", "export", str(best), "--model-dir", str(model), "--version", "2.0.0", "--force"]) == 0
     assert Manifest.read(model).version == "2.0.0"
 
@@ -76,7 +76,7 @@ def test_export_makes_learned_the_models_reading_unless_told_not_to(
     manifest = Manifest.read(model)
     assert manifest.reading.pose == (pose or was) and manifest.ranker is not None
     assert "two chunks" in (model / "manifest.json").read_text()
-    assert capsys.readouterr().out.startswith(f"wrote {model / 'ranker.npz'}; ")
+    assert capsys.readouterr().out.startswith(f"wrote {model / 'ranker.onnx'}; ")
 
 
 def test_label_refuses_a_family_it_does_not_know(closest_model_dir: Path, tmp_path: Path, capsys):

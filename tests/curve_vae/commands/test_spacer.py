@@ -24,9 +24,9 @@ def test_train_then_export_and_the_export_keeps_a_models_guesser_unless_forced(
     shutil.copytree(closest_model_dir, model)
     assert main(["spacer", "export", str(best), "--model-dir", str(model), "--note", "two seconds"]) == 0
     assert Manifest.read(model).spacer is not None
-    kept = (model / "spacer.npz").read_bytes(), (model / "manifest.json").read_text()
+    kept = (model / "spacer.onnx").read_bytes(), (model / "manifest.json").read_text()
     assert main(["spacer", "export", str(best), "--model-dir", str(model), "--version", "2.0.0"]) == 2
     assert "--force" in capsys.readouterr().err
-    assert ((model / "spacer.npz").read_bytes(), (model / "manifest.json").read_text()) == kept
+    assert ((model / "spacer.onnx").read_bytes(), (model / "manifest.json").read_text()) == kept
     assert main(["spacer", "export", str(best), "--model-dir", str(model), "--version", "2.0.0", "--force"]) == 0
     assert Manifest.read(model).version == "2.0.0"
