@@ -67,9 +67,6 @@ GUESSED_NATURAL_STEPS = (6, 12)
 #: polygons 2.7% and waves 1.4% farther, airfoils, NACA sections and closed outlines as before, no answer more
 #: crossing itself; a 128-curve default request reads 13.1 candidates a curve instead of 17.7 (docs/RESULTS.md).
 GUESSED_ARC_READING = "loops_and_corners"
-#: Pose "learned" encodes a curve's first candidate alone where the ranker expects its second to come back more than
-#: this farther (the natural log of the ratio of their errors): inf, both always.
-CONFIDENT_MARGIN = float("inf")
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -196,7 +193,7 @@ class Reader:
             chosen = min(expected, key=expected.__getitem__)
             score = np.where(pose == chosen, score, np.inf)
         keep = [
-            _confident(_distinct(rows[np.argsort(score[rows], kind="stable")], models, RANKED_READS), score)
+            _distinct(rows[np.argsort(score[rows], kind="stable")], models, RANKED_READS)
             for rows in (np.flatnonzero((owner == i) & (score < np.inf)) for i in np.unique(owner))
         ]
         return np.sort(np.concatenate(keep))
@@ -347,14 +344,6 @@ def _distinct(ranked: np.ndarray, models: np.ndarray, count: int) -> np.ndarray:
         if all(np.abs(models[k] - models[j]).max() > SAME_POINTS for j in kept):
             kept.append(int(k))
     return np.array(kept)
-
-
-def _confident(kept: np.ndarray, score: np.ndarray) -> np.ndarray:
-    """`kept` (a curve's ranked candidates, best first), or its first alone where the ranker expects the second to
-    come back more than CONFIDENT_MARGIN farther (natural log of the ratio of their errors)."""
-    if len(kept) > 1 and score[kept[1]] - score[kept[0]] > CONFIDENT_MARGIN:
-        return kept[:1]
-    return kept
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:
