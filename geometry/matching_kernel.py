@@ -35,6 +35,128 @@ def _at(
 
 
 @_compiled()
+def _nearest(samples: np.ndarray, pts: np.ndarray, idx: np.ndarray) -> bool:
+    """Each point's nearest sample into idx, the ends at the spline's ends, in float32 as the programme measures it;
+    whether they run out of order anywhere."""
+    n, m = len(pts), len(samples)
+    tangled = False
+    idx[0] = 0
+    for i in range(1, n):
+        if i == n - 1:
+            idx[i] = m - 1
+        else:
+            px, py = np.float32(pts[i, 0]), np.float32(pts[i, 1])
+            best = np.float32(np.inf)
+            at = 0
+            for j in range(m):
+                dx = samples[j, 0] - px
+                dy = samples[j, 1] - py
+                dd = dx * dx + dy * dy
+                if dd < best:
+                    best = dd
+                    at = j
+            idx[i] = at
+        if idx[i] < idx[i - 1]:
+            tangled = True
+    return tangled
+
+
+@_compiled()
+def _programme(samples: np.ndarray, pts: np.ndarray, idx: np.ndarray) -> None:
+    """The order-keeping match of least total squared distance, ends to ends, into idx (a dynamic programme over
+    points × samples, float32)."""
+    n, m = len(pts), len(samples)
+    cost = np.empty((n, m), np.float32)
+    for j in range(m):
+        cost[0, j] = np.float32(np.inf)
+    dx = samples[0, 0] - np.float32(pts[0, 0])
+    dy = samples[0, 1] - np.float32(pts[0, 1])
+    cost[0, 0] = dx * dx + dy * dy
+    for i in range(1, n):
+        px, py = np.float32(pts[i, 0]), np.float32(pts[i, 1])
+        running = np.float32(np.inf)
+        for j in range(m):
+            if cost[i - 1, j] < running:
+                running = cost[i - 1, j]
+            dx = samples[j, 0] - px
+            dy = samples[j, 1] - py
+            cost[i, j] = running + (dx * dx + dy * dy)
+    j = m - 1
+    for i in range(n - 1, 0, -1):
+        idx[i] = j
+        best = cost[i - 1, 0]
+        at = 0
+        for jj in range(1, j + 1):
+            if cost[i - 1, jj] < best:
+                best = cost[i - 1, jj]
+                at = jj
+        j = at
+    idx[0] = 0
+
+
+@_compiled()
+def _polish(
+    poly: np.ndarray,
+    first: np.ndarray,
+    last: np.ndarray,
+    pts: np.ndarray,
+    u: np.ndarray,
+    step: float,
+    newton: int,
+    r: np.ndarray,
+) -> None:
+    """Newton on each inner point's squared distance from its sample's parameter u, within a sample's step either
+    side, a step that takes it further not taken; the ends stay at 0 and 1. The residuals (spline - point) into r."""
+    n, spans = len(pts), poly.shape[0]
+    ev = np.empty((3, 2))
+    lo = np.empty(n)
+    hi = np.empty(n)
+    t = np.empty((n, 2))
+    k = np.empty((n, 2))
+    for i in range(n):
+        lo[i] = min(max(u[i] - step, 0.0), 1.0)
+        hi[i] = min(max(u[i] + step, 0.0), 1.0)
+    u[0], u[n - 1] = 0.0, 1.0
+    for i in range(n):
+        _at(poly, spans, u[i], 2, first, last, ev)
+        r[i, 0], r[i, 1] = ev[0, 0] - pts[i, 0], ev[0, 1] - pts[i, 1]
+        t[i, 0], t[i, 1], k[i, 0], k[i, 1] = ev[1, 0], ev[1, 1], ev[2, 0], ev[2, 1]
+    for s in range(newton):
+        order = 0 if s == newton - 1 else 2
+        for i in range(1, n - 1):
+            grad = r[i, 0] * t[i, 0] + r[i, 1] * t[i, 1]
+            curv = (t[i, 0] * t[i, 0] + t[i, 1] * t[i, 1]) + (r[i, 0] * k[i, 0] + r[i, 1] * k[i, 1])
+            moved = u[i] - (grad / curv if curv > 0 else 0.0)
+            moved = min(max(moved, lo[i]), hi[i])
+            _at(poly, spans, moved, order, first, last, ev)
+            rx, ry = ev[0, 0] - pts[i, 0], ev[0, 1] - pts[i, 1]
+            if rx * rx + ry * ry < r[i, 0] * r[i, 0] + r[i, 1] * r[i, 1]:
+                u[i] = moved
+                r[i, 0], r[i, 1] = rx, ry
+                if order:
+                    t[i, 0], t[i, 1], k[i, 0], k[i, 1] = ev[1, 0], ev[1, 1], ev[2, 0], ev[2, 1]
+
+
+@_compiled()
+def _in_order(
+    poly: np.ndarray, first: np.ndarray, last: np.ndarray, pts: np.ndarray, u: np.ndarray, r: np.ndarray
+) -> float:
+    """The parameters made a running maximum (a point polished back past the one before it goes where that one is,
+    its residual with it); the sum of squared residuals."""
+    ev = np.empty((3, 2))
+    total = 0.0
+    top = -np.inf
+    for i in range(len(pts)):
+        if u[i] < top:
+            u[i] = top
+            _at(poly, poly.shape[0], u[i], 0, first, last, ev)
+            r[i, 0], r[i, 1] = ev[0, 0] - pts[i, 0], ev[0, 1] - pts[i, 1]
+        top = u[i]
+        total += r[i, 0] * r[i, 0] + r[i, 1] * r[i, 1]
+    return total
+
+
+@_compiled()
 def place(
     poly: np.ndarray,
     ctrl: np.ndarray,
@@ -51,101 +173,18 @@ def place(
     spans, 4, 2), control points (B, n_ctrl, 2), even samples (B, m, 2) float32 at `grid`): their parameters into
     u_out (N,), the sum of squared distances into distance (B,) (geometry.matching.ordered_closest_params).
     programme: run the dynamic programme on every curve, not only where the nearest samples run out of order."""
-    spans = poly.shape[1]
-    m = samples.shape[1]
-    step = 1.0 / (m - 1)
-    ev = np.empty((3, 2))
+    step = 1.0 / (samples.shape[1] - 1)
     for b in range(len(offsets) - 1):
-        a0, a1 = offsets[b], offsets[b + 1]
-        n = a1 - a0
-        first = ctrl[b, 0]
-        last = ctrl[b, ctrl.shape[1] - 1]
+        own = pts[offsets[b] : offsets[b + 1]]
+        n = len(own)
         idx = np.empty(n, np.int64)
-        tangled = False
-        for i in range(n):  # each point's nearest sample, in float32 as the programme below measures it
-            if i == 0:
-                idx[i] = 0
-                continue
-            if i == n - 1:
-                idx[i] = m - 1
-            else:
-                px, py = np.float32(pts[a0 + i, 0]), np.float32(pts[a0 + i, 1])
-                best = np.float32(np.inf)
-                at = 0
-                for j in range(m):
-                    dx = samples[b, j, 0] - px
-                    dy = samples[b, j, 1] - py
-                    dd = dx * dx + dy * dy
-                    if dd < best:
-                        best = dd
-                        at = j
-                idx[i] = at
-            if idx[i] < idx[i - 1]:
-                tangled = True
-        if tangled or programme:  # the order-keeping match of least total squared distance, ends to ends
-            cost = np.empty((n, m), np.float32)
-            for j in range(m):
-                cost[0, j] = np.float32(np.inf)
-            dx = samples[b, 0, 0] - np.float32(pts[a0, 0])
-            dy = samples[b, 0, 1] - np.float32(pts[a0, 1])
-            cost[0, 0] = dx * dx + dy * dy
-            for i in range(1, n):
-                px, py = np.float32(pts[a0 + i, 0]), np.float32(pts[a0 + i, 1])
-                running = np.float32(np.inf)
-                for j in range(m):
-                    if cost[i - 1, j] < running:
-                        running = cost[i - 1, j]
-                    dx = samples[b, j, 0] - px
-                    dy = samples[b, j, 1] - py
-                    cost[i, j] = running + (dx * dx + dy * dy)
-            j = m - 1
-            for i in range(n - 1, 0, -1):
-                idx[i] = j
-                best = cost[i - 1, 0]
-                at = 0
-                for jj in range(1, j + 1):
-                    if cost[i - 1, jj] < best:
-                        best = cost[i - 1, jj]
-                        at = jj
-                j = at
-            idx[0] = 0
+        if _nearest(samples[b], own, idx) or programme:
+            _programme(samples[b], own, idx)
         u = np.empty(n)
-        lo = np.empty(n)
-        hi = np.empty(n)
-        r = np.empty((n, 2))
-        t = np.empty((n, 2))
-        k = np.empty((n, 2))
         for i in range(n):
             u[i] = grid[idx[i]]
-            lo[i] = min(max(u[i] - step, 0.0), 1.0)
-            hi[i] = min(max(u[i] + step, 0.0), 1.0)
-        u[0], u[n - 1] = 0.0, 1.0
-        for i in range(n):
-            _at(poly[b], spans, u[i], 2, first, last, ev)
-            r[i, 0], r[i, 1] = ev[0, 0] - pts[a0 + i, 0], ev[0, 1] - pts[a0 + i, 1]
-            t[i, 0], t[i, 1], k[i, 0], k[i, 1] = ev[1, 0], ev[1, 1], ev[2, 0], ev[2, 1]
-        for s in range(newton):  # Newton on each inner point's squared distance, a step that takes it further not taken
-            order = 0 if s == newton - 1 else 2
-            for i in range(1, n - 1):
-                grad = r[i, 0] * t[i, 0] + r[i, 1] * t[i, 1]
-                curv = (t[i, 0] * t[i, 0] + t[i, 1] * t[i, 1]) + (r[i, 0] * k[i, 0] + r[i, 1] * k[i, 1])
-                moved = u[i] - (grad / curv if curv > 0 else 0.0)
-                moved = min(max(moved, lo[i]), hi[i])
-                _at(poly[b], spans, moved, order, first, last, ev)
-                rx, ry = ev[0, 0] - pts[a0 + i, 0], ev[0, 1] - pts[a0 + i, 1]
-                if rx * rx + ry * ry < r[i, 0] * r[i, 0] + r[i, 1] * r[i, 1]:
-                    u[i] = moved
-                    r[i, 0], r[i, 1] = rx, ry
-                    if order:
-                        t[i, 0], t[i, 1], k[i, 0], k[i, 1] = ev[1, 0], ev[1, 1], ev[2, 0], ev[2, 1]
-        total = 0.0
-        top = -np.inf
-        for i in range(n):  # in order: a running maximum
-            if u[i] < top:
-                u[i] = top
-                _at(poly[b], spans, u[i], 0, first, last, ev)
-                r[i, 0], r[i, 1] = ev[0, 0] - pts[a0 + i, 0], ev[0, 1] - pts[a0 + i, 1]
-            top = u[i]
-            u_out[a0 + i] = u[i]
-            total += r[i, 0] * r[i, 0] + r[i, 1] * r[i, 1]
-        distance[b] = total
+        r = np.empty((n, 2))
+        first, last = ctrl[b, 0], ctrl[b, ctrl.shape[1] - 1]
+        _polish(poly[b], first, last, own, u, step, newton, r)
+        distance[b] = _in_order(poly[b], first, last, own, u, r)
+        u_out[offsets[b] : offsets[b + 1]] = u

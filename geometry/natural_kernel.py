@@ -84,14 +84,19 @@ def _weights(t: np.ndarray, u: float, sp: int, b: np.ndarray, s: np.ndarray) -> 
 
 
 @_compiled()
-def _evaluate(t, u, ctrl, pts, spans, b, s, r) -> float:
-    """Each point's span, weights and slopes at u, its residual r = spline(u) − point; the cost Σ r²."""
-    nc = len(ctrl)
-    cost = 0.0
+def _basis(t: np.ndarray, u: np.ndarray, nc: int, spans: np.ndarray, b: np.ndarray, s: np.ndarray) -> None:
+    """Each parameter's (clipped to [0, 1]) knot span, four weights and their slopes into spans, b and s."""
     for i in range(len(u)):
         ui = min(max(u[i], 0.0), 1.0)
         spans[i] = _span(t, ui, nc)
         _weights(t, ui, spans[i], b[i], s[i])
+
+
+@_compiled()
+def _residuals(ctrl: np.ndarray, pts: np.ndarray, spans: np.ndarray, b: np.ndarray, r: np.ndarray) -> float:
+    """Each point's residual r = spline − point from its basis; the cost Σ r²."""
+    cost = 0.0
+    for i in range(len(pts)):
         x = 0.0
         y = 0.0
         for a in range(4):
@@ -104,6 +109,13 @@ def _evaluate(t, u, ctrl, pts, spans, b, s, r) -> float:
 
 
 @_compiled()
+def _evaluate(t, u, ctrl, pts, spans, b, s, r) -> float:
+    """Each point's span, weights and slopes at u, its residual r = spline(u) − point; the cost Σ r²."""
+    _basis(t, u, len(ctrl), spans, b, s)
+    return _residuals(ctrl, pts, spans, b, r)
+
+
+@_compiled()
 def fit_start(t: np.ndarray, pts: np.ndarray, u: np.ndarray, ctrl: np.ndarray, cost: np.ndarray) -> None:
     """Each row's least-squares control points (K, nc, 2) at its parameters u (K, n) and their cost (K,)."""
     k_rows, n = u.shape
@@ -113,11 +125,10 @@ def fit_start(t: np.ndarray, pts: np.ndarray, u: np.ndarray, ctrl: np.ndarray, c
     s = np.empty((n, 4))
     r = np.empty((n, 2))
     for k in range(k_rows):
+        _basis(t, u[k], nc, spans, b, s)
         btb = 1e-12 * np.eye(nc)
         rhs = np.zeros((nc, 2))
         for i in range(n):
-            spans[i] = _span(t, min(max(u[k, i], 0.0), 1.0), nc)
-            _weights(t, min(max(u[k, i], 0.0), 1.0), spans[i], b[i], s[i])
             o = spans[i] - 3
             for a in range(4):
                 rhs[o + a, 0] += b[i, a] * pts[k, i, 0]
@@ -125,7 +136,96 @@ def fit_start(t: np.ndarray, pts: np.ndarray, u: np.ndarray, ctrl: np.ndarray, c
                 for c in range(4):
                     btb[o + a, o + c] += b[i, a] * b[i, c]
         ctrl[k] = np.linalg.solve(btb, rhs)
-        cost[k] = _evaluate(t, u[k], ctrl[k], pts[k], spans, b, s, r)
+        cost[k] = _residuals(ctrl[k], pts[k], spans, b, r)
+
+
+@_compiled()
+def _normal_equations(
+    ctrl: np.ndarray,
+    spans: np.ndarray,
+    b: np.ndarray,
+    s: np.ndarray,
+    r: np.ndarray,
+    lam: float,
+    tan: np.ndarray,
+    uu: np.ndarray,
+    gu: np.ndarray,
+    schur: np.ndarray,
+    rhs: np.ndarray,
+    diag: np.ndarray,
+) -> None:
+    """One row's damped normal equations with each point's parameter eliminated (its Schur complement, 2nc × 2nc,
+    from 4×4 blocks of the basis), into schur and rhs; each point's tangent, damped curvature term uu and gradient gu
+    kept for the parameters' step (`_moved`). The ends' parameters stay where they are."""
+    n, nc = len(spans), len(ctrl)
+    schur[:] = 0.0
+    rhs[:] = 0.0
+    diag[:] = 0.0
+    for i in range(n):
+        o = spans[i] - 3
+        tx = 0.0
+        ty = 0.0
+        if 0 < i < n - 1:  # the ends stay where they are
+            for a in range(4):
+                tx += s[i, a] * ctrl[o + a, 0]
+                ty += s[i, a] * ctrl[o + a, 1]
+        tan[i, 0], tan[i, 1] = tx, ty
+        uu[i] = (tx * tx + ty * ty) * (1.0 + lam) + 1e-12
+        gu[i] = tx * r[i, 0] + ty * r[i, 1]
+        wxx = 1.0 - tx * tx / uu[i]
+        wyy = 1.0 - ty * ty / uu[i]
+        wxy = -tx * ty / uu[i]
+        ex = r[i, 0] - tx * gu[i] / uu[i]
+        ey = r[i, 1] - ty * gu[i] / uu[i]
+        for a in range(4):
+            ja = o + a
+            diag[ja] += b[i, a] * b[i, a]
+            rhs[ja] += b[i, a] * ex
+            rhs[nc + ja] += b[i, a] * ey
+            for c in range(4):
+                bb = b[i, a] * b[i, c]
+                jc = o + c
+                schur[ja, jc] += bb * wxx
+                schur[nc + ja, nc + jc] += bb * wyy
+                schur[ja, nc + jc] += bb * wxy
+                schur[nc + ja, jc] += bb * wxy
+    for j in range(nc):
+        schur[j, j] += lam * diag[j]
+        schur[nc + j, nc + j] += lam * diag[j]
+    for j in range(2 * nc):
+        schur[j, j] += 1e-14
+
+
+@_compiled()
+def _moved(
+    u: np.ndarray,
+    spans: np.ndarray,
+    b: np.ndarray,
+    dc: np.ndarray,
+    tan: np.ndarray,
+    uu: np.ndarray,
+    gu: np.ndarray,
+    u2: np.ndarray,
+) -> None:
+    """The parameters after the control points' step dc (back-substituted into each point's own), clipped to [0, 1]
+    and never falling, the ends at 0 and 1, into u2."""
+    n, nc = len(u), len(dc) // 2
+    top = 0.0
+    for i in range(n):
+        o = spans[i] - 3
+        dx = 0.0
+        dy = 0.0
+        for a in range(4):
+            dx += b[i, a] * dc[o + a]
+            dy += b[i, a] * dc[nc + o + a]
+        v = u[i] - (gu[i] - (dx * tan[i, 0] + dy * tan[i, 1])) / uu[i]
+        v = min(max(v, 0.0), 1.0)
+        if i > 0 and v < top:  # never falling
+            v = top
+        top = v
+        u2[i] = v
+    u2[0] = 0.0
+    u2[n - 1] = 1.0
 
 
 @_compiled()
@@ -165,64 +265,14 @@ def lm_steps(
             lam = damping[k]
             if lam > 1e8:
                 break
-            schur[:] = 0.0
-            rhs[:] = 0.0
-            diag[:] = 0.0
-            for i in range(n):
-                o = spans[i] - 3
-                tx = 0.0
-                ty = 0.0
-                if 0 < i < n - 1:  # the ends stay where they are
-                    for a in range(4):
-                        tx += s[i, a] * ctrl[k, o + a, 0]
-                        ty += s[i, a] * ctrl[k, o + a, 1]
-                tan[i, 0], tan[i, 1] = tx, ty
-                uu[i] = (tx * tx + ty * ty) * (1.0 + lam) + 1e-12
-                gu[i] = tx * r[i, 0] + ty * r[i, 1]
-                wxx = 1.0 - tx * tx / uu[i]
-                wyy = 1.0 - ty * ty / uu[i]
-                wxy = -tx * ty / uu[i]
-                ex = r[i, 0] - tx * gu[i] / uu[i]
-                ey = r[i, 1] - ty * gu[i] / uu[i]
-                for a in range(4):
-                    ja = o + a
-                    diag[ja] += b[i, a] * b[i, a]
-                    rhs[ja] += b[i, a] * ex
-                    rhs[nc + ja] += b[i, a] * ey
-                    for c in range(4):
-                        bb = b[i, a] * b[i, c]
-                        jc = o + c
-                        schur[ja, jc] += bb * wxx
-                        schur[nc + ja, nc + jc] += bb * wyy
-                        schur[ja, nc + jc] += bb * wxy
-                        schur[nc + ja, jc] += bb * wxy
-            for j in range(nc):
-                schur[j, j] += lam * diag[j]
-                schur[nc + j, nc + j] += lam * diag[j]
-            for j in range(2 * nc):
-                schur[j, j] += 1e-14
+            _normal_equations(ctrl[k], spans, b, s, r, lam, tan, uu, gu, schur, rhs, diag)
             dc = np.linalg.solve(schur, rhs)
             for j in range(nc):
                 ctrl2[j, 0] = ctrl[k, j, 0] - dc[j]
                 ctrl2[j, 1] = ctrl[k, j, 1] - dc[nc + j]
-            top = 0.0
-            for i in range(n):
-                o = spans[i] - 3
-                dx = 0.0
-                dy = 0.0
-                for a in range(4):
-                    dx += b[i, a] * dc[o + a]
-                    dy += b[i, a] * dc[nc + o + a]
-                v = u[k, i] - (gu[i] - (dx * tan[i, 0] + dy * tan[i, 1])) / uu[i]
-                v = min(max(v, 0.0), 1.0)
-                if i > 0 and v < top:  # never falling
-                    v = top
-                top = v
-                u2[i] = v
-            u2[0] = 0.0
-            u2[n - 1] = 1.0
+            _moved(u[k], spans, b, dc, tan, uu, gu, u2)
             cost2 = _evaluate(t, u2, ctrl2, pts[k], spans2, b2, s2, r2)
-            if cost2 < cost[k]:
+            if cost2 < cost[k]:  # kept: the step's basis becomes the row's
                 u[k, :] = u2
                 ctrl[k, :, :] = ctrl2
                 cost[k] = cost2
