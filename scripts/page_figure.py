@@ -12,33 +12,20 @@ from __future__ import annotations
 import argparse
 import os
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
-from playwright.sync_api import Page, sync_playwright
+from playwright.sync_api import sync_playwright
 
 from curve_vae.files import atomic_path
 from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+from tests.e2e.drawing import arc, draw  # noqa: E402 - the page tests' own strokes
+
 ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking"]
-
-
-def arc(cx: float, cy: float, r: float, a0: float, a1: float, n: int = 30) -> list[tuple[float, float]]:
-    t = np.linspace(a0, a1, n)
-    return list(zip(cx + r * np.cos(t), cy + r * np.sin(t)))
-
-
-def draw(page: Page, points: list[tuple[float, float]]) -> None:
-    """A stroke, points in board units (1000 × 700)."""
-    box = page.locator("#board").bounding_box()
-    assert box is not None
-    at = [(box["x"] + x / 1000 * box["width"], box["y"] + y / 700 * box["height"]) for x, y in points]
-    page.mouse.move(*at[0])
-    page.mouse.down()
-    for p in at[1:]:
-        page.mouse.move(*p, steps=2)
-    page.mouse.up()
 
 
 def main() -> None:

@@ -135,3 +135,8 @@ Seed = Annotated[
         "randomness, and the response reports the seed it drew.",
     ),
 ]
+
+
+#: A latent distribution by name, as /sample and /explore take it and GET /model lists them: "learned" (shipped with
+#: the model), "standard" (N(0, I)) or a prior fitted to a user's curves.
+PriorName = Annotated[str | None, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]*$", max_length=100)]

@@ -26,6 +26,7 @@ from curve_vae.service.fields import (  # noqa: F401  (FrameInfo: part of the sc
     MetricsFlag,
     NPoints,
     OutputMode,
+    PriorName,
     Seed,
     _Request,
     reading_field,
@@ -114,10 +115,8 @@ class ExploreRequest(CurvesIn, ReadingIn, OutputIn):
     directions: int = Field(
         2, ge=1, le=4, strict=True, description="How many principal directions, the largest variance first."
     )
-    prior: str | None = Field(
+    prior: PriorName = Field(
         None,
-        pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]*$",
-        max_length=100,
         description="The latent distribution whose principal directions are followed, as /sample names them "
         '(omitted: learned where the model ships it; "standard": the latent\'s first axes).',
     )
@@ -174,10 +173,8 @@ class SampleRequest(_Request, OutputIn):
         "temperature² (standard prior: z ~ N(0, temperature²·I)). 1 is the distribution itself; below 1 stays "
         "near typical shapes, 0 gives the component means.",
     )
-    prior: str | None = Field(
+    prior: PriorName = Field(
         None,
-        pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]*$",
-        max_length=100,
         description='"learned": the Gaussian mixture fitted to the latent means of the training curves, shipped '
         "with the model: curves like the data. \"standard\": the VAE's prior N(0, I), which the encoder's latents "
         "do not fill (small, tangled curves). Any other name: a prior fitted to a user's own curves and loaded "

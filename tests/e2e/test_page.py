@@ -31,6 +31,8 @@ if not Path(CHROMIUM).exists():
 
 from playwright.sync_api import Browser, Page, sync_playwright  # noqa: E402
 
+from tests.e2e.drawing import arc, draw  # noqa: E402,F401 - the page tests import them from here too
+
 pytestmark = pytest.mark.integration
 
 ARGS = [
@@ -68,23 +70,6 @@ def open_page(browser: Browser, url: str, *, width: int = 1280, height: int = 90
     page.on("pageerror", lambda e: errors.append(f"page error: {e}"))
     page.goto(url)
     return page, errors
-
-
-def draw(page: Page, points: list[tuple[float, float]]) -> None:
-    """A stroke with mouse events, points in board units (1000 × 700)."""
-    box = page.locator("#board").bounding_box()
-    assert box is not None
-    at = [(box["x"] + x / 1000 * box["width"], box["y"] + y / 700 * box["height"]) for x, y in points]
-    page.mouse.move(*at[0])
-    page.mouse.down()
-    for p in at[1:]:
-        page.mouse.move(*p, steps=2)
-    page.mouse.up()
-
-
-def arc(cx: float, cy: float, r: float, a0: float, a1: float, n: int = 30) -> list[tuple[float, float]]:
-    t = np.linspace(a0, a1, n)
-    return list(zip(cx + r * np.cos(t), cy + r * np.sin(t)))
 
 
 def drawn(page: Page, selector: str) -> np.ndarray:
