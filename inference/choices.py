@@ -50,8 +50,9 @@ POSE = Option(
         "search": "six poses (the chord turned to -90°, -45° or -135°, each also reversed and mirrored end for end) "
         "encoded and decoded, the reconstruction closest to the input kept (6× the inference).",
         "learned": 'the same candidates (and, with spacing "search", each one\'s natural reading) ranked by the '
-        "model's reading ranker from their points, only the first two encoded and the closer kept (2× the "
-        "inference; needs a model with a ranker, GET /model: ranker).",
+        "model's reading ranker from their points; the first encoded, the second too where the first came back "
+        "farther than 0.05% of the curve's size, and the closer kept (1–2× the inference; needs a model with a "
+        "ranker, GET /model: ranker).",
         "as_is": "the curve as it is listed.",
     },
     before='How a curve is turned before it is encoded (frame "auto").',

@@ -67,6 +67,9 @@ GUESSED_NATURAL_STEPS = (6, 12)
 #: polygons 2.7% and waves 1.4% farther, airfoils, NACA sections and closed outlines as before, no answer more
 #: crossing itself; a 128-curve default request reads 13.1 candidates a curve instead of 17.7 (docs/RESULTS.md).
 GUESSED_ARC_READING = "loops_and_corners"
+#: Pose "learned" reads each curve's second-ranked candidate only where its first came back farther than this (RMS
+#: distance ÷ the curve's bounding-box diagonal, as `closeness` states it); RANKED_READS at most.
+CLOSE_ENOUGH = 0.0005
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -156,18 +159,16 @@ class Reader:
             inputs, index, stage, n_points=self.graphs.n_points, model_size=self.graphs.model_size
         )
         if reading.pose == "learned" and stage:
-            keep = self._ranked(stage, models, shared=shared)
+            ranked = self._ranked(stage, models, shared=shared)
+            if not shared and self.closest:
+                return self._first_then_second(inputs, index, stage, models, fractions, ranked)
+            keep = np.sort(np.concatenate(ranked))
             stage, models, fractions = [stage[k] for k in keep], models[keep], [fractions[k] for k in keep]
         if not stage:
             return []
-        with np.errstate(all="ignore"):
-            mean, log_var = self.graphs.encode(models)
-        _check_finite(mean, log_var, [index[c.curve] for c in stage])
+        rows = self._encoded(stage, models, fractions, index)
         if len(stage) == len(inputs):  # one candidate each: nothing to choose
-            return [
-                ReadCurve(c.frame, m, fr, mu, lv) for c, m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)
-            ]
-        rows = [ReadCurve(c.frame, m, fr, mu, lv) for c, m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)]
+            return rows
         owners = [c.curve for c in stage]
         rows, err = self._decoded([inputs[o] for o in owners], rows)
         owner = np.asarray(owners)
@@ -176,9 +177,52 @@ class Reader:
         best = [int(np.flatnonzero(owner == i)[err[owner == i].argmin()]) for i in range(len(inputs))]
         return [rows[b] for b in best]
 
-    def _ranked(self, stage: list[Candidate], models: np.ndarray, *, shared: bool) -> np.ndarray:
-        """Which candidates pose "learned" encodes: each curve's RANKED_READS the ranker expects closest; shared: in
-        the one pose whose expected errors (each curve's least, relative to its size) sum least over the set."""
+    def _encoded(
+        self, stage: list[Candidate], models: np.ndarray, fractions: list[Any], index: list[int]
+    ) -> list[ReadCurve]:
+        """The candidates' rows, encoded (InputError naming the request's curve where a latent is not finite)."""
+        with np.errstate(all="ignore"):
+            mean, log_var = self.graphs.encode(models)
+        _check_finite(mean, log_var, [index[c.curve] for c in stage])
+        return [ReadCurve(c.frame, m, fr, mu, lv) for c, m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)]
+
+    def _first_then_second(
+        self,
+        inputs: list[np.ndarray],
+        index: list[int],
+        stage: list[Candidate],
+        models: np.ndarray,
+        fractions: list[Any],
+        ranked: list[np.ndarray],
+    ) -> list[ReadCurve]:
+        """Pose "learned", a curve at a time in two rounds: every curve's first candidate, decoded and placed; then,
+        only where that came back farther than CLOSE_ENOUGH (RMS distance ÷ the curve's bounding-box diagonal), its
+        second, the closer of the two kept."""
+        first = [int(r[0]) for r in ranked]
+        rows, err = self._decoded(
+            inputs, self._encoded([stage[k] for k in first], models[first], [fractions[k] for k in first], index)
+        )
+        size = self.graphs.model_size
+        again = [
+            i
+            for i, r in enumerate(ranked)
+            if len(r) > 1 and not _relative_rms(err[i], inputs[i], stage[first[i]].frame, size) <= CLOSE_ENOUGH
+        ]
+        if again:
+            second = [int(ranked[i][1]) for i in again]
+            more, err2 = self._decoded(
+                [inputs[i] for i in again],
+                self._encoded([stage[k] for k in second], models[second], [fractions[k] for k in second], index),
+            )
+            for i, row, e in zip(again, more, err2):
+                if e < err[i]:
+                    rows[i] = row
+        return rows
+
+    def _ranked(self, stage: list[Candidate], models: np.ndarray, *, shared: bool) -> list[np.ndarray]:
+        """Which candidates pose "learned" encodes, per curve, best first: its RANKED_READS the ranker expects
+        closest; shared: in the one pose whose expected errors (each curve's least, relative to its size) sum least
+        over the set."""
         if self.ranker is None:
             raise InputError(("pose",), 'pose "learned" needs a model with a reading ranker; this one has none')
         score = self.ranker.scores(models)
@@ -192,11 +236,10 @@ class Reader:
             }
             chosen = min(expected, key=expected.__getitem__)
             score = np.where(pose == chosen, score, np.inf)
-        keep = [
+        return [
             _distinct(rows[np.argsort(score[rows], kind="stable")], models, RANKED_READS)
             for rows in (np.flatnonzero((owner == i) & (score < np.inf)) for i in np.unique(owner))
         ]
-        return np.sort(np.concatenate(keep))
 
     @staticmethod
     def _in_shared_pose(inputs: list[np.ndarray], stage: list[Candidate], err: np.ndarray) -> np.ndarray:
@@ -344,6 +387,14 @@ def _distinct(ranked: np.ndarray, models: np.ndarray, count: int) -> np.ndarray:
         if all(np.abs(models[k] - models[j]).max() > SAME_POINTS for j in kept):
             kept.append(int(k))
     return np.array(kept)
+
+
+def _relative_rms(err: float, points: np.ndarray, frame: Frame | None, model_size: float) -> float:
+    """A candidate's squared distances in the model plane (summed over the curve's points) as RMS distance ÷ the
+    curve's bounding-box diagonal (geometry.closeness' figure, before any untangling)."""
+    scale = 1.0 if frame is None else frame.size / model_size  # model-plane units to the caller's
+    diagonal = float(np.hypot(*np.ptp(points, axis=0)))
+    return float(np.sqrt(err / len(points)) * scale / diagonal) if diagonal > 0 else float("inf")
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:

@@ -126,6 +126,34 @@ def test_a_symmetric_curve_is_read_two_different_ways(ranked: CurveRuntime):
     stage = reader._candidates([half_circle], [0], Reading(pose="learned", spacing="parameter"))
     g = ranked.graphs
     models, _ = model_points([half_circle], [0], stage, n_points=g.n_points, model_size=g.model_size)
-    keep = reader._ranked(stage, models, shared=False)
+    (keep,) = reader._ranked(stage, models, shared=False)  # one curve: its candidates, best first
     assert len(keep) == 2 and np.abs(models[keep[0]] - models[keep[1]]).max() > 1e-3
     assert any(np.abs(models[i] - models[j]).max() < 1e-6 for i in range(6) for j in range(i))  # twins exist
+
+
+def test_a_second_candidate_is_read_only_where_the_first_is_not_close_enough(shipped_runtime, monkeypatch):
+    """The shipped model reads a quarter circle close on its first candidate (one encoding) and a wavy paper curve
+    not (two); with CLOSE_ENOUGH at 0 every curve reads both, and the closer of the two is never farther than the
+    first alone."""
+    from curve_vae.inference import reader as reader_module
+    from curve_vae.inference.choices import POSE
+
+    assert f"{reader_module.CLOSE_ENOUGH:.2%}" in POSE.values["learned"]  # the documented margin is the one read
+    t = np.linspace(0.0, np.pi / 2, 60)
+    arc = np.c_[np.cos(t), np.sin(t)] * 100.0
+    wavy = bspline_curves(1, seed=4)[0]
+    rows = shipped_runtime.graphs.rows
+
+    def read(curve: np.ndarray) -> tuple[int, float]:
+        before = rows["encoder"]
+        answer = shipped_runtime.reconstruct([curve])
+        assert answer.closeness is not None
+        return rows["encoder"] - before, float(answer.closeness.rms[0])
+
+    once, arc_rms = read(arc)
+    assert once == 1 and arc_rms <= reader_module.CLOSE_ENOUGH
+    twice, wavy_rms = read(wavy)
+    assert twice == 2 and wavy_rms > reader_module.CLOSE_ENOUGH
+    monkeypatch.setattr(reader_module, "CLOSE_ENOUGH", 0.0)
+    both, closer = read(arc)
+    assert both == 2 and closer <= arc_rms + 1e-12
