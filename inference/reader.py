@@ -195,9 +195,9 @@ class Reader:
         fractions: list[Any],
         ranked: list[np.ndarray],
     ) -> list[ReadCurve]:
-        """Pose "learned", a curve at a time in two rounds: every curve's first candidate, decoded and placed; then,
-        only where that came back farther than CLOSE_ENOUGH (RMS distance ÷ the curve's bounding-box diagonal), its
-        second, the closer of the two kept."""
+        """Pose "learned" in two rounds, all curves at once in each: every curve's first candidate, decoded and
+        placed; then, only where that came back farther than CLOSE_ENOUGH (RMS distance ÷ the curve's bounding-box
+        diagonal), its second, the closer of the two kept."""
         first = [int(r[0]) for r in ranked]
         rows, err = self._decoded(
             inputs, self._encoded([stage[k] for k in first], models[first], [fractions[k] for k in first], index)
