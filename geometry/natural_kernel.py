@@ -84,6 +84,12 @@ def _weights(t: np.ndarray, u: float, sp: int, b: np.ndarray, s: np.ndarray) -> 
 
 
 @_compiled()
+def _row_buffers(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A row's n points' knot spans, basis weights, their slopes and residuals (`_basis`, `_residuals`)."""
+    return np.empty(n, np.int64), np.empty((n, 4)), np.empty((n, 4)), np.empty((n, 2))
+
+
+@_compiled()
 def _basis(t: np.ndarray, u: np.ndarray, nc: int, spans: np.ndarray, b: np.ndarray, s: np.ndarray) -> None:
     """Each parameter's (clipped to [0, 1]) knot span, four weights and their slopes into spans, b and s."""
     for i in range(len(u)):
@@ -120,10 +126,7 @@ def fit_start(t: np.ndarray, pts: np.ndarray, u: np.ndarray, ctrl: np.ndarray, c
     """Each row's least-squares control points (K, nc, 2) at its parameters u (K, n) and their cost (K,)."""
     k_rows, n = u.shape
     nc = ctrl.shape[1]
-    spans = np.empty(n, np.int64)
-    b = np.empty((n, 4))
-    s = np.empty((n, 4))
-    r = np.empty((n, 2))
+    spans, b, s, r = _row_buffers(n)
     for k in range(k_rows):
         _basis(t, u[k], nc, spans, b, s)
         btb = 1e-12 * np.eye(nc)
@@ -243,14 +246,8 @@ def lm_steps(
     spline closer (geometry.natural._BatchFit.run says each term)."""
     k_rows, n = u.shape
     nc = ctrl.shape[1]
-    spans = np.empty(n, np.int64)
-    b = np.empty((n, 4))
-    s = np.empty((n, 4))
-    r = np.empty((n, 2))
-    spans2 = np.empty(n, np.int64)
-    b2 = np.empty((n, 4))
-    s2 = np.empty((n, 4))
-    r2 = np.empty((n, 2))
+    spans, b, s, r = _row_buffers(n)
+    spans2, b2, s2, r2 = _row_buffers(n)  # a step's, kept where it brings the spline closer
     tan = np.empty((n, 2))
     uu = np.empty(n)
     gu = np.empty(n)

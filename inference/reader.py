@@ -34,6 +34,7 @@ from curve_vae.geometry.batch import (
     shared_canonical_frames,
     shared_pose_frames,
 )
+from curve_vae.inference import picking
 from curve_vae.inference.cache import EncodingCache
 from curve_vae.inference.cancel import checkpoint
 from curve_vae.inference.candidates import Candidate, model_points
@@ -41,7 +42,7 @@ from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.prepared import Prepared, ReadCurve
-from curve_vae.inference.ranker import RANKED_READS, Ranker
+from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.spacer import Spacer
 from curve_vae.inference.untangling import untangle_rows
@@ -67,9 +68,6 @@ GUESSED_NATURAL_STEPS = (6, 12)
 #: polygons 2.7% and waves 1.4% farther, airfoils, NACA sections and closed outlines as before, no answer more
 #: crossing itself; a 128-curve default request reads 13.1 candidates a curve instead of 17.7 (docs/RESULTS.md).
 GUESSED_ARC_READING = "loops_and_corners"
-#: Pose "learned" reads each curve's second-ranked candidate only where its first came back farther than this (RMS
-#: distance ÷ the curve's bounding-box diagonal, as `closeness` states it); RANKED_READS at most.
-CLOSE_ENOUGH = 0.0005
 #: Chord directions pose "search" tries (geometry.frame.POSE_CHORDS), each as drawn and reversed-and-mirrored.
 POSE_CHORD_COUNT = 3
 ENCODE_OVERFLOW = 'encodes to non-finite values: coordinates far outside the model\'s plane (use frame "auto")'
@@ -159,7 +157,9 @@ class Reader:
             inputs, index, stage, n_points=self.graphs.n_points, model_size=self.graphs.model_size
         )
         if reading.pose == "learned" and stage:
-            ranked = self._ranked(stage, models, shared=shared)
+            if self.ranker is None:
+                raise InputError(("pose",), 'pose "learned" needs a model with a reading ranker; this one has none')
+            ranked = picking.ranked(self.ranker, stage, models, shared=shared)
             if not shared and self.closest:
                 return self._first_then_second(inputs, index, stage, models, fractions, ranked)
             keep = np.sort(np.concatenate(ranked))
@@ -173,7 +173,7 @@ class Reader:
         rows, err = self._decoded([inputs[o] for o in owners], rows)
         owner = np.asarray(owners)
         if shared:
-            err = self._in_shared_pose(inputs, stage, err)
+            err = picking.in_shared_pose(inputs, stage, err)
         best = [int(np.flatnonzero(owner == i)[err[owner == i].argmin()]) for i in range(len(inputs))]
         return [rows[b] for b in best]
 
@@ -196,8 +196,8 @@ class Reader:
         ranked: list[np.ndarray],
     ) -> list[ReadCurve]:
         """Pose "learned" in two rounds, all curves at once in each: every curve's first candidate, decoded and
-        placed; then, only where that came back farther than CLOSE_ENOUGH (RMS distance ÷ the curve's bounding-box
-        diagonal), its second, the closer of the two kept."""
+        placed; then, only where that did not come back close enough (inference.picking.CLOSE_ENOUGH), its second,
+        the closer of the two kept."""
         first = [int(r[0]) for r in ranked]
         rows, err = self._decoded(
             inputs, self._encoded([stage[k] for k in first], models[first], [fractions[k] for k in first], index)
@@ -206,7 +206,7 @@ class Reader:
         again = [
             i
             for i, r in enumerate(ranked)
-            if len(r) > 1 and not _relative_rms(err[i], inputs[i], stage[first[i]].frame, size) <= CLOSE_ENOUGH
+            if len(r) > 1 and not picking.close_enough(err[i], inputs[i], stage[first[i]].frame, size)
         ]
         if again:
             second = [int(ranked[i][1]) for i in again]
@@ -218,42 +218,6 @@ class Reader:
                 if e < err[i]:
                     rows[i] = row
         return rows
-
-    def _ranked(self, stage: list[Candidate], models: np.ndarray, *, shared: bool) -> list[np.ndarray]:
-        """Which candidates pose "learned" encodes, per curve, best first: its RANKED_READS the ranker expects
-        closest; shared: in the one pose whose expected errors (each curve's least, relative to its size) sum least
-        over the set."""
-        if self.ranker is None:
-            raise InputError(("pose",), 'pose "learned" needs a model with a reading ranker; this one has none')
-        score = self.ranker.scores(models)
-        owner = np.array([c.curve for c in stage])
-        if shared:
-            pose = np.array([c.pose for c in stage])
-            curves = range(int(owner.max()) + 1)
-            expected = {
-                int(p): sum(float(np.exp(score[(pose == p) & (owner == i)].min())) for i in curves)
-                for p in np.unique(pose)
-            }
-            chosen = min(expected, key=expected.__getitem__)
-            score = np.where(pose == chosen, score, np.inf)
-        return [
-            _distinct(rows[np.argsort(score[rows], kind="stable")], models, RANKED_READS)
-            for rows in (np.flatnonzero((owner == i) & (score < np.inf)) for i in np.unique(owner))
-        ]
-
-    @staticmethod
-    def _in_shared_pose(inputs: list[np.ndarray], stage: list[Candidate], err: np.ndarray) -> np.ndarray:
-        """The candidates' errors with every pose but the set's best made infinite: the best pose is the one whose
-        closest candidate per curve (a mean squared distance, so that long curves do not outweigh short ones) sums
-        least over the set; each curve then keeps its closest candidate in that pose (its spacing)."""
-        owner = np.array([c.curve for c in stage])
-        pose = np.array([c.pose for c in stage])
-        per_point = err / np.array([len(inputs[o]) for o in owner])
-        totals = {}
-        for p in np.unique(pose):
-            totals[int(p)] = float(sum(per_point[(pose == p) & (owner == i)].min() for i in range(len(inputs))))
-        chosen = min(totals, key=totals.__getitem__)
-        return np.where(pose == chosen, err, np.inf)
 
     def _candidates(
         self, inputs: list[np.ndarray], index: list[int], reading: Reading, *, shared: bool = False
@@ -371,30 +335,6 @@ class Reader:
             curves = Ragged.of(inputs)
             return curves.split(FrameRows.of(given).to_model(curves, self.graphs.model_size))
         return [f.to_model(p, self.graphs.model_size) if f is not None else p for f, p in zip(frames, inputs)]
-
-
-#: Candidates whose model-plane points all lie within this (plane units; the plane is 128 across) are one reading:
-#: a symmetric curve reversed and mirrored end for end is itself again.
-SAME_POINTS = 1e-3
-
-
-def _distinct(ranked: np.ndarray, models: np.ndarray, count: int) -> np.ndarray:
-    """The first `count` of `ranked` (candidate rows, best first) whose model-plane points differ from those kept."""
-    kept = [int(ranked[0])]
-    for k in ranked[1:]:
-        if len(kept) == count:
-            break
-        if all(np.abs(models[k] - models[j]).max() > SAME_POINTS for j in kept):
-            kept.append(int(k))
-    return np.array(kept)
-
-
-def _relative_rms(err: float, points: np.ndarray, frame: Frame | None, model_size: float) -> float:
-    """A candidate's squared distances in the model plane (summed over the curve's points) as RMS distance ÷ the
-    curve's bounding-box diagonal (geometry.closeness' figure, before any untangling)."""
-    scale = 1.0 if frame is None else frame.size / model_size  # model-plane units to the caller's
-    diagonal = float(np.hypot(*np.ptp(points, axis=0)))
-    return float(np.sqrt(err / len(points)) * scale / diagonal) if diagonal > 0 else float("inf")
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:

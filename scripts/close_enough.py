@@ -1,5 +1,5 @@
 """Pose "learned" reads a curve's second-ranked candidate only where its first came back farther than CLOSE_ENOUGH
-(inference.reader): per set, against reading both always (CLOSE_ENOUGH 0), the mean relative RMSE, the farthest any
+(inference.picking): per set, against reading both always (CLOSE_ENOUGH 0), the mean relative RMSE, the farthest any
 single curve moved, the share of curves read once, the encoder rows a curve and the time.
 
     .venv/bin/python scripts/close_enough.py --count 200                   # the shipped CLOSE_ENOUGH
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.geometry import closeness
-from curve_vae.inference import reader as reader_module
+from curve_vae.inference import picking
 from curve_vae.inference.cpus import limit_blas_threads
 from curve_vae.inference.runtime import CurveRuntime
 
@@ -31,7 +31,7 @@ from paired_readings import curve_sets  # noqa: E402
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--count", type=int, default=200, help="curves per suite set and closed outlines (default: 200)")
-    p.add_argument("--taus", type=float, nargs="+", default=[reader_module.CLOSE_ENOUGH])
+    p.add_argument("--taus", type=float, nargs="+", default=[picking.CLOSE_ENOUGH])
     a = p.parse_args()
     limit_blas_threads(1)
     rt = CurveRuntime.load(ROOT / "models", providers="cpu", intra_op_threads=1, cache_bytes=0)
@@ -41,7 +41,7 @@ def main() -> None:
     print("| CLOSE_ENOUGH | set | error ÷ both always | farthest curve ÷ | read once | encoder rows a curve | time ÷ |")
     print("|---|---|---|---|---|---|---|")
     for tau in [0.0, *a.taus]:
-        reader_module.CLOSE_ENOUGH = tau
+        picking.CLOSE_ENOUGH = tau
         for name, curves in sets.items():
             rows = rt.graphs.rows["encoder"]
             t0 = time.perf_counter()

@@ -73,3 +73,8 @@ def together(fn, args):
 
     with cf.ThreadPoolExecutor(len(args)) as pool:
         return list(pool.map(call, args))
+
+
+#: How exactly each of the page's file formats gives its curves back, as relative tolerance: SVG writes 10 significant
+#: digits, as the command line does; the others the numbers themselves.
+EXPORT_TOLERANCE = {"json": 0.0, "csv": 0.0, "svg": 1e-9, "dxf": 0.0}

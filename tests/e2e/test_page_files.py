@@ -18,7 +18,7 @@ from ezdxf import recover
 from curve_vae.curvefiles import CurveFileError, read_curves
 from curve_vae.curvefiles.text import parse_csv
 from tests.e2e.test_page import arc, browser, draw, open_page, server, state  # noqa: F401 - fixtures
-from tests.helpers import FIXTURES, ROOT
+from tests.helpers import EXPORT_TOLERANCE, FIXTURES, ROOT
 
 FILES = FIXTURES / "files"
 FILES_JS = ROOT / "service" / "static" / "files.js"
@@ -62,15 +62,7 @@ def exported(browser, server, tmp_path_factory):  # noqa: F811
     return drawn, files
 
 
-@pytest.mark.parametrize(
-    ("kind", "rtol"),
-    [
-        pytest.param("json", 0, id="json"),
-        pytest.param("csv", 0, id="csv"),
-        pytest.param("svg", 1e-9, id="svg"),  # 10 significant digits, as the command line writes SVG
-        pytest.param("dxf", 0, id="dxf"),
-    ],
-)
+@pytest.mark.parametrize(("kind", "rtol"), list(EXPORT_TOLERANCE.items()), ids=list(EXPORT_TOLERANCE))
 def test_each_export_reopens_into_the_drawn_curves(browser, server, exported, kind, rtol):  # noqa: F811
     drawn, files = exported
     page, errors = open_page(browser, server.url + "/")

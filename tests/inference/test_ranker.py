@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from curve_vae.inference import picking
 from curve_vae.inference.candidates import model_points
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
@@ -110,13 +111,13 @@ def test_a_model_without_a_ranker_names_what_is_missing(runtime: CurveRuntime):
 
 def test_the_second_read_is_never_the_first_again():
     """A symmetric curve reversed and mirrored end for end is itself: that candidate is skipped for the next one."""
-    from curve_vae.inference.reader import _distinct
+    from curve_vae.inference.picking import distinct
 
     a = np.zeros((161, 2))
     models = np.stack([a, a + 1e-5, a + 1.0, a + 2.0])
-    assert _distinct(np.array([0, 1, 2, 3]), models, 2).tolist() == [0, 2]
-    assert _distinct(np.array([3, 0, 1]), models, 2).tolist() == [3, 0]
-    assert _distinct(np.array([1, 0]), models, 2).tolist() == [1]  # nothing else to read
+    assert distinct(np.array([0, 1, 2, 3]), models, 2).tolist() == [0, 2]
+    assert distinct(np.array([3, 0, 1]), models, 2).tolist() == [3, 0]
+    assert distinct(np.array([1, 0]), models, 2).tolist() == [1]  # nothing else to read
 
 
 def test_a_symmetric_curve_is_read_two_different_ways(ranked: CurveRuntime):
@@ -126,7 +127,7 @@ def test_a_symmetric_curve_is_read_two_different_ways(ranked: CurveRuntime):
     stage = reader._candidates([half_circle], [0], Reading(pose="learned", spacing="parameter"))
     g = ranked.graphs
     models, _ = model_points([half_circle], [0], stage, n_points=g.n_points, model_size=g.model_size)
-    (keep,) = reader._ranked(stage, models, shared=False)  # one curve: its candidates, best first
+    (keep,) = picking.ranked(reader.ranker, stage, models, shared=False)  # one curve: its candidates, best first
     assert len(keep) == 2 and np.abs(models[keep[0]] - models[keep[1]]).max() > 1e-3
     assert any(np.abs(models[i] - models[j]).max() < 1e-6 for i in range(6) for j in range(i))  # twins exist
 
@@ -135,10 +136,9 @@ def test_a_second_candidate_is_read_only_where_the_first_is_not_close_enough(shi
     """The shipped model reads a quarter circle close on its first candidate (one encoding) and a wavy paper curve
     not (two); with CLOSE_ENOUGH at 0 every curve reads both, and the closer of the two is never farther than the
     first alone."""
-    from curve_vae.inference import reader as reader_module
     from curve_vae.inference.choices import POSE
 
-    assert f"{reader_module.CLOSE_ENOUGH:.2%}" in POSE.values["learned"]  # the documented margin is the one read
+    assert f"{picking.CLOSE_ENOUGH:.2%}" in POSE.values["learned"]  # the documented margin is the one read
     t = np.linspace(0.0, np.pi / 2, 60)
     arc = np.c_[np.cos(t), np.sin(t)] * 100.0
     wavy = bspline_curves(1, seed=4)[0]
@@ -151,9 +151,9 @@ def test_a_second_candidate_is_read_only_where_the_first_is_not_close_enough(shi
         return rows["encoder"] - before, float(answer.closeness.rms[0])
 
     once, arc_rms = read(arc)
-    assert once == 1 and arc_rms <= reader_module.CLOSE_ENOUGH
+    assert once == 1 and arc_rms <= picking.CLOSE_ENOUGH
     twice, wavy_rms = read(wavy)
-    assert twice == 2 and wavy_rms > reader_module.CLOSE_ENOUGH
-    monkeypatch.setattr(reader_module, "CLOSE_ENOUGH", 0.0)
+    assert twice == 2 and wavy_rms > picking.CLOSE_ENOUGH
+    monkeypatch.setattr(picking, "CLOSE_ENOUGH", 0.0)
     both, closer = read(arc)
     assert both == 2 and closer <= arc_rms + 1e-12

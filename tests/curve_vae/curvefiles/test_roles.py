@@ -16,7 +16,7 @@ from ezdxf import recover
 from curve_vae.curvefiles import CurveFileWarning, read_curves, write_output
 from curve_vae.curvefiles.dxf import layer_name
 from curve_vae.curvefiles.roles import Found, role_of, the_inputs
-from tests.helpers import FIXTURES
+from tests.helpers import EXPORT_TOLERANCE, FIXTURES
 
 FILES = FIXTURES / "files"
 PAGE = json.loads((FILES / "page-export.json").read_text())["curves"]
@@ -25,13 +25,7 @@ SQUARE_WAVE = [[0, 0], [1, 1], [2, 0], [3, 1]]
 
 
 @pytest.mark.parametrize(
-    ("name", "rtol"),
-    [
-        pytest.param("page-export.json", 0, id="json"),
-        pytest.param("page-export.csv", 0, id="csv"),
-        pytest.param("page-export.svg", 1e-9, id="svg"),  # 10 significant digits, as the command line writes SVG
-        pytest.param("page-export.dxf", 0, id="dxf"),
-    ],
+    ("name", "rtol"), [pytest.param(f"page-export.{kind}", rtol, id=kind) for kind, rtol in EXPORT_TOLERANCE.items()]
 )
 def test_each_of_the_pages_exports_gives_the_drawings_inputs(name, rtol):
     derived = len(PAGE) - len(INPUTS)
