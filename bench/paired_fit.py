@@ -13,14 +13,13 @@ cache, numpy's BLAS on one thread as the service runs it.
 from __future__ import annotations
 
 import argparse
-import importlib.util
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from bench.revisions import module_at
 from curve_vae.geometry import closeness
 from curve_vae.geometry import natural as fit_now
 from curve_vae.inference.cpus import limit_blas_threads
@@ -33,16 +32,7 @@ from paired_readings import curve_sets  # noqa: E402
 
 def fit_of(revision: str):  # noqa: ANN201 - a module
     """geometry/natural.py as it is at `revision`, as a module of its own."""
-    text = subprocess.run(
-        ["git", "show", f"{revision}:geometry/natural.py"], cwd=ROOT, capture_output=True, text=True, check=True
-    ).stdout
-    path = Path("/tmp") / f"natural_{revision.replace('/', '_')}.py"
-    path.write_text(text)
-    spec = importlib.util.spec_from_file_location(f"curve_vae.geometry.natural_{revision}", path)
-    assert spec and spec.loader
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return module_at(revision, "geometry/natural.py", f"curve_vae.geometry.natural_{revision}")
 
 
 def main() -> None:

@@ -14,16 +14,15 @@ cache, numpy's BLAS on one thread as the service runs it.
 from __future__ import annotations
 
 import argparse
-import importlib.util
-import subprocess
+import json
 import sys
 import time
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import numpy as np
 
+from bench.revisions import module_at, saved, show
 from curve_vae.geometry import closeness
 from curve_vae.inference.cpus import limit_blas_threads
 from curve_vae.inference.runtime import CurveRuntime
@@ -33,43 +32,17 @@ sys.path.insert(0, str(ROOT / "scripts"))
 from paired_readings import curve_sets  # noqa: E402
 
 
-def _show(revision: str, path: str) -> bytes:
-    return subprocess.run(["git", "show", f"{revision}:{path}"], cwd=ROOT, capture_output=True, check=True).stdout
-
-
-def _module(revision: str, name: str) -> ModuleType:
-    """inference/`name`.py as it is at `revision`, registered as curve_vae.inference.`name` while it loads (so that
-    the revision's other old modules import it), then put back."""
-    path = Path("/tmp") / f"{name}_{revision.replace('/', '_')}.py"
-    path.write_bytes(_show(revision, f"inference/{name}.py"))
-    full = f"curve_vae.inference.{name}"
-    spec = importlib.util.spec_from_file_location(full, path)
-    assert spec and spec.loader
-    module = importlib.util.module_from_spec(spec)
-    kept = sys.modules.get(full)
-    sys.modules[full] = module
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        if kept is not None:
-            sys.modules[full] = kept
-    return module
-
-
 def parts_of(revision: str) -> tuple[Any, Any]:
     """The revision's ranker and guesser, loaded from its own files and weights (numpy .npz before 0.24.0)."""
-    manifest = __import__("json").loads(_show(revision, "models/manifest.json"))
+    manifest = json.loads(show(revision, "models/manifest.json"))
     out = []
     for name in ("ranker", "spacer"):
         file = manifest[name]["file"]
-        if file.endswith(".npz"):
-            _module(revision, "weights")
-        cls = getattr(_module(revision, name), name.capitalize())
-        local = Path("/tmp") / f"{revision}_{file}"
-        local.write_bytes(_show(revision, f"models/{file}"))
-        out.append(cls.load(local) if file.endswith(".npz") else None)
-    if None in out:
-        raise SystemExit(f"{revision}'s parts are ONNX graphs already: compare models with scripts/paired_readings.py")
+        if not file.endswith(".npz"):
+            raise SystemExit(f"{revision}'s {name} is a graph already: compare models with scripts/paired_readings.py")
+        module_at(revision, "inference/weights.py", "curve_vae.inference.weights", register=True)
+        module = module_at(revision, f"inference/{name}.py", f"curve_vae.inference.{name}", register=True)
+        out.append(getattr(module, name.capitalize()).load(saved(revision, f"models/{file}")))
     return out[0], out[1]
 
 

@@ -20,9 +20,8 @@ from curve_vae.inference.sessions import SessionConfig
 class PartGraph:
     """One learned part's session and the input shape it takes (None where any size goes)."""
 
-    def __init__(self, session: ort.InferenceSession, path: Path) -> None:
+    def __init__(self, session: ort.InferenceSession) -> None:
         self.session = session
-        self.path = path
         inp = session.get_inputs()[0]
         self.input_name = inp.name
         self.input_shape = [d if isinstance(d, int) else None for d in inp.shape]
@@ -43,7 +42,7 @@ class PartGraph:
             session = ort.InferenceSession(str(path), sess_options=sessions.options(), providers=providers)
         except Exception as e:  # onnxruntime raises its own exception types
             raise InvalidInput(f"onnxruntime cannot open it: {e}") from e
-        graph = cls(session, path)
+        graph = cls(session)
         want = [None, *shape]
         got = graph.input_shape
         if len(got) != len(want) or any(w is not None and g != w for g, w in zip(got, want)):
