@@ -32,14 +32,13 @@ def labels(closest_model_dir: Path, tmp_path_factory: pytest.TempPathFactory) ->
 def test_the_exported_graph_is_the_torch_net(tmp_path: Path, closest_model_dir: Path):
     torch.manual_seed(1)
     net = RankerNet().eval()
+    torch.save({"model": net.state_dict()}, tmp_path / "ranker.pt")  # a checkpoint as training writes it
     model = tmp_path / "model"
     shutil.copytree(closest_model_dir, model)
-    npz = save_npz(tmp_path / "ranker.npz", RANKER_KIND, ranker_weights(4))
-    net = RankerNet.from_weights(ranker_weights(4)).eval()
     pts = np.asarray(bspline_curves(5, seed=2), np.float32)
     with torch.no_grad():
         expected = net(torch.from_numpy(ranker_inputs(pts))).numpy()
-    export_ranker(npz, model)  # numpy weights of before 0.14.0, converted
+    export_ranker(tmp_path / "ranker.pt", model)
     runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
     assert runtime.reader.ranker is not None
     np.testing.assert_allclose(runtime.reader.ranker.scores(pts), expected, rtol=1e-4, atol=1e-5)
