@@ -21,7 +21,7 @@ from tests.e2e.test_page import arc, browser, draw, open_page, server, state  # 
 from tests.helpers import EXPORT_TOLERANCE, FIXTURES, ROOT
 
 FILES = FIXTURES / "files"
-FILES_JS = ROOT / "service" / "static" / "files.js"
+FILES_JS = [ROOT / "service" / "static" / name for name in ("files.js", "files-drawings.js")]  # the readers
 FORMATS = ("json", "csv", "svg", "dxf")
 
 pytestmark = pytest.mark.integration
@@ -124,12 +124,13 @@ def test_the_sheet_holds_one_cell_per_in_between_with_its_weights(browser, expor
 
 @pytest.fixture(scope="module")
 def files_page(browser):  # noqa: F811
-    """A blank page with files.js, and the errors it raises."""
+    """A blank page with the readers (files.js, files-drawings.js), and the errors it raises."""
     page = browser.new_page()
     errors: list[str] = []
     page.on("pageerror", lambda e: errors.append(str(e)))
     page.set_content("<!doctype html><html><body></body></html>")
-    page.add_script_tag(path=str(FILES_JS))
+    for script in FILES_JS:
+        page.add_script_tag(path=str(script))
     yield page, errors
     page.close()
 
