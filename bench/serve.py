@@ -55,6 +55,7 @@ RUNS = (
     "one_thread",
     "one_session",
     "micro_batch",
+    "switch_5ms",
     "C",
 )
 
@@ -198,6 +199,7 @@ VARIANTS = {  # run as B (the default request), each against a server started wi
     "spinning": (["--spinning", "true"], "B with onnxruntime's spin-waiting on"),
     "access_log": (["--access-log", "true"], "B with the access log on"),
     "one_worker": (["--workers", "1"], "B (and A, where asked) in one worker process, as before service 0.18.0"),
+    "switch_5ms": (["--workers", "1", "--gil-switch-ms", "5"], "B in one worker, Python's own GIL switch interval"),
     "one_thread": (["--inference-concurrency", "1"], "B (and A, where asked) with one inference thread a worker"),
     "one_session": (["--sessions", "1"], "B with one session pair shared by both inference threads"),
     "micro_batch": (["--micro-batch", "true"], "B with micro-batching (32 rows, 2 ms)"),

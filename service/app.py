@@ -22,6 +22,7 @@ route shapes the JSON. Every rejected request gets the same JSON error body:
 from __future__ import annotations
 
 import logging
+import sys
 from collections.abc import AsyncIterator, Callable
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
@@ -72,6 +73,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     settings: Settings = app.state.settings
     owned = app.state.runtime is None
     slots = app.state.slots
+    sys.setswitchinterval(settings.gil_switch_ms / 1e3)  # the event loop's turn comes sooner (Settings)
     if owned:
         app.state.runtime = await _load_runtime(settings, slots)
     runtime: CurveRuntime = app.state.runtime

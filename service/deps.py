@@ -4,6 +4,7 @@ the bounded, timed run of the work in a worker thread."""
 from __future__ import annotations
 
 import asyncio
+import sys
 import time
 from collections.abc import Callable, Hashable
 from typing import Annotated, Any, TypeVar
@@ -71,6 +72,7 @@ def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
         **runtime.graphs.pool.applied(),
         "blas_threads": blas_threads(),
         "inference_threads": request.app.state.slots,
+        "gil_switch_ms": round(sys.getswitchinterval() * 1e3, 6),
         "micro_batch": batching,
         "coalesce": None
         if (coalescer := coalescer_of(request)) is None

@@ -101,6 +101,12 @@ _GROUPS: dict[str, list[_Option]] = {
             int,
             "most curves of concurrent /encode and /reconstruct requests read as one batch; 0: each alone",
         ),
+        (
+            "--gil-switch-ms",
+            "gil_switch_ms",
+            float,
+            "milliseconds a thread runs Python before another takes the GIL (Python's own: 5)",
+        ),
     ],
 }
 _OPTIONS: list[_Option] = [option for group in _GROUPS.values() for option in group]

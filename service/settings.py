@@ -51,6 +51,10 @@ class Settings(BaseSettings):
     # answered its own part (inference/coalescing.py: /encode and /reconstruct of equal options, requests of at most
     # half as many curves; one batch at a time a CPU of the worker); 0: each alone
     coalesce_curves: int = Field(default=32, ge=0)
+    # milliseconds a thread runs Python before another waiting for the GIL takes it (sys.setswitchinterval, set in
+    # each worker at start): the event loop waits less behind the inference threads. Python's own 5 ms serves
+    # single-curve requests from one worker ~17% slower (docs/BENCHMARKS.md, service 0.25.0)
+    gil_switch_ms: float = Field(default=2.0, gt=0, le=100)
     access_log: bool = False  # uvicorn's line per request: log volume (its CPU cost is within noise, BENCHMARKS)
     # requests waiting for an inference slot; beyond them: 503 with Retry-After
     max_queue: int = Field(default=64, ge=0)

@@ -104,6 +104,7 @@ def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypa
         "spinning": False,
         "blas_threads": 2,  # numpy's BLAS as many as onnxruntime
         "inference_threads": 3,
+        "gil_switch_ms": 2.0,  # Python's own is 5
         "micro_batch": None,
         "coalesce": {"curves": 32, "readers": 3, "hold_ms": 5.0},  # one batch a CPU, at most one an inference
     }

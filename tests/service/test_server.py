@@ -55,6 +55,13 @@ def test_numpys_blas_runs_one_inferences_threads(live_server):
     assert execution["blas_threads"] == execution["intra_op_threads"] >= 1
 
 
+def test_the_worker_hands_the_gil_round_sooner_than_pythons_own_5_ms(live_server):
+    """sys.getswitchinterval() of the live worker: the setting's 2 ms, so the event loop waits less behind the
+    inference threads."""
+    execution = httpx.get(f"{live_server.url}/model", timeout=30).json()["execution"]
+    assert execution["gil_switch_ms"] == 2.0
+
+
 def _counts(metrics: str) -> dict[str, float]:
     """curve_vae_http_requests_total by its labels, from a Prometheus text page."""
     out = {}
@@ -252,6 +259,8 @@ def test_configuration_errors(tmp_path, model_dir, capsys):
     assert "manifest.json is missing" in capsys.readouterr().err
     assert run(parser.parse_args(["--model-dir", str(model_dir), "--max-points", "2"])) == 2
     assert "max_points" in capsys.readouterr().err
+    assert run(parser.parse_args(["--model-dir", str(model_dir), "--gil-switch-ms", "0"])) == 2
+    assert "gil_switch_ms" in capsys.readouterr().err
 
 
 def test_help_names_defaults_and_variables():
