@@ -73,6 +73,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     settings: Settings = app.state.settings
     owned = app.state.runtime is None
     slots = app.state.slots
+    switch = sys.getswitchinterval()
     sys.setswitchinterval(settings.gil_switch_ms / 1e3)  # the event loop's turn comes sooner (Settings)
     if owned:
         app.state.runtime = await _load_runtime(settings, slots)
@@ -103,6 +104,7 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
     finally:
         app.state.ready = False
         app.state.metrics.ready.set(0)
+        sys.setswitchinterval(switch)  # the process's own again, for an app that starts again or shares it
         app.state.executor.shutdown(wait=False, cancel_futures=True)
         app.state.executor = inference_executor(slots)  # for a lifespan that starts again (tests)
         if batcher is not None:

@@ -52,8 +52,8 @@ class Settings(BaseSettings):
     # half as many curves; one batch at a time a CPU of the worker); 0: each alone
     coalesce_curves: int = Field(default=32, ge=0)
     # milliseconds a thread runs Python before another waiting for the GIL takes it (sys.setswitchinterval, set in
-    # each worker at start): the event loop waits less behind the inference threads. Python's own 5 ms serves
-    # single-curve requests from one worker ~17% slower (docs/BENCHMARKS.md, service 0.25.0)
+    # each worker at start): the event loop waits less behind the inference threads. At Python's own 5 ms one
+    # worker answered 189 single-curve requests a second against 232 (docs/BENCHMARKS.md, service 0.25.0)
     gil_switch_ms: float = Field(default=2.0, gt=0, le=100)
     access_log: bool = False  # uvicorn's line per request: log volume (its CPU cost is within noise, BENCHMARKS)
     # requests waiting for an inference slot; beyond them: 503 with Retry-After

@@ -122,6 +122,21 @@ def test_model_reports_the_inference_threads_and_no_micro_batching(make_client):
     assert execution["inference_threads"] == 3 and execution["micro_batch"] is None
 
 
+def test_the_switch_interval_is_the_settings_while_the_app_serves_and_the_processs_own_after(model_dir, runtime):
+    import sys
+
+    from fastapi.testclient import TestClient
+
+    from curve_vae.service.app import create_app
+    from curve_vae.service.settings import Settings
+
+    before = sys.getswitchinterval()
+    with TestClient(create_app(Settings(model_dir=model_dir, gil_switch_ms=3.5), runtime=runtime)) as client:
+        assert client.get("/model").json()["execution"]["gil_switch_ms"] == 3.5
+        assert sys.getswitchinterval() == pytest.approx(0.0035)
+    assert sys.getswitchinterval() == before
+
+
 def test_model_reports_micro_batching_when_on_and_answers_the_same(make_client, runtime):
     client = make_client(
         share_runtime=False,
