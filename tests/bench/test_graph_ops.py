@@ -45,7 +45,7 @@ def test_a_matrix_product_counts_its_inner_dimension_and_other_nodes_nothing():
 
 def test_the_table_names_every_shipped_graph():
     done = subprocess.run(
-        [sys.executable, "-m", "bench.graph_ops", "--batch", "2", "--runs", "2", "--top", "1"],
+        [sys.executable, "-m", "bench.graph_ops", "--batch", "2", "--runs", "2", "--top", "1", "--curves", "4"],
         cwd=ROOT,
         capture_output=True,
         text=True,
@@ -54,3 +54,14 @@ def test_the_table_names_every_shipped_graph():
     assert done.returncode == 0, done.stderr
     for graph in ("encoder", "decoder", "ranker", "spacer"):
         assert f"| {graph} |" in done.stdout and f"- {graph} " in done.stdout
+    assert "A default request of 4 paper curves runs, a curve: encoder " in done.stdout
+
+
+def test_a_default_request_reads_each_curve_once_or_twice_ranking_every_candidate():
+    """The rows counted at onnxruntime's door: one guess a curve, one or two encodings and as many decodings, the
+    ranker over every candidate (more than the two read)."""
+    from bench.graph_ops import rows_a_curve
+
+    rows = rows_a_curve(ROOT / "models", curves=6)
+    assert rows["spacer"] == 1.0 and 1.0 <= rows["encoder"] <= 2.0 and rows["decoder"] == rows["encoder"]
+    assert rows["ranker"] > 2.0
