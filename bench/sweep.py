@@ -15,6 +15,8 @@ import json
 import urllib.request
 from pathlib import Path
 
+from prometheus_client.parser import text_string_to_metric_families
+
 from bench.serve import NO_CACHE, ROOT, Server, _callers, json_body, wrk
 
 
@@ -45,8 +47,13 @@ def _coalesced(server: Server) -> tuple[float, float]:
     """Requests read in coalesced batches so far, and the batches (`curve_vae_coalesced_requests` in /metrics, the
     worker this scrape reaches; with --workers 1, the only one)."""
     with urllib.request.urlopen(f"{server.url}/metrics", timeout=30) as r:
-        lines = r.read().decode().splitlines()
-    value = {ln.split()[0]: float(ln.split()[1]) for ln in lines if ln.startswith("curve_vae_coalesced_requests_")}
+        text = r.read().decode()
+    value = {
+        s.name: s.value
+        for family in text_string_to_metric_families(text)
+        if family.name == "curve_vae_coalesced_requests"
+        for s in family.samples
+    }
     return value.get("curve_vae_coalesced_requests_sum", 0.0), value.get("curve_vae_coalesced_requests_count", 0.0)
 
 
