@@ -15,6 +15,7 @@ from scipy.interpolate import BSpline, make_lsq_spline
 
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry.frame import cumulative_length
+from curve_vae.geometry.metrics import diagonal
 
 
 def clamped_uniform_knots(n_ctrl: int, degree: int = 3) -> np.ndarray:
@@ -342,7 +343,7 @@ def fit_bspline_auto(
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 4:
         raise InvalidInput(f"points must have shape (n ≥ 4, 2), got {pts.shape}")
-    goal = tolerance * float(np.linalg.norm(np.ptp(pts, axis=0)))
+    goal = tolerance * float(diagonal(pts))
     limit = min(len(pts), max_ctrl)
     best: BSplineFit | None = None
     for n in [*(k for k in AUTO_CTRL if k < limit), limit]:

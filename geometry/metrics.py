@@ -17,6 +17,14 @@ def mse_per_curve(target: np.ndarray, pred: np.ndarray) -> np.ndarray:
     return np.mean(d * d, axis=(-2, -1))
 
 
+def diagonal(points: np.ndarray) -> np.ndarray:
+    """The bounding-box diagonal of (…, n, 2) points, over their n: the size every relative figure of a curve is
+    divided by (`closeness`, the reader's "close enough", a morph's drift, a spline fit's tolerance). A float array:
+    () for one curve, (B,) for a stack."""
+    extent = np.ptp(np.asarray(points, np.float64), axis=-2)
+    return np.hypot(extent[..., 0], extent[..., 1])
+
+
 def closeness(inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """How close each output came to its input, point for point, relative to the input's size: the RMS distance and
     the largest distance, each ÷ the input's bounding-box diagonal, and the index of that farthest point; three (B,)

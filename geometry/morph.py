@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from curve_vae.geometry.metrics import diagonal
+
 
 def chord_directions(curves: np.ndarray) -> np.ndarray:
     """(steps,) the direction (radians) of each curve's chord, first point -> last."""
@@ -40,7 +42,7 @@ def end_drift(sweep: np.ndarray) -> float:
     the diagonal of the ends' joint bounding box."""
     c = np.asarray(sweep, np.float64)
     ends = np.concatenate([c[0], c[-1]])
-    diagonal = float(np.hypot(*np.ptp(ends, axis=0)))
+    size = float(diagonal(ends))
     worst = 0.0
     for k in (0, -1):
         a, b = c[0, k], c[-1, k]
@@ -48,7 +50,7 @@ def end_drift(sweep: np.ndarray) -> float:
         ab = b - a
         t = np.clip(((p - a) @ ab) / max(float(ab @ ab), 1e-300), 0.0, 1.0)
         worst = max(worst, float(np.linalg.norm(p - (a + t[:, None] * ab), axis=1).max(initial=0.0)))
-    return worst / diagonal if diagonal > 0 else 0.0
+    return worst / size if size > 0 else 0.0
 
 
 def _wrapped(angle: np.ndarray | float) -> np.ndarray:

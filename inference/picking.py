@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from curve_vae.geometry import Frame
+from curve_vae.geometry.metrics import diagonal
 from curve_vae.inference.candidates import Candidate
 from curve_vae.inference.ranker import RANKED_READS, Ranker
 
@@ -57,8 +58,8 @@ def close_enough(err: float, points: np.ndarray, frame: Frame | None, model_size
     the curve's bounding-box diagonal (geometry.closeness' figure, before any untangling), are within CLOSE_ENOUGH;
     a curve without size, or a distance that is not finite, is not."""
     scale = 1.0 if frame is None else frame.size / model_size  # model-plane units to the caller's
-    diagonal = float(np.hypot(*np.ptp(points, axis=0)))
-    return diagonal > 0 and bool(np.sqrt(err / len(points)) * scale / diagonal <= CLOSE_ENOUGH)
+    size = float(diagonal(points))
+    return size > 0 and bool(np.sqrt(err / len(points)) * scale / size <= CLOSE_ENOUGH)
 
 
 def in_shared_pose(inputs: list[np.ndarray], stage: list[Candidate], err: np.ndarray) -> np.ndarray:

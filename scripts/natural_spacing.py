@@ -25,7 +25,15 @@ import time
 
 import numpy as np
 
-from curve_vae.geometry import arc_fractions, closest_squared_distances, natural_readings, resample, to_model_plane
+from curve_vae.geometry import (
+    arc_fractions,
+    closeness,
+    closest_squared_distances,
+    diagonal,
+    natural_readings,
+    resample,
+    to_model_plane,
+)
 from curve_vae.geometry.bspline import basis_and_slope
 from curve_vae.training.suite import paper_test_split
 
@@ -40,7 +48,7 @@ def gap(model_dir: str, even: np.ndarray, drawn: list[np.ndarray]) -> None:
     params = list(even)
     own = rt.reconstruct(drawn, n_points=3201).curves
     twins = rt.reconstruct(params, n_points=3201).curves
-    diag = np.array([np.hypot(*np.ptp(c, axis=0)) for c in even])
+    diag = diagonal(even)
 
     def dist(points: list[np.ndarray], lines: list[np.ndarray]) -> float:
         return float(np.mean([np.sqrt(closest_squared_distances(p, q).mean()) for p, q in zip(points, lines)] / diag))
@@ -65,13 +73,13 @@ def main() -> None:
     drawn = [resample(c, len(c)) for c in even]
 
     def rel(x: np.ndarray, ref: np.ndarray) -> float:
-        return float(np.sqrt(((x - ref) ** 2).sum(-1).mean()) / np.hypot(*np.ptp(ref, axis=0)))
+        return float(closeness([ref], [x])[0][0])
 
     def fit_rms(points: np.ndarray, u: np.ndarray) -> float:
         """RMS distance ÷ diagonal from the points to the least-squares 10-point spline at their parameters u."""
         basis, _ = basis_and_slope(u, 10)
         fitted = basis @ np.linalg.lstsq(basis, points, rcond=None)[0]
-        return float(np.sqrt(((fitted - points) ** 2).sum(-1).mean()) / np.hypot(*np.ptp(points, axis=0)))
+        return float(closeness([points], [fitted])[0][0])
 
     as_drawn = np.array([rel(d, c) for d, c in zip(drawn, even)])
     print(f"as drawn: median {np.median(as_drawn):.2%}, mean {as_drawn.mean():.2%}")

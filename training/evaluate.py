@@ -18,6 +18,7 @@ import numpy as np
 
 from curve_vae.files import atomic_write_text
 from curve_vae.geometry import mse_per_curve, self_intersects, simplex_grid, smoothness
+from curve_vae.geometry.metrics import diagonal
 
 Reconstructor = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, N, 2), decoding the mean
 Encoder = Callable[[np.ndarray], np.ndarray]  # (B, N, 2) → (B, Z) latent means
@@ -125,12 +126,11 @@ def sample_quality(samples: np.ndarray, data: np.ndarray, reference: np.ndarray)
     mean distance from each sample to its nearest data curve, over the reference's. 1 means
     "as close as real data"; above 1, samples miss parts of the data (coverage) or lie off it.
     """
-    size = lambda c: np.linalg.norm(np.ptp(c, axis=1), axis=1)  # bounding-box diagonals
     return {
         "self_intersecting": float(np.mean(self_intersects(samples))),
         "roughness": float(smoothness(samples)["roughness"].mean()),
         "roughness_data": float(smoothness(data)["roughness"].mean()),
-        "size_vs_data": float(size(samples).mean() / size(data).mean()),
+        "size_vs_data": float(diagonal(samples).mean() / diagonal(data).mean()),
         "coverage_vs_real": float(nearest_distances(data, samples).mean() / nearest_distances(data, reference).mean()),
         "precision_vs_real": float(nearest_distances(samples, data).mean() / nearest_distances(reference, data).mean()),
     }

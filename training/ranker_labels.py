@@ -20,6 +20,7 @@ import numpy as np
 
 from curve_vae.files import atomic_path
 from curve_vae.geometry.frame import resample, resample_index
+from curve_vae.geometry.metrics import diagonal
 from curve_vae.inference.candidates import model_points
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
@@ -85,7 +86,7 @@ def label(runtime: CurveRuntime, curves: list[np.ndarray]) -> dict[str, np.ndarr
     owner = np.array([c.curve for c in stage], np.int32)
     _, err = reader._decoded([inputs[o] for o in owner], rows)
     targets = reader._targets([inputs[o] for o in owner], [c.frame for c in stage])
-    diag = np.array([np.hypot(*np.ptp(t, axis=0)) for t in targets])  # in the model plane, where err is
+    diag = np.array([diagonal(t) for t in targets])  # in the model plane, where err is
     rel = np.sqrt(err / np.array([len(t) for t in targets])) / diag  # frames are similarities: the caller's ratio
     return {
         "points": models.astype(np.float32),

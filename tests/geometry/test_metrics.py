@@ -5,8 +5,10 @@ import numpy as np
 import pytest
 
 from curve_vae.geometry import (
+    closeness,
     closest_squared_distances,
     curve_length,
+    diagonal,
     evaluate_bspline,
     mse_per_curve,
     random_control_points,
@@ -98,3 +100,25 @@ def test_self_intersects_crossings_and_touches(curve, crosses):
 def test_mse_per_curve_broadcasts_over_batches_and_one_curve():
     a = np.array([[0.0, 0.0], [1.0, 1.0]])
     assert float(mse_per_curve(a, a + [2.0, 0.0])) == pytest.approx(2.0)  # (4 + 0 + 4 + 0) / 4
+
+
+def test_diagonal_of_one_curve_and_a_stack():
+    rect = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 4.0], [1.0, 2.0]])
+    assert float(diagonal(rect)) == pytest.approx(5.0)
+    stack = np.stack([rect, 2 * rect, rect + 100])
+    np.testing.assert_allclose(diagonal(stack), [5.0, 10.0, 5.0])
+    assert float(diagonal(np.ones((3, 2)))) == 0.0  # coinciding points have no size
+
+
+def test_closeness_divides_by_the_diagonal_of_each_input():
+    a = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 4.0]])
+    b = np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [10.0, 0.0]])
+    moved = [a + [0.5, 0.0], b + [0.0, 1.0]]
+    rms, worst, where = closeness([a, b], moved)
+    np.testing.assert_allclose(rms, [0.5 / 5.0, 1.0 / 10.0])
+    np.testing.assert_allclose(worst, [0.5 / 5.0, 1.0 / 10.0])
+    assert where.shape == (2,)
+    bent = a.copy()
+    bent[1] += [0.0, 2.0]  # one point 2 away: RMS sqrt(4/3), the farthest 2, at index 1
+    rms, worst, where = closeness([a], [bent])
+    assert rms[0] == pytest.approx(np.sqrt(4 / 3) / 5.0) and worst[0] == pytest.approx(2 / 5.0) and where[0] == 1
