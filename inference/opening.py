@@ -17,7 +17,7 @@ from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.named_priors import load_priors
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
-from curve_vae.inference.sessions import SessionConfig, resolve_providers
+from curve_vae.inference.sessions import SessionConfig
 from curve_vae.inference.spacer import Spacer
 
 T = TypeVar("T")
@@ -47,23 +47,23 @@ def open_model(
             f"graphs do not match the manifest: the prior has {prior.latent_dim} latent dimensions, "
             f"the model {manifest.latent_dim}"
         )
-    # the learned parts run where the graphs do, each one session that every inference thread shares
-    provider_list = resolve_providers(providers)
+    graphs = ModelGraphs.open(
+        root, manifest, providers=providers, sessions=sessions, batch_size=batch_size, warm_up=warm_up
+    )
+    # the learned parts run where the graphs do (the providers their sessions opened on), each one session that
+    # every inference thread shares
     part_sessions = replace(sessions, sessions=1)
     ranker = _load_part(
         root,
         manifest.ranker,
         "reading ranker",
-        lambda p: Ranker.load(p, n_points=manifest.n_points, providers=provider_list, sessions=part_sessions),
+        lambda p: Ranker.load(p, n_points=manifest.n_points, providers=graphs.providers, sessions=part_sessions),
     )
     spacer = _load_part(
         root,
         manifest.spacer,
         "spacing guesser",
-        lambda p: Spacer.load(p, providers=provider_list, sessions=part_sessions),
-    )
-    graphs = ModelGraphs.open(
-        root, manifest, providers=providers, sessions=sessions, batch_size=batch_size, warm_up=warm_up
+        lambda p: Spacer.load(p, providers=graphs.providers, sessions=part_sessions),
     )
     closest = None if placement == "model" else placement == "closest"
     cache = EncodingCache(cache_bytes) if cache_bytes > 0 else None
