@@ -188,6 +188,12 @@ def callers_curves(model_plane: np.ndarray, *, seed: int) -> list[np.ndarray]:
     return out
 
 
+def posted(count: int, seed: int) -> np.ndarray:
+    """(count, 161, 2): `count` of the paper's curves as a caller posts them (`callers_curves` of `curves`, one seed
+    for both): the bodies bench.serve and bench.sweep send."""
+    return np.stack(callers_curves(curves(count, seed=seed), seed=seed))
+
+
 def measure(
     model_dir: Path, *, seconds: float = 5.0, cores: int | None = None, eager: bool = True, details: bool = True
 ) -> dict[str, Any]:

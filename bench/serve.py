@@ -72,7 +72,7 @@ class Server(LiveServer):
         workers = int(flags[flags.index("--workers") + 1]) if "--workers" in flags else 0
         workers = workers or available_cpus()  # the service's default: one per CPU
         try:
-            self.wait_ready(timeout=90, listeners=workers)  # wrk's connections are shared out as they open
+            self.wait_ready(listeners=workers)  # wrk's connections are shared out as they open
         except BaseException:
             self.stop()
             raise
@@ -247,19 +247,13 @@ SEARCH = {"pose": "search", "spacing": "search"}  # every pose and spacing candi
 NO_CACHE = {"CURVE_VAE_CACHE_BYTES": "0"}  # wrk posts one body again and again: without this, every curve is a hit
 
 
-def _callers(count: int, seed: int) -> np.ndarray:
-    """`count` of the paper's curves as a caller posts them (bench.ceiling.callers_curves: turned, mirrored or
-    reversed at random, in pixel coordinates with y down, spaced by arc length)."""
-    return np.stack(ceiling.callers_curves(ceiling.curves(count, seed=seed), seed=seed))
-
-
 def _default_server_runs(
     load: Callable[..., dict[str, Any]], report: dict[str, Any], model_dir: Path, runs: set[str], augment_count: int
 ) -> None:
     """The runs against a server with the service's defaults but no encoding cache (every request read afresh: the
     headline A and B are the default request, no pose or spacing fields, curves in a caller's frame, beside the fast
     path), then B against one with its cache (the same curve every time: what a re-posted curve costs)."""
-    one, many = _callers(1, seed=1), _callers(128, seed=2)
+    one, many = ceiling.posted(1, seed=1), ceiling.posted(128, seed=2)
     server = Server(model_dir, env=NO_CACHE)
     try:
         if "A" in runs:
@@ -282,10 +276,10 @@ def _default_server_runs(
             load("latency_1_fast", server, "/reconstruct", json_body(one, **FAST), c=1)
             load("latency_1_search", server, "/reconstruct", json_body(one, **SEARCH), c=1)
         if "interpolate" in runs:
-            load("interpolate", server, "/interpolate", json_body(_callers(2, seed=3), steps=5))
+            load("interpolate", server, "/interpolate", json_body(ceiling.posted(2, seed=3), steps=5))
         if "augment" in runs:
             print("augment ...", file=sys.stderr)
-            report["augment"] = augment(server, _callers(8, seed=4), augment_count)
+            report["augment"] = augment(server, ceiling.posted(8, seed=4), augment_count)
     finally:
         server.stop()
     if "B" in runs:
@@ -303,18 +297,20 @@ ONE_PASS_NAMES = tuple(f"{v}_one" for v in ONE_PASS_VARIANTS)
 
 def _variant_runs(load: Callable[..., dict[str, Any]], model_dir: Path, runs: set[str]) -> None:
     """B against a server of each asked-for variant (VARIANTS), one server each."""
-    single = json_body(_callers(1, seed=1))
+    single = json_body(ceiling.posted(1, seed=1))
     for name, (flags, _) in VARIANTS.items():
         if name in runs:
             server = Server(model_dir, *flags, env=NO_CACHE)
             try:
                 if name in WITH_A and "A" in runs:  # large requests on 2 connections, hashed to the workers
-                    r = load(f"A_{name}", server, "/reconstruct", json_body(_callers(128, seed=2)), c=2, at_least=60.0)
+                    r = load(
+                        f"A_{name}", server, "/reconstruct", json_body(ceiling.posted(128, seed=2)), c=2, at_least=60.0
+                    )
                     r["curves_per_s"] = r["rps"] * 128
                 load(name, server, "/reconstruct", single)
                 if name in ONE_PASS_VARIANTS and "one_pass" in runs:  # does sharing graph runs, or one process
                     # (one GIL for the event loop and the inference threads), help or hinder a one-pass request?
-                    load(f"{name}_one", server, "/reconstruct", json_body(_callers(1, seed=1), **ONE_PASS))
+                    load(f"{name}_one", server, "/reconstruct", json_body(ceiling.posted(1, seed=1), **ONE_PASS))
             finally:
                 server.stop()
 

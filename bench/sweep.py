@@ -17,12 +17,13 @@ from pathlib import Path
 
 from prometheus_client.parser import text_string_to_metric_families
 
-from bench.serve import NO_CACHE, ROOT, Server, _callers, json_body, wrk
+from bench.ceiling import posted
+from bench.serve import NO_CACHE, ROOT, Server, json_body, wrk
 
 
 def sweep(flag_sets: list[str], *, seconds: float, with_a: bool, model_dir: Path) -> list[dict]:
     """Per flag set: GET /model's `execution` and its B (and A) runs, as bench.serve.wrk reports them."""
-    single, many = json_body(_callers(1, seed=1)), json_body(_callers(128, seed=2))
+    single, many = json_body(posted(1, seed=1)), json_body(posted(128, seed=2))
     rows = []
     for flags in flag_sets:
         server = Server(model_dir, *flags.split(), env=NO_CACHE)
