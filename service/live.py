@@ -42,6 +42,12 @@ def listening_sockets(port: int) -> int | None:
     return count
 
 
+#: How long `wait_ready` waits by default: a start with an empty numba cache compiles the reading's kernels in its
+#: warm-up request before /ready answers (18.8 s for two workers on this project's 2 cores, alone: longer beside
+#: other work).
+READY_TIMEOUT = 180.0
+
+
 class LiveServer:
     """The service in a subprocess on a free loopback port; `wait_ready` polls GET /ready until it answers 200."""
 
@@ -94,7 +100,7 @@ class LiveServer:
         except subprocess.TimeoutExpired:
             self._printed = ""
 
-    def wait_ready(self, timeout: float = 60.0, *, listeners: int = 1) -> None:
+    def wait_ready(self, timeout: float = READY_TIMEOUT, *, listeners: int = 1) -> None:
         """Poll /ready until 200 and until `listeners` sockets listen on the port (each worker its own: a client
         that connects before a worker listens stays with the others); RuntimeError (with the server's output) if it
         exits, TimeoutError if it is slow."""

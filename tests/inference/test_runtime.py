@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,8 +15,10 @@ import pytest
 from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve, simplex_grid
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
+from tests.helpers import ROOT, SHIPPED
 
 # ----------------------------------------------------------------------------- loading
 
@@ -28,6 +32,52 @@ def _copy(model_dir: Path, tmp_path: Path) -> Path:
 def test_load_reports_cpu_provider(runtime):
     assert runtime.graphs.providers[0] == "CPUExecutionProvider"
     assert (runtime.n_points, runtime.latent_dim, runtime.model_size) == (161, 32, 100.0)
+
+
+_KERNELS_AFTER_LOAD = """
+import json, sys
+from curve_vae.geometry.matching_kernel import place
+from curve_vae.geometry.natural_kernel import fit_start, lm_steps
+from curve_vae.inference.runtime import CurveRuntime
+rt = CurveRuntime.load(sys.argv[1], providers="cpu", warm_up=sys.argv[2] == "1")
+print(json.dumps({
+    "compiled": [len(k.signatures) for k in (fit_start, lm_steps, place)],
+    "rows": rt.graphs.rows,
+    "cache": [len(rt.cache), rt.cache.hits, rt.cache.misses],
+}))
+"""
+
+
+@pytest.mark.parametrize("warm", [True, False])
+def test_loading_runs_a_default_request_so_the_first_callers_does_not_compile(warm):
+    """In a fresh process (nothing compiled yet): the shipped model's default reading runs the natural fit's and the
+    placement's compiled kernels, which loading with warm-up has compiled (or loaded from numba's cache) already,
+    leaving the encoding cache empty and the graphs' row counts at the graphs' own warm-up; without it, none is."""
+    if not (SHIPPED / "manifest.json").is_file():
+        pytest.skip("no shipped model: models/manifest.json is absent")
+    done = subprocess.run(
+        [sys.executable, "-c", _KERNELS_AFTER_LOAD, str(SHIPPED), "1" if warm else "0"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    assert done.returncode == 0, done.stderr
+    got = json.loads(done.stdout.strip().splitlines()[-1])
+    if warm:
+        assert all(n >= 1 for n in got["compiled"]), got
+        assert got["rows"] == {"encoder": 1, "decoder": 1} and got["cache"] == [0, 0, 0]
+    else:
+        assert got["compiled"] == [0, 0, 0] and got["rows"] == {"encoder": 0, "decoder": 0}
+
+
+def test_a_warm_up_request_that_fails_is_a_startup_error(model_dir, monkeypatch):
+    def broken(self, *args, **kwargs):
+        raise ValueError("the reading broke")
+
+    monkeypatch.setattr(Reader, "read", broken)
+    with pytest.raises(ModelLoadError, match="warm-up request failed: the reading broke"):
+        CurveRuntime.load(model_dir, providers="cpu", cache_bytes=0)
 
 
 def test_tampered_graph_is_a_startup_error(model_dir, tmp_path):

@@ -123,7 +123,7 @@ def test_few_keep_alive_clients_end_up_shared_out_evenly(server_factory, model_d
     """Eight keep-alive connections to two workers, in two waves: the kernel's hash alone leaves them four and four
     27% of the time; with the moves, every wave ends four and four (a client reconnects when it is told to)."""
     server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
-    server.wait_ready(timeout=90, listeners=2)
+    server.wait_ready(listeners=2)
     moved = 0
     for wave in range(2):
         conns = [http.client.HTTPConnection("127.0.0.1", server.port, timeout=30) for _ in range(8)]
