@@ -37,10 +37,9 @@ from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.manifest import Manifest, ModelLoadError  # noqa: F401  (ModelLoadError: part of its API)
 from curve_vae.inference.mixing import mix
 from curve_vae.inference.named_priors import NamedPrior
-from curve_vae.inference.opening import open_model
+from curve_vae.inference.opening import open_model, warm_up_request
 from curve_vae.inference.placing import (
     check_range,
-    closed_rows,
     decoded_to_caller,
     each_to_caller,
     placed_to_caller,
@@ -62,14 +61,12 @@ from curve_vae.inference.results import (
     head_splines,
     no_closeness,
 )
-from curve_vae.inference.sampling import MAX_DRAWS, Sampler, fresh_seed
+from curve_vae.inference.sampling import MAX_DRAWS, Sampler
 from curve_vae.inference.sessions import SessionConfig
 from curve_vae.inference.spacer import Spacer
 
 DEFAULT = Reading()
 T = TypeVar("T")
-#: Points of the warm-up request's curve: not the model's count, so that it is resampled and fitted as callers' are.
-WARM_UP_POINTS = 57
 
 
 class CurveRuntime:
@@ -139,26 +136,9 @@ class CurveRuntime:
             priors_dir=priors_dir,
         )
         runtime = cls(**parts)
-        if warm_up:
-            runtime.warm_up()
+        if warm_up:  # one default request before the first caller's (inference.opening.warm_up_request)
+            warm_up_request(runtime)
         return runtime
-
-    def warm_up(self) -> None:
-        """One default request, read as any caller's is: the compiled kernels it runs (geometry's natural fit and
-        placement, numba) load here, or compile into numba's cache on a machine's first start (about 30 s; 0.5 s from
-        the cache), so that no caller's first request pays for them. The encoding cache and the graphs' row counts
-        are left as they were; ModelLoadError if the request fails."""
-        t = np.linspace(0.2, 2.9, WARM_UP_POINTS)
-        arc = np.stack([300 + 120 * np.cos(t), 200 - 80 * np.sin(t) + 10 * np.sin(3 * t)], axis=1)
-        rows, cache = dict(self.graphs.rows), self.reader.cache
-        self.reader.cache = None
-        try:
-            self.reconstruct([arc])
-        except Exception as e:  # noqa: BLE001  (whatever fails, the model cannot serve: say so at start)
-            raise ModelLoadError(f"warm-up request failed: {e}") from e
-        finally:
-            self.reader.cache = cache
-            self.graphs.rows.update(rows)
 
     # ----------------------------------------------------------------------- what the model is
 
@@ -334,31 +314,17 @@ class CurveRuntime:
         frame: Frame | None = None,
     ) -> Sampled:
         """New curves from a latent distribution (inference.sampling), in the model plane or mapped into `frame`."""
-        root = fresh_seed() if seed is None else seed
-        drawn = self.sampler.draw(
-            count, seed=root, temperature=temperature, prior=prior, valid=valid, max_draws=max_draws, offset=offset
-        )
-        frames: list[Frame] | None = [frame] * count if frame else None
-        out, ctrl = drawn.decoded, drawn.ctrl
-        named = self.priors.get(drawn.prior)
-        if named is not None:  # a user's family: each sample in the frame of its nearest reference curve
-            if frames is None and named.reference.frames.size:
-                frames = [named.reference.frame(int(i)) for i in named.nearest(drawn.latents)]
-            if named.closed:  # loops stay loops
-                out, ctrl = closed_rows(out, ctrl)
-        placed = decoded_to_caller(
-            self.graphs, out, ctrl, drawn.params, frames=frames, n_points=n_points, spacing=spacing
-        )
-        return Sampled(
-            placed.curves,
-            placed.frames,
-            placed.splines,
-            latents=drawn.latents,
-            prior=drawn.prior,
-            seed=root,
+        return self.sampler.sample(
+            count,
+            seed=seed,
+            temperature=temperature,
+            prior=prior,
+            valid=valid,
+            max_draws=max_draws,
             offset=offset,
-            rejected=drawn.rejected,
-            invalid=drawn.invalid,
+            n_points=n_points,
+            spacing=spacing,
+            frame=frame,
         )
 
     def explore(

@@ -2,8 +2,8 @@
 
 `Sampler.draw` draws latents from a prior (the learned mixture shipped with the model, or N(0, I)) and decodes
 them in the model plane, rejecting and redrawing curves that cross themselves or leave the region the reference
-curves live in; `CurveRuntime.sample` maps the result to the caller. `fresh_seed` draws a seed for a request that
-gave none.
+curves live in; `Sampler.sample` maps the result to the caller (`CurveRuntime.sample`). `fresh_seed` draws a seed
+for a request that gave none.
 """
 
 from __future__ import annotations
@@ -12,12 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from curve_vae.geometry import sample_bspline, self_intersects
+from curve_vae.geometry import Frame, sample_bspline, self_intersects
 from curve_vae.geometry.adapt import joined_ends
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.named_priors import NamedPrior
+from curve_vae.inference.placing import closed_rows, decoded_to_caller
 from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.results import Sampled
 
 MAX_DRAWS = 10  # per sampled curve: the shipped prior rejects 25% of draws, so 10 fail with probability ~1e-6;
 # and a distribution that rejects almost everything (the standard prior) costs at most 10 decodes a curve
@@ -150,6 +152,50 @@ class Sampler:
         if ok.any():
             ok[ok] = ~self_intersects(curves[ok])
         return ok
+
+    def sample(
+        self,
+        count: int,
+        *,
+        seed: int | None = None,
+        temperature: float = 1.0,
+        prior: str | None = None,
+        valid: bool = True,
+        max_draws: int = MAX_DRAWS,
+        offset: int = 0,
+        n_points: int | None = None,
+        spacing: str = "parameter",
+        frame: Frame | None = None,
+    ) -> Sampled:
+        """`draw`n curves mapped to the caller: into `frame`, or, drawn from a user's family, each into the frame of
+        its nearest reference curve (loops kept loops); else left in the model plane. `seed` None: a fresh one,
+        reported back."""
+        root = fresh_seed() if seed is None else seed
+        drawn = self.draw(
+            count, seed=root, temperature=temperature, prior=prior, valid=valid, max_draws=max_draws, offset=offset
+        )
+        frames: list[Frame] | None = [frame] * count if frame else None
+        out, ctrl = drawn.decoded, drawn.ctrl
+        named = self.named.get(drawn.prior)
+        if named is not None:
+            if frames is None and named.reference.frames.size:
+                frames = [named.reference.frame(int(i)) for i in named.nearest(drawn.latents)]
+            if named.closed:
+                out, ctrl = closed_rows(out, ctrl)
+        placed = decoded_to_caller(
+            self.graphs, out, ctrl, drawn.params, frames=frames, n_points=n_points, spacing=spacing
+        )
+        return Sampled(
+            placed.curves,
+            placed.frames,
+            placed.splines,
+            latents=drawn.latents,
+            prior=drawn.prior,
+            seed=root,
+            offset=offset,
+            rejected=drawn.rejected,
+            invalid=drawn.invalid,
+        )
 
 
 def fresh_seed() -> int:
