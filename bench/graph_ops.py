@@ -89,7 +89,7 @@ def rows_a_curve(model_dir: Path, curves: int) -> dict[str, float]:
         return run(self, output_names, feed, *rest)  # type: ignore[arg-type]
 
     rt = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1, cache_bytes=0)
-    asked = list(ceiling.callers_curves(ceiling.curves(curves, seed=2), seed=2))
+    asked = list(ceiling.posted(curves, seed=2))
     ort.InferenceSession.run = counting  # type: ignore[method-assign]
     try:
         rt.reconstruct(asked)

@@ -65,8 +65,7 @@ def main() -> None:
     args = p.parse_args()
     limit_blas_threads(1)
     rt = CurveRuntime.load(args.model_dir, sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
-    plane = ceiling.curves(64 * args.curves, seed=3)
-    callers = list(ceiling.callers_curves(plane, seed=3))
+    callers = list(ceiling.posted(64 * args.curves, seed=3))
     requests = [callers[i : i + args.curves] for i in range(0, len(callers), args.curves)]
     reading = READINGS[args.reading]
     rt.reconstruct(requests[0], reading)  # warm: graphs, compiled code
