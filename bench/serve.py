@@ -241,8 +241,8 @@ def _load(
     return report[name]
 
 
-FAST = {"pose": "as_is", "spacing": "parameter"}  # the fast path: the curve read as it is listed
-ONE_PASS = {"pose": "canonical", "spacing": "parameter"}  # one encoding per curve, in the canonical pose
+FAST = {"pose": "as_is", "spacing": "parameter", "looks": 0}  # the fast path: the curve read as it is listed
+ONE_PASS = {"pose": "canonical", "spacing": "parameter", "looks": 0}  # one encoding per curve, canonical pose
 SEARCH = {"pose": "search", "spacing": "search"}  # every pose and spacing candidate, the closest kept
 NO_CACHE = {"CURVE_VAE_CACHE_BYTES": "0"}  # wrk posts one body again and again: without this, every curve is a hit
 

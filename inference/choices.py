@@ -50,9 +50,8 @@ POSE = Option(
         "search": "six poses (the chord turned to -90°, -45° or -135°, each also reversed and mirrored end for end) "
         "encoded and decoded, the reconstruction closest to the input kept (6× the inference).",
         "learned": 'the same candidates (and, with spacing "search", each one\'s natural reading) ranked by the '
-        "model's reading ranker from their points; the first encoded, the second too where the first came back "
-        "farther than 0.05% of the curve's size, and the closer kept (1–2× the inference; needs a model with a "
-        "ranker, GET /model: ranker).",
+        "model's reading ranker from their points, the first encoded (one encoding; needs a model with a ranker, "
+        "GET /model: ranker).",
         "as_is": "the curve as it is listed.",
     },
     before='How a curve is turned before it is encoded (frame "auto").',
@@ -75,6 +74,20 @@ SPACING = Option(
     before="How the points of a curve are read along it.",
     after="Returned curves of `n_points` are at the model's own spacing (evenly in its spline parameter) except "
     'with "arc_length".',
+)
+
+#: Most looks again a request may ask for (each one encoder and one decoder pass a curve; inference/looking.py).
+MAX_LOOKS = 5
+
+LOOKS = Option(
+    "looks again after reading: fixed-point steps z ← z + E(x) − E(D(z)), as the service's `looks`",
+    {},
+    before="Looks again after reading. Each look re-encodes the decoded curve and moves the latent by what the "
+    "encoder reads differently from the input (z ← z + E(x) − E(D(z))), kept only where it brings the decoding "
+    "closer: one encoder and one decoder pass a curve each, no training, no Jacobian. In /encode the returned means "
+    "are the latents after the looks; `refine` starts from them.",
+    ge=0,
+    le=MAX_LOOKS,
 )
 
 #: Most fitting steps a request may ask for (each costs about 7 decoder runs per curve: a Jacobian of 32 runs every

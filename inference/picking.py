@@ -1,30 +1,24 @@
-"""Which of a curve's candidate readings the reader keeps (inference.reader): pose "learned"'s first and second by the
-reading ranker, whether the first came back close enough to stop there, and, for a set that is mixed together, the
-one pose the whole set is read in.
+"""Which of a curve's candidate readings the reader keeps (inference.reader): pose "learned"'s best by the reading
+ranker, and, for a set that is mixed together, the one pose the whole set is read in.
 
-    candidates (k, 161, 2) --ranker.scores--> each curve's RANKED_READS best, distinct (`ranked`)
-        --the first encoded, decoded, placed--> within CLOSE_ENOUGH of its size? kept : the second too, the closer kept
+    candidates (k, 161, 2) --ranker.scores--> each curve's `count` best, distinct (`ranked`) --encoded--> (the closest
+        decoded kept where there are several)
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from curve_vae.geometry import Frame
-from curve_vae.geometry.metrics import diagonal
 from curve_vae.inference.candidates import Candidate
-from curve_vae.inference.ranker import RANKED_READS, Ranker
+from curve_vae.inference.ranker import Ranker
 
-#: Pose "learned" reads each curve's second-ranked candidate only where its first came back farther than this (RMS
-#: distance ÷ the curve's bounding-box diagonal, as `closeness` states it); RANKED_READS at most.
-CLOSE_ENOUGH = 0.0005
 #: Candidates whose model-plane points all lie within this (plane units; the plane is 128 across) are one reading:
 #: a symmetric curve reversed and mirrored end for end is itself again.
 SAME_POINTS = 1e-3
 
 
-def ranked(ranker: Ranker, stage: list[Candidate], models: np.ndarray, *, shared: bool) -> list[np.ndarray]:
-    """Which candidates pose "learned" encodes, per curve, best first: its RANKED_READS the ranker expects closest;
+def ranked(ranker: Ranker, stage: list[Candidate], models: np.ndarray, *, shared: bool, count: int) -> list[np.ndarray]:
+    """Which candidates pose "learned" encodes, per curve, best first: the `count` the ranker expects closest;
     shared: in the one pose whose expected errors (each curve's least, relative to its size) sum least over the set."""
     score = ranker.scores(models)
     owner = np.array([c.curve for c in stage])
@@ -37,7 +31,7 @@ def ranked(ranker: Ranker, stage: list[Candidate], models: np.ndarray, *, shared
         chosen = min(expected, key=expected.__getitem__)
         score = np.where(pose == chosen, score, np.inf)
     return [
-        distinct(rows[np.argsort(score[rows], kind="stable")], models, RANKED_READS)
+        distinct(rows[np.argsort(score[rows], kind="stable")], models, count)
         for rows in (np.flatnonzero((owner == i) & (score < np.inf)) for i in np.unique(owner))
     ]
 
@@ -51,15 +45,6 @@ def distinct(ranked: np.ndarray, models: np.ndarray, count: int) -> np.ndarray:
         if all(np.abs(models[k] - models[j]).max() > SAME_POINTS for j in kept):
             kept.append(int(k))
     return np.array(kept)
-
-
-def close_enough(err: float, points: np.ndarray, frame: Frame | None, model_size: float) -> bool:
-    """Whether a candidate's squared distances in the model plane (summed over the curve's points), as RMS distance ÷
-    the curve's bounding-box diagonal (geometry.closeness' figure, before any untangling), are within CLOSE_ENOUGH;
-    a curve without size, or a distance that is not finite, is not."""
-    scale = 1.0 if frame is None else frame.size / model_size  # model-plane units to the caller's
-    size = float(diagonal(points))
-    return size > 0 and bool(np.sqrt(err / len(points)) * scale / size <= CLOSE_ENOUGH)
 
 
 def in_shared_pose(inputs: list[np.ndarray], stage: list[Candidate], err: np.ndarray) -> np.ndarray:

@@ -27,6 +27,7 @@ class ReadCurve:
     params: np.ndarray | None = None  # (n_points,) its points' spline parameters, with a head that learns them
     feet: np.ndarray | None = None  # with closest placement or refine: each caller point's spline parameter
     repair: np.ndarray | None = None  # (n_ctrl, 2) float64: how `ctrl` was moved to uncross the answer (untangling)
+    distance: float | None = None  # the decoding's squared distance from the input in the model plane (Reader._decoded)
 
     ARRAYS: ClassVar[tuple[str, ...]] = (
         "model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet", "repair"
@@ -52,9 +53,18 @@ class ReadCurve:
         return replace(self, **views) if views else self
 
     def with_decoding(
-        self, decoded: np.ndarray, ctrl: np.ndarray | None, params: np.ndarray | None, feet: np.ndarray | None
+        self,
+        decoded: np.ndarray,
+        ctrl: np.ndarray | None,
+        params: np.ndarray | None,
+        feet: np.ndarray | None,
+        distance: float | None = None,
     ) -> ReadCurve:
-        return replace(self, decoded=decoded, ctrl=ctrl, params=params, feet=feet, repair=None)
+        return replace(self, decoded=decoded, ctrl=ctrl, params=params, feet=feet, repair=None, distance=distance)
+
+    def moved_to(self, mean: np.ndarray) -> ReadCurve:
+        """This reading with another latent, not decoded yet (a look again, a fit)."""
+        return replace(self, mean=mean, decoded=None, ctrl=None, params=None, feet=None, repair=None, distance=None)
 
 
 @dataclass(frozen=True)

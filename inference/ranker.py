@@ -1,7 +1,7 @@
 """The reading ranker: from each candidate reading's model-plane points, the natural log of the relative RMSE the model
 would bring it back at (trained by training/ranker.py against the frozen graphs, run as the ONNX graph it exports:
 the service has no torch, and onnxruntime releases the GIL while it runs). Reading pose "learned" encodes only the
-two candidates it ranks first (inference.reader).
+candidate it ranks first (inference.reader), then looks again (inference.looking).
 
 The network: the points centred on the plane and their steps along the curve (4 channels), three convolutions of
 kernel 5 and stride 2 with ReLU, the mean and the maximum over the curve, a hidden layer, one output.
@@ -18,8 +18,9 @@ from curve_vae.inference.learned import PartGraph
 from curve_vae.inference.sessions import SessionConfig
 
 RANKER_KIND = "conv1d-3x5s2-meanmax-v1"
-#: Readings pose "learned" encodes per curve: the ranker's first two.
-RANKED_READS = 2
+#: Readings pose "learned" encodes per curve: the ranker's first. With a look again after it, the first alone reads
+#: closer than the closer of the first two read without one, at the same graph passes (docs/RESULTS.md, "Readings").
+RANKED_READS = 1
 #: Scale of the plane (half its side) and of a step between neighbouring points in the ranker's inputs.
 PLANE_HALF = 64.0
 STEP_SCALE = 20.0

@@ -41,8 +41,9 @@ from curve_vae.inference.candidates import Candidate, model_points
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.looking import look_again
 from curve_vae.inference.prepared import Prepared, ReadCurve
-from curve_vae.inference.ranker import Ranker
+from curve_vae.inference.ranker import RANKED_READS, Ranker
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.spacer import Spacer
 from curve_vae.inference.untangling import untangle_rows
@@ -93,6 +94,9 @@ class Reader:
         self.fitter = fitter
         self.cache = cache
         self.untangle = True  # answers that cross themselves where their inputs do not are untangled (untangling)
+        #: pose "learned": how many of each curve's candidates the ranker's order reads, the closest kept. One, then
+        #: a look again, reads closer than two at the cost of two (docs/RESULTS.md, "Readings").
+        self.ranked_reads = RANKED_READS
 
     def read(
         self, curves: Sequence[np.ndarray], reading: Reading, *, decoded: bool = True, shared: bool = False
@@ -117,7 +121,12 @@ class Reader:
         todo = [i for i, r in enumerate(rows) if r is None]
         if shared and todo:  # the set's pose is chosen for all its curves at once
             todo = list(range(len(inputs)))
-        for i, row in zip(todo, self._fresh([inputs[i] for i in todo], todo, reading, shared=shared)):
+        new = self._fresh([inputs[i] for i in todo], todo, reading, shared=shared)
+        unlooked: dict[int, ReadCurve] = {}  # each row as read, before its looks (refine starts from the looks)
+        if reading.looks > 0 and new:
+            before, new = self._looked([inputs[i] for i in todo], new, reading.looks)
+            unlooked = dict(zip(todo, before)) if reading.refine == 0 else {}
+        for i, row in zip(todo, new):
             rows[i] = row
         read = [r for r in rows if r is not None]  # every row now: cached or read just now
         if reading.refine > 0 and todo:  # cached rows were cached refined: the reading's key counts the steps
@@ -133,15 +142,7 @@ class Reader:
             for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [read[i] for i in missing])[0]):
                 read[i] = row
         if self.untangle:  # rows read or decoded just now (cached rows were untangled when they were read)
-            fresh = sorted(set(todo) | set(missing))
-            untangled = untangle_rows(
-                [inputs[i] for i in fresh],
-                [read[i] for i in fresh],
-                model_size=self.graphs.model_size,
-                degree=self.graphs.spline_degree,
-            )
-            for i, row in zip(fresh, untangled):
-                read[i] = row
+            self._untangle(inputs, read, sorted(set(todo) | set(missing)), unlooked)
         if self.cache is not None:
             for k, row in zip(keys, read):
                 self.cache.put(k, row)
@@ -159,9 +160,7 @@ class Reader:
         if reading.pose == "learned" and stage:
             if self.ranker is None:
                 raise InputError(("pose",), 'pose "learned" needs a model with a reading ranker; this one has none')
-            ranked = picking.ranked(self.ranker, stage, models, shared=shared)
-            if not shared and self.closest:
-                return self._first_then_second(inputs, index, stage, models, fractions, ranked)
+            ranked = picking.ranked(self.ranker, stage, models, shared=shared, count=self.ranked_reads)
             keep = np.sort(np.concatenate(ranked))
             stage, models, fractions = [stage[k] for k in keep], models[keep], [fractions[k] for k in keep]
         if not stage:
@@ -185,39 +184,6 @@ class Reader:
             mean, log_var = self.graphs.encode(models)
         _check_finite(mean, log_var, [index[c.curve] for c in stage])
         return [ReadCurve(c.frame, m, fr, mu, lv) for c, m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)]
-
-    def _first_then_second(
-        self,
-        inputs: list[np.ndarray],
-        index: list[int],
-        stage: list[Candidate],
-        models: np.ndarray,
-        fractions: list[Any],
-        ranked: list[np.ndarray],
-    ) -> list[ReadCurve]:
-        """Pose "learned" in two rounds, all curves at once in each: every curve's first candidate, decoded and
-        placed; then, only where that did not come back close enough (inference.picking.CLOSE_ENOUGH), its second,
-        the closer of the two kept."""
-        first = [int(r[0]) for r in ranked]
-        rows, err = self._decoded(
-            inputs, self._encoded([stage[k] for k in first], models[first], [fractions[k] for k in first], index)
-        )
-        size = self.graphs.model_size
-        again = [
-            i
-            for i, r in enumerate(ranked)
-            if len(r) > 1 and not picking.close_enough(err[i], inputs[i], stage[first[i]].frame, size)
-        ]
-        if again:
-            second = [int(ranked[i][1]) for i in again]
-            more, err2 = self._decoded(
-                [inputs[i] for i in again],
-                self._encoded([stage[k] for k in second], models[second], [fractions[k] for k in second], index),
-            )
-            for i, row, e in zip(again, more, err2):
-                if e < err[i]:
-                    rows[i] = row
-        return rows
 
     def _candidates(
         self, inputs: list[np.ndarray], index: list[int], reading: Reading, *, shared: bool = False
@@ -302,6 +268,35 @@ class Reader:
                 raise
         return out
 
+    def _looked(
+        self, inputs: list[np.ndarray], rows: list[ReadCurve], steps: int
+    ) -> tuple[list[ReadCurve], list[ReadCurve]]:
+        """The rows decoded (where they are not yet), and after `steps` looks again (inference.looking)."""
+        todo = [i for i, r in enumerate(rows) if not r.decoded_yet or r.distance is None]
+        rows = list(rows)
+        for i, row in zip(todo, self._decoded([inputs[i] for i in todo], [rows[i] for i in todo])[0]):
+            rows[i] = row
+        err = np.array([r.distance for r in rows], np.float64)
+        return rows, look_again(self.graphs, inputs, rows, err, steps, self._decoded)[0]
+
+    def _untangle(
+        self, inputs: list[np.ndarray], read: list[ReadCurve], fresh: list[int], unlooked: dict[int, ReadCurve]
+    ) -> None:
+        """`read[i]` for each i in `fresh` untangled (inference.untangling), in place; where a looked-at answer still
+        crosses itself, the answer read before the looks, untangled, if that one does not."""
+        size, degree = self.graphs.model_size, self.graphs.spline_degree
+        rows, tangled = untangle_rows([inputs[i] for i in fresh], [read[i] for i in fresh], model_size=size,
+                                      degree=degree)  # fmt: skip
+        for i, row in zip(fresh, rows):
+            read[i] = row
+        back = [fresh[k] for k in tangled if fresh[k] in unlooked]
+        if back:
+            rows, still = untangle_rows([inputs[i] for i in back], [unlooked[i] for i in back], model_size=size,
+                                        degree=degree)  # fmt: skip
+            for k, (i, row) in enumerate(zip(back, rows)):
+                if k not in still:
+                    read[i] = row
+
     # ----------------------------------------------------------------------------------- decoding, placement
 
     def _decoded(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], np.ndarray]:
@@ -320,13 +315,18 @@ class Reader:
             else:
                 model = np.stack([r.model for r in rows]).astype(np.float64)
                 err = ((decoded.astype(np.float64) - model) ** 2).sum(axis=(1, 2))
+        err = np.where(np.isfinite(err), err, np.inf)
         out = [
             r.with_decoding(
-                decoded[i], None if ctrl is None else ctrl[i], None if params is None else params[i], feet[i]
+                decoded[i],
+                None if ctrl is None else ctrl[i],
+                None if params is None else params[i],
+                feet[i],
+                float(err[i]),
             )
             for i, r in enumerate(rows)
         ]
-        return out, np.where(np.isfinite(err), err, np.inf)
+        return out, err
 
     def _targets(self, inputs: list[np.ndarray], frames: list[Frame | None]) -> list[np.ndarray]:
         """Each caller curve in the model plane, through its frame: all at once where every curve has one."""

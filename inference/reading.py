@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, fields, replace
 from functools import cache
 from typing import Any, get_args, get_type_hints
 
-from curve_vae.inference.choices import FRAME, POSE, REFINE, SPACING, FrameMode, Option, Pose, Spacing
+from curve_vae.inference.choices import FRAME, LOOKS, POSE, REFINE, SPACING, FrameMode, Option, Pose, Spacing
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ReadingSpec
 
@@ -29,6 +29,7 @@ class Reading:
     frame: FrameMode = field(default="auto", metadata={"option": FRAME})
     pose: Pose = field(default="auto", metadata={"option": POSE})
     spacing: Spacing = field(default="auto", metadata={"option": SPACING})
+    looks: int = field(default=1, metadata={"option": LOOKS})  # fixed-point steps after reading (inference.looking)
     refine: int = field(default=0, metadata={"option": REFINE})  # Levenberg–Marquardt steps (inference.fitting)
 
     def __post_init__(self) -> None:
@@ -53,7 +54,7 @@ class Reading:
     @property
     def key(self) -> str:
         """The reading as a cache key."""
-        return f"{self.frame}/{self.pose}/{self.spacing}/{self.refine}"
+        return f"{self.frame}/{self.pose}/{self.spacing}/{self.looks}/{self.refine}"
 
 
 def _within(value: object, doc: Option) -> bool:

@@ -30,14 +30,15 @@ class _Indexed(Protocol):
 
 def untangle_rows(
     inputs: Sequence[np.ndarray], rows: Sequence[ReadCurve], *, model_size: float, degree: int
-) -> list[ReadCurve]:
+) -> tuple[list[ReadCurve], list[int]]:
     """The rows whose answers (their splines at their points' parameters) cross themselves where the inputs do not,
-    untangled against the inputs' own points; the rest as they are. Rows without a spline or placed points (a model
-    without a B-spline head or closest placement) are returned as they are."""
+    untangled against the inputs' own points; the rest as they are; and which rows still cross after it. Rows without
+    a spline or placed points (a model without a B-spline head or closest placement) are returned as they are."""
     out = list(rows)
+    tangled: list[int] = []
     placed = [i for i, r in enumerate(rows) if r.ctrl is not None and r.feet is not None]
     if not placed:
-        return out
+        return out, tangled
     ctrl = [_closed_ctrl(inputs[i], rows[i]) for i in placed]
     feet = [np.asarray(rows[i].feet, np.float64) for i in placed]
     lengths = np.array([len(f) for f in feet])
@@ -50,9 +51,11 @@ def untangle_rows(
         i = placed[j]
         row = rows[i]
         target = row.frame.to_model(inputs[i], model_size) if row.frame is not None else np.asarray(inputs[i])
-        fixed, _ = untangled(ctrl[j], feet[j], target, closed=is_closed(inputs[i]), degree=degree)
+        fixed, free = untangled(ctrl[j], feet[j], target, closed=is_closed(inputs[i]), degree=degree)
         out[i] = dataclasses.replace(row, ctrl=fixed, repair=fixed - ctrl[j])  # float64: the fit's own digits
-    return out
+        if not free:
+            tangled.append(i)
+    return out, tangled
 
 
 def _closed_ctrl(points: np.ndarray, row: ReadCurve) -> np.ndarray:

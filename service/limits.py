@@ -18,6 +18,7 @@ from pydantic import BaseModel
 
 from curve_vae.geometry import simplex_grid, simplex_grid_size
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.reading import Reading
 from curve_vae.service.schemas import AugmentRequest, InterpolateRequest, RevolveRequest
 
 DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
@@ -93,7 +94,7 @@ def check_request(req: BaseModel, settings: Any, curves: list[np.ndarray], *, sk
     check(req, settings, skip=skip)
     reading = getattr(req, "reading", None)
     if reading is not None:
-        check_refine(reading().refine, curves, settings)
+        check_refine(reading(), curves, settings)
     if isinstance(req, AugmentRequest):
         check_augment_format(req, settings)
     if isinstance(req, RevolveRequest):
@@ -136,19 +137,27 @@ def curves_of(req: WithCurves) -> list[np.ndarray]:
 #: What one curve costs a fitting step beyond its points, in points: its decoder runs (inference/fitting.py) take
 #: about as long as matching 300 points (10 steps: ~86 ms for a 4-point curve, ~130 ms for a 161-point one).
 REFINE_POINTS_PER_CURVE = 300
+#: What one curve costs a look again (inference/looking.py), in the same points: one encoder and one decoder row and a
+#: placement, ~2.1–2.5 ms a curve of 8 to 1,000 points where a refine step of a 161-point curve costs ~2.0 ms beyond
+#: its first (the Jacobian's) and 300 + 161 points of work.
+LOOK_POINTS_PER_CURVE = 80
 
 
-def check_refine(steps: int, curves: list[np.ndarray], settings: Any) -> None:
-    """The fitting work a request asks for — steps × (input points + REFINE_POINTS_PER_CURVE per curve) — within
-    CURVE_VAE_MAX_REFINE_WORK."""
+def check_refine(reading: Reading, curves: list[np.ndarray], settings: Any) -> None:
+    """The fitting work a request asks for — refine × (input points + REFINE_POINTS_PER_CURVE per curve) + looks ×
+    LOOK_POINTS_PER_CURVE per curve — within CURVE_VAE_MAX_REFINE_WORK; the field named is refine where it asks for
+    steps, else looks."""
     points = sum(len(c) for c in curves)
-    work = steps * (points + REFINE_POINTS_PER_CURVE * len(curves))
+    fitting = reading.refine * (points + REFINE_POINTS_PER_CURVE * len(curves))
+    work = fitting + reading.looks * LOOK_POINTS_PER_CURVE * len(curves)
     if work > settings.max_refine_work:
+        field = "refine" if reading.refine else "looks"
         raise InputError(
-            ("refine",),
-            f"{steps} steps on {len(curves)} curves of {points} points in all are {work} units of work (steps × "
-            f"(points + {REFINE_POINTS_PER_CURVE} per curve)); at most {settings.max_refine_work} "
-            "(CURVE_VAE_MAX_REFINE_WORK): send fewer curves or steps",
+            (field,),
+            f"refine {reading.refine} and looks {reading.looks} on {len(curves)} curves of {points} points in all "
+            f"are {work} units of work (refine × (points + {REFINE_POINTS_PER_CURVE} per curve) + looks × "
+            f"{LOOK_POINTS_PER_CURVE} per curve); at most {settings.max_refine_work} (CURVE_VAE_MAX_REFINE_WORK): "
+            "send fewer curves, steps or looks",
         )
 
 

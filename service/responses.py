@@ -205,10 +205,11 @@ class ModelInfo(BaseModel):
     n_points: int = Field(description="Points per curve the model sees (161).")
     latent_dim: int = Field(description="Length of every latent vector.")
     model_size: float = Field(description='Bounding-box size curves are scaled to by frame "auto".')
-    reading: dict[str, str] = Field(
-        description='What pose and spacing "auto" mean for this model: the reading its encoder was trained for '
-        '("canonical" pose, "parameter" spacing: one encoding per curve; "search": the candidates searched; '
-        '"learned" pose: the search\'s candidates ranked by `ranker`, two encoded per curve).'
+    reading: dict[str, str | int] = Field(
+        description="A request's reading when it sets none of the reading fields: the pose and spacing the model's "
+        'encoder was trained for (what "auto" means: "canonical" pose with "parameter" spacing, one encoding per '
+        'curve; "search", the candidates searched; "learned" pose, the search\'s candidates ranked by `ranker` and '
+        "the first encoded), the looks again after it and the refine steps."
     )
     ranker: dict[str, Any] | None = Field(
         None,

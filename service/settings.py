@@ -67,8 +67,9 @@ class Settings(BaseSettings):
     # curves of one streamed .npy (/augment format npy): ~13 MB per 10k
     max_stream_curves: int = Field(default=100_000, ge=1)
     max_mesh_triangles: int = Field(default=1_000_000, ge=1)  # triangles of one /revolve mesh: 50 MB of STL
-    # Fitting work of one request, steps × (input points + 300 per curve) (service/deps.py check_refine): about 35 s
-    # of one CPU core here, under request_timeout; 256 curves of 161 points may take 10 steps.
+    # Fitting work of one request, refine × (input points + 300 per curve) + looks × 80 per curve (service/limits.py
+    # check_refine): about 35 s of one CPU core here, under request_timeout; 256 curves of 161 points may take 10
+    # steps.
     max_refine_work: int = Field(default=1_200_000, ge=0)
     # Bytes the encoding cache may hold (inference/cache.py): curves posted again — the page's slider, a pipeline's
     # seed curves and retries — skip the encoder; 0 turns it off. ~3.4 KB a curve of 161 points.

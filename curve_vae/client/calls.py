@@ -174,9 +174,11 @@ def parse_json(body: bytes, _model: ModelRef, _headers: Headers = NO_HEADERS) ->
 # ------------------------------------------------------------------------------------------ the endpoints
 
 
-def reading(frame: FrameMode | None, pose: Pose | None, spacing: Spacing | None, refine: int | None) -> dict[str, Any]:
+def reading(
+    frame: FrameMode | None, pose: Pose | None, spacing: Spacing | None, looks: int | None, refine: int | None
+) -> dict[str, Any]:
     """The reading's fields the caller set (inference.reading.Reading's options; the server's defaults for the rest)."""
-    return _fields(frame=frame, pose=pose, spacing=spacing, refine=refine)
+    return _fields(frame=frame, pose=pose, spacing=spacing, looks=looks, refine=refine)
 
 
 def output(n_points: int | None, output_as: str | None, metrics: bool | None) -> dict[str, Any]:

@@ -154,6 +154,7 @@ class Client(Endpoints):
         frame: FrameMode | None = None,
         pose: Pose | None = None,
         spacing: Spacing | None = None,
+        looks: int | None = None,
         refine: int | None = None,
         n_points=None,
     ) -> Iterator[Augmented]:
@@ -164,7 +165,7 @@ class Client(Endpoints):
         mix needs two), before the first chunk is asked for."""
         seeds = as_batch(curves, "augment_chunks", at_least=2)
         seed = fresh_seed() if seed is None else seed
-        fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points)
+        fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, looks, refine), n_points)
         return self._chunks(seeds, count, chunk, offset, seed, fields)
 
     def _chunks(
@@ -260,13 +261,14 @@ class AsyncClient(Endpoints):
         frame: FrameMode | None = None,
         pose: Pose | None = None,
         spacing: Spacing | None = None,
+        looks: int | None = None,
         refine: int | None = None,
         n_points=None,
     ) -> AsyncIterator[Augmented]:
         """See `Client.augment_chunks`: an async iterator (`async for chunk in c.augment_chunks(…)`)."""
         seeds = as_batch(curves, "augment_chunks", at_least=2)
         seed = fresh_seed() if seed is None else seed
-        fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points)
+        fields = augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, looks, refine), n_points)
         return self._chunks(seeds, count, chunk, offset, seed, fields)
 
     async def _chunks(

@@ -29,11 +29,12 @@ class Endpoints:
         frame: FrameMode | None = None,
         pose: Pose | None = None,
         spacing: Spacing | None = None,
+        looks: int | None = None,
         refine: int | None = None,
     ) -> Any:
         """Latent means and log-variances (`Encoded`: mean, log_var, frames, closeness) of curves, or of one curve
         (an (n, 2) array: answered as a batch of one)."""
-        fields = k.reading(frame, pose, spacing, refine)
+        fields = k.reading(frame, pose, spacing, looks, refine)
         curves = as_batch(curves, "encode")
         return self._call(k.curves_call("/encode", curves, fields, k.parse_encoded, npy_points=self.npy_points))
 
@@ -52,6 +53,7 @@ class Endpoints:
         frame: FrameMode | None = None,
         pose: Pose | None = None,
         spacing: Spacing | None = None,
+        looks: int | None = None,
         refine: int | None = None,
         n_points=None,
         output=None,
@@ -59,7 +61,7 @@ class Endpoints:
     ) -> Any:
         """Each curve through the model (`Reconstructed`: curves, mse, closeness, repaired, splines); one curve (an
         (n, 2) array) is answered as a batch of one, its curve `.curve`."""
-        fields = {**k.reading(frame, pose, spacing, refine), **k.output(n_points, output, metrics)}
+        fields = {**k.reading(frame, pose, spacing, looks, refine), **k.output(n_points, output, metrics)}
         curves = as_batch(curves, "reconstruct")
         return self._call(
             k.curves_call("/reconstruct", curves, fields, k.parse_reconstructed, npy_points=self.npy_points)
@@ -74,6 +76,7 @@ class Endpoints:
         frame: FrameMode | None = None,
         pose: Pose | None = None,
         spacing: Spacing | None = None,
+        looks: int | None = None,
         refine: int | None = None,
         n_points=None,
         output=None,
@@ -84,7 +87,7 @@ class Endpoints:
         sending."""
         curves = as_batch(curves, "interpolate", at_least=2)
         fields = {
-            **k.reading(frame, pose, spacing, refine),
+            **k.reading(frame, pose, spacing, looks, refine),
             **k.output(n_points, output, metrics),
             **k._fields(steps=steps, weights=None if weights is None else k.array(weights)),
         }
@@ -134,6 +137,7 @@ class Endpoints:
         frame: FrameMode | None = None,
         pose: Pose | None = None,
         spacing: Spacing | None = None,
+        looks: int | None = None,
         refine: int | None = None,
         n_points=None,
         output=None,
@@ -144,7 +148,7 @@ class Endpoints:
         sending."""
         curves = as_batch(curves, "augment", at_least=2)
         fields = {
-            **augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, refine), n_points),
+            **augment_fields(mode, seed, neighbours, k.reading(frame, pose, spacing, looks, refine), n_points),
             **k._fields(offset=offset, output=output, metrics=metrics),
         }
         return self._call(k.augment_call(curves, {"count": count, **fields}, npy=False))

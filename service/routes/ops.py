@@ -60,7 +60,7 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
         "n_points": runtime.n_points,
         "latent_dim": runtime.latent_dim,
         "model_size": runtime.model_size,
-        "reading": m.reading.model_dump(include={"pose", "spacing"}),
+        "reading": default_reading(runtime),
         "ranker": m.ranker.model_dump(include={"file", "kind", "held_out"}) if m.ranker else None,
         "spacer": m.spacer.model_dump(include={"file", "kind", "held_out"}) if m.spacer else None,
         "prior": m.prior.model_dump(include={"kind", "components", "fitted_on"}) if m.prior else None,
@@ -91,6 +91,12 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
         },
         "execution": execution_of(request, runtime),
     }
+
+
+def default_reading(runtime: Any) -> dict[str, str | int]:
+    """The reading a request gets when it sets no reading field, "auto" made concrete."""
+    r = runtime.reading()
+    return {"pose": r.pose, "spacing": r.spacing, "looks": r.looks, "refine": r.refine}
 
 
 @ops_router.get(

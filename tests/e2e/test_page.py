@@ -230,7 +230,8 @@ def test_fit_closely_refines_the_reconstructions_and_the_mix(browser, server):
         "window.curveVae.recon[0].refine === 10 && window.curveVae.result && window.curveVae.result.body.refine === 10"
     )
     fitted = state(page)
-    assert fitted["recon"][0]["mse"] < plain["recon"][0]["mse"] / 2, (plain["recon"][0], fitted["recon"][0])
+    # the default already looks again (about 2× closer than the reading alone); ten fitting steps come closer still
+    assert fitted["recon"][0]["mse"] < 0.7 * plain["recon"][0]["mse"], (plain["recon"][0], fitted["recon"][0])
     body = {"curves": fitted["curves"], "spacing": "auto", "n_points": 100, "output": "both", "refine": 10}
     answer = httpx.post(server.url + "/reconstruct", json=body, timeout=30).json()
     np.testing.assert_allclose(drawn(page, "path.reconstruction >> nth=0"), answer["curves"][0], atol=2e-3)

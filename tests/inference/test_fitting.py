@@ -43,13 +43,15 @@ def test_refining_brings_the_shipped_models_reconstructions_much_closer(shipped_
     paper = _in_a_user_frame(bspline_curves(8, seed=11))
     sets = {"parameter": paper, "arc length, 90 points": [resample(c, 90) for c in paper]}
     for name, curves in sets.items():
-        res = shipped_runtime.reconstruct(curves)
+        res = shipped_runtime.reconstruct(curves)  # read, then looked at again
         plain, plain_mse = res.curves, res.mse
-        res = shipped_runtime.reconstruct(curves, Reading(refine=6))
+        res = shipped_runtime.reconstruct(curves, Reading(refine=6))  # fitted from there
         fitted, fitted_mse, splines = res.curves, res.mse, res.splines
         assert (fitted_mse <= plain_mse * (1 + 1e-9)).all(), name
-        before, after = relative_rmse(curves, plain).mean(), relative_rmse(curves, fitted).mean()
-        assert after < before / 2, (name, before, after)
+        read = shipped_runtime.reconstruct(curves, Reading(looks=0)).curves  # the reading alone
+        before, after = relative_rmse(curves, read).mean(), relative_rmse(curves, fitted).mean()
+        assert after < before / 3, (name, before, after)
+        assert after < 0.8 * relative_rmse(curves, plain).mean(), name
         for c, s in zip(fitted, splines):  # the returned points lie on the returned spline, at its params
             np.testing.assert_allclose(evaluate_bspline(s.control_points, s.params), c, atol=1e-9 * np.abs(c).max())
 
@@ -217,10 +219,15 @@ def test_a_request_asking_for_too_much_fitting_work_is_refused_before_any(make_c
         r = client.post(path, json={"curves": c, "refine": 4, **extra})
         assert r.status_code == 422, (path, r.text)
         assert r.json()["detail"] == (
-            "refine: 4 steps on 2 curves of 322 points in all are 3688 units of work (steps × (points + 300 per "
-            "curve)); at most 3000 (CURVE_VAE_MAX_REFINE_WORK): send fewer curves or steps"
+            "refine: refine 4 and looks 1 on 2 curves of 322 points in all are 3848 units of work (refine × "
+            "(points + 300 per curve) + looks × 80 per curve); at most 3000 (CURVE_VAE_MAX_REFINE_WORK): send fewer "
+            "curves, steps or looks"
         )
-        assert client.post(path, json={"curves": c, "refine": 3, **extra}).status_code == 200  # 2766
+        assert client.post(path, json={"curves": c, "refine": 3, **extra}).status_code == 200  # 2766 + 160
+        r = client.post(path, json={"curves": c, "refine": 3, "looks": 5, **extra})  # 2766 + 800
+        assert r.status_code == 422 and r.json()["detail"].startswith("refine: refine 3 and looks 5"), r.text
+    r = client.post("/reconstruct", json={"curves": c * 10, "looks": 4})  # 20 curves × 4 looks × 80
+    assert r.status_code == 422 and r.json()["detail"].startswith("looks: refine 0 and looks 4"), r.text
     assert client.get("/model").json()["limits"]["max_refine_work"] == 3000
 
 

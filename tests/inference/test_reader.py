@@ -113,8 +113,8 @@ def test_a_natural_reading_that_puts_the_points_where_they_are_is_not_tried_agai
     rows: list[int] = []
     encode = runtime.graphs.encode
     monkeypatch.setattr(runtime.graphs, "encode", lambda x: rows.append(len(x)) or encode(x))
-    runtime.reconstruct([even], Reading(spacing="search"))
-    runtime.reconstruct([drawn], Reading(spacing="search"))
+    runtime.reconstruct([even], Reading(spacing="search", looks=0))
+    runtime.reconstruct([drawn], Reading(spacing="search", looks=0))
     poses = 2 * reader_module.POSE_CHORD_COUNT
     assert rows[0] == poses * len(natural_readings(even))  # "parameter", and the readings but the closest
     assert rows[1] == poses * (1 + len(natural_readings(drawn)))
@@ -148,16 +148,25 @@ def _moves_of(c: np.ndarray) -> dict[str, tuple]:
     }
 
 
-def test_the_default_reading_is_one_pass(canonical):
-    assert canonical.reading() == Reading(pose="canonical", spacing="parameter")
+def _graph_rows(rt: CurveRuntime, curves: list[np.ndarray], reading: Reading | None = None) -> dict[str, int]:
+    """The encoder and decoder rows one reconstruction runs."""
     rows: dict[str, list[int]] = {"encoder": [], "decoder": []}
-    run = canonical.graphs._run_graph
-    canonical.graphs._run_graph = lambda s, graph, x, o: rows[graph].append(len(x)) or run(s, graph, x, o)
+    run = rt.graphs._run_graph
+    rt.graphs._run_graph = lambda s, graph, x, o: rows[graph].append(len(x)) or run(s, graph, x, o)
     try:
-        canonical.reconstruct(list(bspline_curves(10, 90, seed=3) * 0.3 - 5))
+        rt.reconstruct(curves, reading)
     finally:
-        canonical.graphs._run_graph = run
-    assert sum(rows["encoder"]) == 10 and sum(rows["decoder"]) == 10
+        rt.graphs._run_graph = run
+    return {k: sum(v) for k, v in rows.items()}
+
+
+def test_the_default_reading_is_one_encoding_and_one_look(canonical):
+    """Ten curves: one encoder and one decoder batch to read them, one of each to look again (inference.looking);
+    without the look, one of each."""
+    assert canonical.reading() == Reading(pose="canonical", spacing="parameter", looks=1)
+    curves = list(bspline_curves(10, 90, seed=3) * 0.3 - 5)
+    assert _graph_rows(canonical, curves) == {"encoder": 20, "decoder": 20}
+    assert _graph_rows(canonical, curves, Reading(looks=0)) == {"encoder": 10, "decoder": 10}
 
 
 @pytest.mark.parametrize("move", ["reversed", "mirrored", "rotated", "all of them"])

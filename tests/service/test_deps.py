@@ -102,18 +102,18 @@ def test_weight_rows_must_sum_to_one_within_a_millionth(client, weights, status)
 
 @pytest.mark.parametrize(
     ("limit", "status"),
-    [pytest.param(614, 200, id="work-at-the-limit"), pytest.param(613, 422, id="one-unit-over")],
+    [pytest.param(774, 200, id="work-at-the-limit"), pytest.param(773, 422, id="one-unit-over")],
 )
 def test_the_refine_work_limit_is_inclusive(make_client, limit, status):
-    """One step on two curves of 7 points: 1 × (14 + 2 × 300) = 614 units of work."""
+    """One step and the default look on two curves of 7 points: 1 × (14 + 2 × 300) + 1 × 2 × 80 = 774 units."""
     client = make_client(max_refine_work=limit)
     for path, extra in (("/reconstruct", {}), ("/augment", {"count": 1, "seed": 1})):
         r = client.post(path, json={"curves": [CURVE, CURVE[::-1]], "refine": 1, **extra})
         assert r.status_code == status, (path, r.text)
         if status == 422:
             assert r.json()["detail"].startswith(
-                "refine: 1 steps on 2 curves of 14 points in all are 614 units of work (steps × (points + 300 per "
-                "curve)); at most 613 (CURVE_VAE_MAX_REFINE_WORK)"
+                "refine: refine 1 and looks 1 on 2 curves of 14 points in all are 774 units of work (refine × "
+                "(points + 300 per curve) + looks × 80 per curve); at most 773 (CURVE_VAE_MAX_REFINE_WORK)"
             )
 
 

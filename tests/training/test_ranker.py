@@ -97,7 +97,7 @@ def test_training_resumes_where_it_stopped_and_exports_the_models_reading(
     assert runtime.reading().pose == "learned"
     curves = list(bspline_curves(3, seed=6))
     before = runtime.graphs.rows["encoder"]
-    runtime.reconstruct(curves)
+    runtime.reconstruct(curves, Reading(looks=0))
     assert runtime.graphs.rows["encoder"] - before == RANKED_READS * len(curves)
 
 
@@ -114,5 +114,5 @@ def test_export_can_leave_the_models_reading_and_version_as_they_were(
     runtime = CurveRuntime.load(model, providers="cpu", intra_op_threads=1, cache_bytes=0)
     curves = list(bspline_curves(2, seed=7))
     before_rows = runtime.graphs.rows["encoder"]
-    runtime.reconstruct(curves, Reading(pose="learned", spacing="search"))  # there when asked for
+    runtime.reconstruct(curves, Reading(pose="learned", spacing="search", looks=0))  # there when asked for
     assert runtime.graphs.rows["encoder"] - before_rows == RANKED_READS * len(curves)

@@ -60,7 +60,8 @@ def test_a_call_without_a_body_sends_none():
 
 
 def test_the_reading_and_output_fields_are_those_set():
-    assert calls.reading(None, "search", None, 0) == {"pose": "search", "refine": 0}
+    assert calls.reading(None, "search", None, None, 0) == {"pose": "search", "refine": 0}
+    assert calls.reading(None, None, None, 2, None) == {"looks": 2}
     assert calls.output(None, "both", False) == {"output": "both", "metrics": False}
 
 

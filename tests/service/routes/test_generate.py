@@ -165,6 +165,7 @@ def test_the_stream_holds_one_chunk_at_a_time(make_client, runtime, monkeypatch)
             "seed": 1,
             "pose": "as_is",
             "spacing": "parameter",
+            "looks": 0,  # a look decodes the seeds too
         },
     )
     assert r.status_code == 200 and len(r.content) == 128 + 1000 * 7 * 2 * 4

@@ -35,7 +35,8 @@ def test_model_lists_only_the_files_the_directory_holds(model_dir, tmp_path):
     with TestClient(create_app(Settings(model_dir=copy, providers="cpu"))) as client:
         info = client.get("/model").json()
     assert set(info["files"]) == {"encoder.onnx", "decoder.onnx", "prior.npz"}
-    assert info["reading"] == {"pose": "search", "spacing": "search"}  # exported before readings were recorded
+    # exported before readings were recorded: the search, and the look again every reading has by default
+    assert info["reading"] == {"pose": "search", "spacing": "search", "looks": 1, "refine": 0}
 
 
 def test_model_info_names_the_spline_head(client):
@@ -62,10 +63,11 @@ def _gauge(text: str, graph: str) -> float:
 
 
 def test_metrics_report_the_rows_each_graph_has_run(client, curves):
-    """One encoding per curve (pose "as_is", spacing "parameter"), one decoding per latent: the gauges /metrics
-    refreshes from the runtime move by exactly that (the runtime is shared, so by differences)."""
+    """One encoding per curve (pose "as_is", spacing "parameter", no look again), one decoding per latent: the gauges
+    /metrics refreshes from the runtime move by exactly that (the runtime is shared, so by differences)."""
     before = client.get("/metrics").text
-    client.post("/encode", json={"curves": curves(3).tolist(), "pose": "as_is", "spacing": "parameter"})
+    one = {"pose": "as_is", "spacing": "parameter", "looks": 0}
+    client.post("/encode", json={"curves": curves(3).tolist(), **one})
     client.post("/decode", json={"latents": [[0.0] * 32] * 5})
     after = client.get("/metrics").text
     assert _gauge(after, "encoder") - _gauge(before, "encoder") == 3
