@@ -9,6 +9,7 @@ from curve_vae.geometry import Frame, blend_frames
 from curve_vae.geometry.adapt import is_closed, joined_ends, spline_params
 from curve_vae.geometry.bspline import spline_values
 from curve_vae.geometry.validity import crosses
+from curve_vae.inference.ends import pinned_mixes
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.placing import check_finite, check_range, joined, to_caller
 from curve_vae.inference.prepared import Prepared
@@ -43,7 +44,8 @@ def mix(
         positions = _positions(prep, w) if blend else None
         repaired = np.zeros(len(w), bool)
         if ctrl is not None:
-            ctrl, repaired = _valid_ctrl(g, prep, w, ctrl, params, positions, n_points, spacing, closed)
+            ctrl = _ends_kept(g, prep, w, ctrl, frames, closed)
+            ctrl, repaired = _valid_ctrl(g, prep, w, ctrl, params, positions, n_points, spacing)
         results, splines = [], []
         for k, o in enumerate(out):
             c, u = None if ctrl is None else ctrl[k], None if params is None else params[k]
@@ -68,6 +70,24 @@ def mix(
     )
 
 
+def _ends_kept(
+    g: ModelGraphs, prep: Prepared, w: np.ndarray, ctrl: np.ndarray, frames: list[Frame | None], closed: bool
+) -> np.ndarray:
+    """The rows' control points (float64) carrying their ends' moves in proportion, onto their inputs' ends and out of
+    crossings (a row [1, 0] is its first end's answer), joined where every input is closed, and moved onto the blend
+    of the inputs' matching ends (inference.ends)."""
+    ctrl = ctrl.astype(np.float64)
+    for what in ("pin", "repair"):
+        shares = mixed_repairs(prep.rows, w, what=what)
+        if shares is not None:
+            ctrl += shares
+    if closed:
+        ctrl = np.stack([joined_ends(c) for c in ctrl])
+    if not prep.ends_kept:
+        return ctrl
+    return pinned_mixes(ctrl, prep.inputs, prep.frames, w, frames, model_size=g.model_size, degree=g.spline_degree)
+
+
 def _valid_ctrl(
     g: ModelGraphs,
     prep: Prepared,
@@ -77,25 +97,17 @@ def _valid_ctrl(
     positions: np.ndarray | None,
     n_points: int | None,
     spacing: str,
-    closed: bool,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The rows' control points (float64, joined where every input is closed) carrying their ends' repairs in
-    proportion (a row [1, 0] is its first end's answer), those that still cross untangled against the blend of their
-    ends (inference.untangling); and which rows carry a repair of either kind."""
-    ctrl = ctrl.astype(np.float64)
+    """The rows' control points with those that cross untangled against the blend of their ends
+    (inference.untangling); and which rows carry a repair, their ends' or their own."""
     shares = mixed_repairs(prep.rows, w)
-    carried = np.zeros(len(w), bool)
-    if shares is not None:
-        ctrl += shares
-        carried = np.abs(shares).reshape(len(w), -1).max(axis=1) > 0
-    if closed:
-        ctrl = np.stack([joined_ends(c) for c in ctrl])
+    carried = np.zeros(len(w), bool) if shares is None else np.abs(shares).reshape(len(w), -1).max(axis=1) > 0
     if not len(w):
         return ctrl, carried
     heads = [None if params is None else params[k] for k in range(len(w))]
     at = [_params_of(g, ctrl[k], heads[k], positions, k, prep.placed, n_points, spacing) for k in range(len(w))]
     targets = _Targets(g, prep, w, at, positions is not None and prep.placed)
-    ctrl, repaired = untangle_mixes(ctrl, at, targets, closed=closed, degree=g.spline_degree)
+    ctrl, repaired = untangle_mixes(ctrl, at, targets, degree=g.spline_degree)
     return ctrl, repaired | carried
 
 

@@ -27,10 +27,11 @@ class ReadCurve:
     params: np.ndarray | None = None  # (n_points,) its points' spline parameters, with a head that learns them
     feet: np.ndarray | None = None  # with closest placement or refine: each caller point's spline parameter
     repair: np.ndarray | None = None  # (n_ctrl, 2) float64: how `ctrl` was moved to uncross the answer (untangling)
+    pin: np.ndarray | None = None  # (n_ctrl, 2) float64: how `ctrl` was moved onto the input's ends (inference.ends)
     distance: float | None = None  # the decoding's squared distance from the input in the model plane (Reader._decoded)
 
     ARRAYS: ClassVar[tuple[str, ...]] = (
-        "model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet", "repair"
+        "model", "fraction", "mean", "log_var", "decoded", "ctrl", "params", "feet", "repair", "pin"
     )  # fmt: skip
 
     @property
@@ -60,11 +61,15 @@ class ReadCurve:
         feet: np.ndarray | None,
         distance: float | None = None,
     ) -> ReadCurve:
-        return replace(self, decoded=decoded, ctrl=ctrl, params=params, feet=feet, repair=None, distance=distance)
+        return replace(
+            self, decoded=decoded, ctrl=ctrl, params=params, feet=feet, repair=None, pin=None, distance=distance
+        )
 
     def moved_to(self, mean: np.ndarray) -> ReadCurve:
         """This reading with another latent, not decoded yet (a look again, a fit)."""
-        return replace(self, mean=mean, decoded=None, ctrl=None, params=None, feet=None, repair=None, distance=None)
+        return replace(
+            self, mean=mean, decoded=None, ctrl=None, params=None, feet=None, repair=None, pin=None, distance=None
+        )
 
 
 @dataclass(frozen=True)
@@ -73,6 +78,7 @@ class Prepared:
 
     inputs: list[np.ndarray]  # the caller's curves, float64
     rows: list[ReadCurve]
+    ends_kept: bool = True  # answers start and end where their inputs do; so do curves mixed of them (inference.ends)
 
     @property
     def frames(self) -> list[Frame | None]:

@@ -13,6 +13,7 @@ with the same reading come from the encoding cache. `refine` fits each latent cl
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -38,6 +39,7 @@ from curve_vae.inference import picking
 from curve_vae.inference.cache import EncodingCache
 from curve_vae.inference.cancel import checkpoint
 from curve_vae.inference.candidates import Candidate, model_points
+from curve_vae.inference.ends import pinned_rows
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs
@@ -94,6 +96,7 @@ class Reader:
         self.fitter = fitter
         self.cache = cache
         self.untangle = True  # answers that cross themselves where their inputs do not are untangled (untangling)
+        self.keep_ends = True  # answers start and end where their inputs do (inference.ends)
         #: pose "learned": how many of each curve's candidates the ranker's order reads, the closest kept. One, then
         #: a look again, reads closer than two at the cost of two (docs/RESULTS.md, "Readings").
         self.ranked_reads = RANKED_READS
@@ -111,7 +114,7 @@ class Reader:
             and reading.frame != "model"
             and reading.pose in ("canonical", "search", "learned")
         )
-        key = f"{reading.key}/{'closest' if self.closest else 'index'}"
+        key = f"{reading.key}/{'closest' if self.closest else 'index'}/{'ends' if self.keep_ends else 'decoded'}"
         if shared:  # a curve's pose depends on its set: kept apart from its pose alone, per set
             key += "/set/" + EncodingCache.key(np.concatenate(inputs), str([len(c) for c in inputs])).hex()
         keys = [EncodingCache.key(c, key) for c in inputs] if self.cache is not None else []
@@ -141,12 +144,12 @@ class Reader:
             missing = [i for i, r in enumerate(read) if not r.decoded_yet]
             for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [read[i] for i in missing])[0]):
                 read[i] = row
-        if self.untangle:  # rows read or decoded just now (cached rows were untangled when they were read)
-            self._untangle(inputs, read, sorted(set(todo) | set(missing)), unlooked)
+        # rows read or decoded just now (cached rows were finished when they were read)
+        self._finish(inputs, read, sorted(set(todo) | set(missing)), unlooked)
         if self.cache is not None:
             for k, row in zip(keys, read):
                 self.cache.put(k, row)
-        return Prepared(inputs, read)
+        return Prepared(inputs, read, ends_kept=self.keep_ends)
 
     # ----------------------------------------------------------------------------------- candidates
 
@@ -279,25 +282,47 @@ class Reader:
         err = np.array([r.distance for r in rows], np.float64)
         return rows, look_again(self.graphs, inputs, rows, err, steps, self._decoded)[0]
 
-    def _untangle(
+    def _finish(
         self, inputs: list[np.ndarray], read: list[ReadCurve], fresh: list[int], unlooked: dict[int, ReadCurve]
     ) -> None:
-        """`read[i]` for each i in `fresh` untangled (inference.untangling), in place; where a looked-at answer still
-        crosses itself, the answer read before the looks, untangled, if that one does not."""
-        size, degree = self.graphs.model_size, self.graphs.spline_degree
-        rows, tangled = untangle_rows([inputs[i] for i in fresh], [read[i] for i in fresh], model_size=size,
-                                      degree=degree)  # fmt: skip
+        """`read[i]` for each i in `fresh`, in place: its ends kept (inference.ends) and untangled (inference.
+        untangling); where a looked-at answer still crosses itself, the answer read before the looks, finished so,
+        if that one does not."""
+        rows, tangled = self._finished([inputs[i] for i in fresh], [read[i] for i in fresh])
         for i, row in zip(fresh, rows):
             read[i] = row
         back = [fresh[k] for k in tangled if fresh[k] in unlooked]
         if back:
-            rows, still = untangle_rows([inputs[i] for i in back], [unlooked[i] for i in back], model_size=size,
-                                        degree=degree)  # fmt: skip
+            rows, still = self._finished([inputs[i] for i in back], [unlooked[i] for i in back])
             for k, (i, row) in enumerate(zip(back, rows)):
                 if k not in still:
                     read[i] = row
 
+    def _finished(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], list[int]]:
+        """The rows with their ends kept and untangled, and which of them still cross themselves."""
+        size, degree = self.graphs.model_size, self.graphs.spline_degree
+        if self.keep_ends:
+            rows = self._placed_again(inputs, pinned_rows(inputs, rows, model_size=size, degree=degree))
+        if not self.untangle:
+            return rows, []
+        return untangle_rows(inputs, rows, model_size=size, degree=degree)
+
     # ----------------------------------------------------------------------------------- decoding, placement
+
+    def _placed_again(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> list[ReadCurve]:
+        """Rows placed on their splines (closest placement), each caller point placed again on its spline as it is
+        now (its ends moved: inference.ends)."""
+        have = [i for i, r in enumerate(rows) if r.feet is not None and r.ctrl is not None]
+        if not have:
+            return rows
+        ctrl = np.stack([rows[i].ctrl for i in have])  # type: ignore[misc]
+        targets = self._targets([inputs[i] for i in have], [rows[i].frame for i in have])
+        with np.errstate(all="ignore"):
+            feet, err = ordered_closest_params(ctrl, targets, degree=self.graphs.spline_degree)
+        out = list(rows)
+        for k, i in enumerate(have):
+            out[i] = dataclasses.replace(rows[i], feet=feet[k], distance=float(err[k]))
+        return out
 
     def _decoded(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], np.ndarray]:
         """Rows with their latents decoded and, placed closest, each caller point's parameter on the spline; and each

@@ -51,7 +51,7 @@ def untangle_rows(
         i = placed[j]
         row = rows[i]
         target = row.frame.to_model(inputs[i], model_size) if row.frame is not None else np.asarray(inputs[i])
-        fixed, free = untangled(ctrl[j], feet[j], target, closed=is_closed(inputs[i]), degree=degree)
+        fixed, free = untangled(ctrl[j], feet[j], target, degree=degree)
         out[i] = dataclasses.replace(row, ctrl=fixed, repair=fixed - ctrl[j])  # float64: the fit's own digits
         if not free:
             tangled.append(i)
@@ -64,9 +64,10 @@ def _closed_ctrl(points: np.ndarray, row: ReadCurve) -> np.ndarray:
     return joined_ends(c) if is_closed(points) else c
 
 
-def mixed_repairs(rows: Sequence[ReadCurve], weights: np.ndarray) -> np.ndarray | None:
-    """Each weight row's share of the rows' repairs, (len(weights), n_ctrl, 2); None where no row was repaired."""
-    repairs = [r.repair for r in rows]
+def mixed_repairs(rows: Sequence[ReadCurve], weights: np.ndarray, *, what: str = "repair") -> np.ndarray | None:
+    """Each weight row's share of the rows' repairs (or of another move of their control points, `what`: "pin"),
+    (len(weights), n_ctrl, 2); None where no row has one."""
+    repairs = [getattr(r, what) for r in rows]
     if all(r is None for r in repairs):
         return None
     like = next(r for r in repairs if r is not None)
@@ -75,7 +76,7 @@ def mixed_repairs(rows: Sequence[ReadCurve], weights: np.ndarray) -> np.ndarray 
 
 
 def untangle_mixes(
-    ctrl: np.ndarray, params: Sequence[np.ndarray], targets: _Indexed, *, closed: bool, degree: int
+    ctrl: np.ndarray, params: Sequence[np.ndarray], targets: _Indexed, *, degree: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """In-betweens (rows, n_ctrl, 2) whose splines at their `params` (n_k,) cross themselves, untangled against
     `targets[k]` (n_k, 2), the blend of their ends at those points (asked for only for the rows that cross): the
@@ -92,6 +93,6 @@ def untangle_mixes(
         rows = np.flatnonzero(bad)
         aims = {int(k): targets[int(k)] for k in rows}
         for k in (int(k) for k in rows[~crosses(list(aims.values()))]):
-            c[k], _ = untangled(c[k], params[k], aims[k], closed=closed, degree=degree)
+            c[k], _ = untangled(c[k], params[k], aims[k], degree=degree)
             repaired[k] = True
     return c, repaired

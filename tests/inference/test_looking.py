@@ -16,12 +16,12 @@ from tests.inference.test_untangling import naca
 
 
 def _plain(rt: CurveRuntime, curves: list[np.ndarray], reading: Reading):
-    """The answer before untangling: what the look compares."""
-    rt.reader.untangle = False
+    """The answer before its ends are kept and before untangling: what the look compares."""
+    rt.reader.untangle = rt.reader.keep_ends = False
     try:
         return rt.reconstruct(curves, reading)
     finally:
-        rt.reader.untangle = True
+        rt.reader.untangle = rt.reader.keep_ends = True
 
 
 def test_one_look_is_the_fixed_point_step_on_the_graphs(shipped_runtime: CurveRuntime):

@@ -57,12 +57,21 @@ def test_decode_in_the_model_plane_and_in_a_frame(client, runtime):
     assert np.all(ext.max(axis=1) < 2.0)  # an untrained decoder's scribble, scaled to the frame
 
 
-def test_encode_then_decode_in_the_returned_frames_is_the_reconstruction(client, curves):
+def test_encode_then_decode_in_the_returned_frames_is_the_reconstruction_but_for_its_ends(client, runtime, curves):
+    """/decode draws the latent /encode returns as the model does; /reconstruct's answer is that drawing with its ends
+    moved onto the input's (inference.ends)."""
     c = (curves(2) * 3 - 11).tolist()  # read as given (spacing "parameter"): the returned points are the model's
     enc = client.post("/encode", json={"curves": c, "spacing": "parameter"}).json()
     dec = client.post("/decode", json={"latents": enc["mean"], "frames": enc["frames"]}).json()
     rec = client.post("/reconstruct", json={"curves": c, "spacing": "parameter"}).json()
-    np.testing.assert_allclose(dec["curves"], rec["curves"], rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose([r[0] for r in rec["curves"]], [x[0] for x in c], atol=1e-9)
+    np.testing.assert_allclose([r[-1] for r in rec["curves"]], [x[-1] for x in c], atol=1e-9)
+    runtime.reader.keep_ends = False
+    try:
+        drawn = client.post("/reconstruct", json={"curves": c, "spacing": "parameter"}).json()
+    finally:
+        runtime.reader.keep_ends = True
+    np.testing.assert_allclose(dec["curves"], drawn["curves"], rtol=1e-6, atol=1e-6)
 
 
 def test_reconstruct(client, curves):
