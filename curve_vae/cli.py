@@ -1,8 +1,8 @@
 """`curve-vae` command line: train, export and serve the model; reconstruct, encode, sample, augment, fit and revolve
 curves; fit priors to your own.
 
-Commands: dataset, train, average, ranker, spacer, export, evaluate, triton, reconstruct, encode, sample, augment, fit,
-revolve, prior, evaluate-prior, serve.
+Commands: dataset, train, average, ranker, spacer, export, evaluate, triton, warm-up, reconstruct, encode, sample,
+augment, fit, revolve, prior, evaluate-prior, serve.
 
 The commands live in `curve_vae/commands/`, one module per group; this module assembles the parser.
 Each subcommand imports what it needs when it runs, so `curve-vae serve` and the offline

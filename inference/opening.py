@@ -115,3 +115,37 @@ def warm_up_request(runtime: CurveRuntime) -> None:
     finally:
         runtime.reader.cache = cache
         runtime.graphs.rows.update(rows)
+
+
+#: The compiled kernels a reading calls (the rest are compiled into them): geometry.natural_kernel's fit and
+#: geometry.matching_kernel's placement.
+KERNELS = (("natural_kernel", "fit_start"), ("natural_kernel", "lm_steps"), ("matching_kernel", "place"))
+
+
+def compiled_kernels() -> tuple[str, list[str]]:
+    """Where numba caches the reading's compiled kernels (KERNELS), and which of them it holds no index for yet: what
+    a first start compiles (warm_up_request)."""
+    from curve_vae.geometry import matching_kernel, natural_kernel
+
+    modules = {"natural_kernel": natural_kernel, "matching_kernel": matching_kernel}
+    stats = [getattr(modules[module], name).stats for module, name in KERNELS]
+    paths = sorted({s.cache_path for s in stats if s.cache_path})
+    if not paths:
+        return "no cache (each process compiles them)", [name for _, name in KERNELS]
+    where = Path(paths[0])
+    return str(where), [name for module, name in KERNELS if not any(where.glob(f"{module}.{name}-*.nbi"))]
+
+
+def seed_kernel_cache(seed: Path) -> str | None:
+    """Copy a numba cache compiled elsewhere (`curve-vae warm-up` at an image's build) into NUMBA_CACHE_DIR where
+    that holds none of the reading's kernels yet (a new container or pod: an empty, writable directory), so that the
+    start loads them instead of compiling; what was done, or None where nothing was (no NUMBA_CACHE_DIR, no seed,
+    or the kernels there already)."""
+    import os
+    import shutil
+
+    target = os.environ.get("NUMBA_CACHE_DIR")
+    if not target or not seed.is_dir() or not compiled_kernels()[1]:
+        return None
+    shutil.copytree(seed, target, dirs_exist_ok=True)
+    return f"copied the compiled kernels of {seed} into {target}"

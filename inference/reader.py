@@ -125,10 +125,11 @@ class Reader:
         if shared and todo:  # the set's pose is chosen for all its curves at once
             todo = list(range(len(inputs)))
         new = self._fresh([inputs[i] for i in todo], todo, reading, shared=shared)
-        unlooked: dict[int, ReadCurve] = {}  # each row as read, before its looks (refine starts from the looks)
+        earlier: dict[int, list[ReadCurve]] = {i: [] for i in todo}  # each row before its looks, before refine
         if reading.looks > 0 and new:
             before, new = self._looked([inputs[i] for i in todo], new, reading.looks)
-            unlooked = dict(zip(todo, before)) if reading.refine == 0 else {}
+            for i, row in zip(todo, before):
+                earlier[i].insert(0, row)
         for i, row in zip(todo, new):
             rows[i] = row
         read = [r for r in rows if r is not None]  # every row now: cached or read just now
@@ -138,6 +139,7 @@ class Reader:
             for i, row in zip(
                 todo, self.fitter.refine([inputs[i] for i in todo], [read[i] for i in todo], reading.refine)
             ):
+                earlier[i].insert(0, read[i])
                 read[i] = row
         missing: list[int] = []
         if decoded or self.closest:
@@ -145,7 +147,7 @@ class Reader:
             for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [read[i] for i in missing])[0]):
                 read[i] = row
         # rows read or decoded just now (cached rows were finished when they were read)
-        self._finish(inputs, read, sorted(set(todo) | set(missing)), unlooked)
+        self._finish(inputs, read, sorted(set(todo) | set(missing)), earlier)
         if self.cache is not None:
             for k, row in zip(keys, read):
                 self.cache.put(k, row)
@@ -283,20 +285,22 @@ class Reader:
         return rows, look_again(self.graphs, inputs, rows, err, steps, self._decoded)[0]
 
     def _finish(
-        self, inputs: list[np.ndarray], read: list[ReadCurve], fresh: list[int], unlooked: dict[int, ReadCurve]
+        self, inputs: list[np.ndarray], read: list[ReadCurve], fresh: list[int], earlier: dict[int, list[ReadCurve]]
     ) -> None:
         """`read[i]` for each i in `fresh`, in place: its ends kept (inference.ends) and untangled (inference.
-        untangling); where a looked-at answer still crosses itself, the answer read before the looks, finished so,
-        if that one does not."""
+        untangling). Where an answer still crosses itself, the row before its last step (refine, the looks: `earlier`,
+        latest first), finished so, in its place where that one does not."""
         rows, tangled = self._finished([inputs[i] for i in fresh], [read[i] for i in fresh])
         for i, row in zip(fresh, rows):
             read[i] = row
-        back = [fresh[k] for k in tangled if fresh[k] in unlooked]
-        if back:
-            rows, still = self._finished([inputs[i] for i in back], [unlooked[i] for i in back])
-            for k, (i, row) in enumerate(zip(back, rows)):
-                if k not in still:
-                    read[i] = row
+        for i in tangled:
+            for before in earlier.get(i, []):
+                if not before.decoded_yet:
+                    before = self._decoded([inputs[i]], [before])[0][0]
+                (row,), still = self._finished([inputs[i]], [before])
+                if not still:  # repaired, and says so: another latent than the steps asked for
+                    read[i] = row if row.repair is not None or row.ctrl is None else replace_repair(row)
+                    break
 
     def _finished(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], list[int]]:
         """The rows with their ends kept and untangled, and which of them still cross themselves."""
@@ -360,6 +364,12 @@ class Reader:
             curves = Ragged.of(inputs)
             return curves.split(FrameRows.of(given).to_model(curves, self.graphs.model_size))
         return [f.to_model(p, self.graphs.model_size) if f is not None else p for f, p in zip(frames, inputs)]
+
+
+def replace_repair(row: ReadCurve) -> ReadCurve:
+    """A row marked repaired (`ReadCurve.repair` set, all zeros: its control points are its decoding's)."""
+    assert row.ctrl is not None
+    return dataclasses.replace(row, repair=np.zeros_like(np.asarray(row.ctrl, np.float64)))
 
 
 def _check_finite(mean: np.ndarray, log_var: np.ndarray, owners: list[int]) -> None:

@@ -136,9 +136,17 @@ class CurveRuntime:
             priors_dir=priors_dir,
         )
         runtime = cls(**parts)
-        if warm_up:  # one default request before the first caller's (inference.opening.warm_up_request)
-            warm_up_request(runtime)
+        if warm_up:
+            runtime.warm_up(graphs=False)  # the graphs were warmed as they opened
         return runtime
+
+    def warm_up(self, *, graphs: bool = True) -> None:
+        """The graphs' first runs (ModelGraphs.warm_up) and one default request before the first caller's
+        (inference.opening.warm_up_request: the compiled kernels load, or compile on a first start); ModelLoadError
+        where either fails."""
+        if graphs:
+            self.graphs.warm_up()
+        warm_up_request(self)
 
     # ----------------------------------------------------------------------- what the model is
 

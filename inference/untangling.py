@@ -46,15 +46,18 @@ def untangle_rows(
     answers = np.split(
         spline_values(np.stack(ctrl), np.concatenate(feet), owner, degree=degree)[0], np.cumsum(lengths)[:-1]
     )
-    bad = new_crossings([inputs[i] for i in placed], answers)
-    for j in np.flatnonzero(bad):
+    bad = np.flatnonzero(new_crossings([inputs[i] for i in placed], answers))
+    fixed_answers = []
+    for j in bad:
         i = placed[j]
         row = rows[i]
         target = row.frame.to_model(inputs[i], model_size) if row.frame is not None else np.asarray(inputs[i])
-        fixed, free = untangled(ctrl[j], feet[j], target, degree=degree)
+        fixed, _ = untangled(ctrl[j], feet[j], target, degree=degree)
         out[i] = dataclasses.replace(row, ctrl=fixed, repair=fixed - ctrl[j])  # float64: the fit's own digits
-        if not free:
-            tangled.append(i)
+        fixed_answers.append(spline_values(fixed, feet[j], degree=degree)[0])
+    if len(bad):  # still crossing as the answer is checked (geometry.validity.new_crossings), not only as the fit saw
+        still = new_crossings([inputs[placed[j]] for j in bad], fixed_answers)
+        tangled = [placed[int(j)] for j in bad[still]]
     return out, tangled
 
 

@@ -3,9 +3,13 @@ time of each of the first single-curve default requests, each on a new connectio
 
     .venv/bin/python scripts/first_request.py                       # an empty numba cache: a new container's start
     .venv/bin/python scripts/first_request.py --cache-dir /tmp/nc   # run twice with one directory: the second start
+    NUMBA_CACHE_DIR=/tmp/seed .venv/bin/curve-vae warm-up            # a cache compiled at an image's build, then
+    .venv/bin/python scripts/first_request.py --seed /tmp/seed      # a new container's start with it (copied in)
 
-The reading's compiled kernels (numba) compile into NUMBA_CACHE_DIR; the service's warm-up request (inference.runtime
-`CurveRuntime.warm_up`) compiles them, or loads them from that cache, before `/ready` answers.
+The reading's compiled kernels (numba) compile into NUMBA_CACHE_DIR; the service's warm-up (inference.runtime
+`CurveRuntime.warm_up`) compiles them, or loads them from that cache, while the server already answers (/health 200,
+/ready 503 "warming up"), before `/ready` answers 200. Printed: when the port first answered, when /ready said 200.
+NUMBA_CPU_NAME in the environment (`generic`: a cache any x86-64 host can load) passes to the server.
 """
 
 from __future__ import annotations
@@ -31,13 +35,23 @@ def main() -> None:
     p.add_argument("--cache-dir", type=Path, help="NUMBA_CACHE_DIR (default: a new, empty directory)")
     p.add_argument("--requests", type=int, default=6)
     p.add_argument("--model-dir", type=Path, default=ROOT / "models")
+    p.add_argument("--seed", type=Path, help="CURVE_VAE_KERNEL_CACHE_SEED: a cache compiled by `curve-vae warm-up`")
     a = p.parse_args()
     cache = a.cache_dir or Path(tempfile.mkdtemp(prefix="numba-cache-"))
     body = json.dumps({"curves": posted(1, seed=1).tolist()}).encode()
     start = time.perf_counter()
     env = {"CURVE_VAE_CACHE_BYTES": "0", "NUMBA_CACHE_DIR": str(cache)}
+    if a.seed:
+        env["CURVE_VAE_KERNEL_CACHE_SEED"] = str(a.seed)
     server = LiveServer("--model-dir", str(a.model_dir), "--providers", "cpu", env=env, cwd=ROOT, capture=True)
     try:
+        while True:
+            try:
+                urllib.request.urlopen(f"{server.url}/health", timeout=1).close()
+                break
+            except OSError:
+                time.sleep(0.05)
+        print(f"answering after {time.perf_counter() - start:.1f} s")
         server.wait_ready(listeners=available_cpus())  # the service's default: a worker a CPU
         print(f"ready after {time.perf_counter() - start:.1f} s (numba cache {cache})")
         for k in range(a.requests):

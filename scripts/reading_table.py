@@ -10,10 +10,10 @@ Two groups of sets, seeded:
 Each cell: mean relative RMSE (% of the bounding-box diagonal, at the curve's own points). Cost: milliseconds of
 one core a curve (one onnxruntime thread, encoding cache off), the users' sets read a set a request ("in a set") and
 the paper's curves as drawn one request each ("alone"). Crossing: answers that cross themselves where their input
-does not, after untangling, over every set. The readings: the ranker's two candidates, the closer kept (service
-0.26.0's default, there with the second read only where the first came back farther than 0.05%); the ranker's first
-alone; the canonical pose at the natural spacing; one encoding (canonical, as given); each with 0–3 looks again
-(inference.looking); the search; refine 2.
+does not, after untangling, over every set. The readings: service 0.26.0's default (the ranker's two candidates, the
+closer kept, the ends as decoded; 0.26.0 read the second only where the first came back farther than 0.05%); the
+ranker's two, the ends kept; the ranker's first alone; the canonical pose at the natural spacing; one encoding
+(canonical, as given); each with 0–3 looks again (inference.looking); the search; refine 2.
 
     .venv/bin/python scripts/reading_table.py [--count 100] [--json out.json] [--plot out.png] [--morphs 40]
 
@@ -54,6 +54,7 @@ class Row:
     fields: dict
     ranked_reads: int = 1
     base: str = ""  # the reading it adds looks to (the plot joins them)
+    keep_ends: bool = True  # False: the ends as decoded (service 0.26.0's answers)
 
     @property
     def reading(self) -> Reading:
@@ -67,6 +68,7 @@ def _with_looks(name: str, fields: dict, ranked_reads: int = 1, looks: tuple[int
 
 
 ROWS: list[Row] = [
+    Row("0.26.0's default", {"looks": 0}, ranked_reads=2, keep_ends=False),
     *_with_looks("the ranker's two", {}, ranked_reads=2),
     *_with_looks("the ranker's first", {}),
     *_with_looks("canonical, natural", {"pose": "canonical", "spacing": "natural"}),
@@ -75,7 +77,7 @@ ROWS: list[Row] = [
     Row("the ranker's first, 1 look, refine 2", {"refine": 2}),
 ]
 #: The row today's answers are compared with (service 0.26.0's default), and the default chosen by this table.
-BEFORE = "the ranker's two, 0 looks"
+BEFORE = "0.26.0's default"
 DEFAULT = "the ranker's first, 1 look"
 
 
@@ -117,8 +119,8 @@ def table_sets() -> dict[str, list[np.ndarray]]:
 
 def measure(rt: CurveRuntime, row: Row, groups: dict[str, dict[str, list[np.ndarray]]]) -> dict:
     """One row: each set's mean error (%), the crossings after untangling, and the cost a curve."""
-    rt.reader.ranked_reads = row.ranked_reads
-    out: dict = {"fields": row.fields, "ranked_reads": row.ranked_reads, "crossing": 0}
+    rt.reader.ranked_reads, rt.reader.keep_ends = row.ranked_reads, row.keep_ends
+    out: dict = {"fields": row.fields, "ranked_reads": row.ranked_reads, "keep_ends": row.keep_ends, "crossing": 0}
     for group, sets in groups.items():
         errors, spent, count = {}, 0.0, 0
         for name, curves in sets.items():
@@ -135,7 +137,7 @@ def measure(rt: CurveRuntime, row: Row, groups: dict[str, dict[str, list[np.ndar
     for c in alone:
         rt.reconstruct([c], row.reading)
     out["ms_alone"] = 1000 * (time.perf_counter() - t0) / len(alone)
-    rt.reader.ranked_reads = 1
+    rt.reader.ranked_reads, rt.reader.keep_ends = 1, True
     return out
 
 
@@ -249,9 +251,9 @@ def main() -> None:
         rows, pairs = {r.name: r for r in ROWS}, morph_pairs(paper_test_split(), a.morphs)
         out["morphs"] = {}
         for name in (BEFORE, DEFAULT):
-            rt.reader.ranked_reads = rows[name].ranked_reads
+            rt.reader.ranked_reads, rt.reader.keep_ends = rows[name].ranked_reads, rows[name].keep_ends
             out["morphs"] |= run_morphs(rt, pairs, readings={name: rows[name].reading})
-        rt.reader.ranked_reads = 1
+        rt.reader.ranked_reads, rt.reader.keep_ends = 1, True
         print(format_morphs(out["morphs"]))
     if a.json:
         with open(a.json, "w") as fh:

@@ -21,8 +21,10 @@ route shapes the JSON. Every rejected request gets the same JSON error body:
 
 from __future__ import annotations
 
+import asyncio
 import logging
 import sys
+import time
 from collections.abc import AsyncIterator, Callable
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
@@ -47,6 +49,7 @@ from curve_vae.inference.cpus import (
 )
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.opening import compiled_kernels
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.access import ApiKeyMiddleware
 from curve_vae.service.cors import add_cors
@@ -69,17 +72,64 @@ log = logging.getLogger("service")
 
 @asynccontextmanager
 async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
-    """Load the model (unless the app was given one), start the micro-batcher where asked, serve, and undo it all."""
+    """Open the model (unless the app was given one) and serve at once: the warm-up — the compiled kernels loaded, or
+    compiled on a first start — runs in the background (`_warm_then_serve`), /ready answering 503 "warming up" until it
+    is done and requests waiting for it; then the micro-batcher where asked, and everything undone at the end."""
     settings: Settings = app.state.settings
     owned = app.state.runtime is None
-    slots = app.state.slots
     switch = sys.getswitchinterval()
     sys.setswitchinterval(settings.gil_switch_ms / 1e3)  # the event loop's turn comes sooner (Settings)
+    app.state.failed = None
     if owned:
-        app.state.runtime = await _load_runtime(settings, slots)
+        app.state.runtime = await _load_runtime(settings, app.state.slots)
+        app.state.warming = asyncio.create_task(_warm_then_serve(app))
+    else:  # given loaded and warm
+        _serve(app)
+    try:
+        yield
+    finally:
+        if app.state.warming is not None:
+            app.state.warming.cancel()
+            app.state.warming = None
+        app.state.ready = False
+        app.state.metrics.ready.set(0)
+        sys.setswitchinterval(switch)  # the process's own again, for an app that starts again or shares it
+        app.state.executor.shutdown(wait=False, cancel_futures=True)
+        app.state.executor = inference_executor(app.state.slots)  # for a lifespan that starts again (tests)
+        if app.state.batcher is not None:
+            app.state.batcher.close()
+            app.state.batcher = None
+        if owned:
+            app.state.runtime = None
+        app.state.metrics.worker_exit()
+
+
+async def _warm_then_serve(app: FastAPI) -> None:
+    """The warm-up of a just-opened model in a worker thread (CurveRuntime.warm_up), said in the log — what it loads
+    or compiles, and when it is ready — then `_serve`. A warm-up that fails is logged and stated by /health and
+    /ready (503), so an orchestrator restarts the process."""
     runtime: CurveRuntime = app.state.runtime
-    batcher = _start_batcher(app, settings, runtime) if settings.micro_batch else None
-    app.state.batcher = batcher
+    where, missing = compiled_kernels()
+    if missing:
+        log.info("warming up: compiling the reading's kernels into %s (a first start only; 15-30 s)", where)
+    else:
+        log.info("warming up: loading the reading's compiled kernels from %s", where)
+    start = time.perf_counter()
+    try:
+        await anyio.to_thread.run_sync(runtime.warm_up)
+    except ModelLoadError as e:
+        app.state.failed = str(e)
+        log.error("cannot serve the model: %s", e)
+        return
+    _serve(app)
+    log.info("ready after %.1f s of warming up", time.perf_counter() - start)
+
+
+def _serve(app: FastAPI) -> None:
+    """A warm runtime served: the micro-batcher where asked, the coalescer, and ready."""
+    settings: Settings = app.state.settings
+    runtime: CurveRuntime = app.state.runtime
+    app.state.batcher = _start_batcher(app, settings, runtime) if settings.micro_batch else None
     app.state.coalescer = (
         runtime_coalescer(
             runtime,
@@ -99,19 +149,6 @@ async def _lifespan(app: FastAPI) -> AsyncIterator[None]:
         settings.model_dir,
         runtime.graphs.providers,
     )
-    try:
-        yield
-    finally:
-        app.state.ready = False
-        app.state.metrics.ready.set(0)
-        sys.setswitchinterval(switch)  # the process's own again, for an app that starts again or shares it
-        app.state.executor.shutdown(wait=False, cancel_futures=True)
-        app.state.executor = inference_executor(slots)  # for a lifespan that starts again (tests)
-        if batcher is not None:
-            batcher.close()
-        if owned:
-            app.state.runtime = None
-        app.state.metrics.worker_exit()
 
 
 async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
@@ -137,6 +174,7 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
                 placement=settings.placement,
                 cache_bytes=settings.cache_bytes,
                 priors_dir=settings.priors_dir,
+                warm_up=False,  # _warm_then_serve, while the server answers
             )
         )
     except ModelLoadError as e:
@@ -216,6 +254,9 @@ def create_app(settings: Settings | None = None, *, runtime: CurveRuntime | None
         openapi_tags=OPENAPI_TAGS,
     )
     app.state.settings, app.state.runtime, app.state.ready = settings, runtime, False
+    app.state.warming = None  # the lifespan's warm-up task while it runs
+    app.state.failed = None  # why the warm-up failed, where it did
+    app.state.batcher = None
     app.state.metrics = Metrics()
     app.state.coalescer = None  # the lifespan's, over the runtime
     app.state.pending = 0  # requests in deps.run_inference: running or waiting for an inference slot

@@ -31,16 +31,28 @@ def settings_of(request: Request) -> Settings:
 
 
 def runtime_of(request: Request) -> CurveRuntime:
-    if not request.app.state.ready or request.app.state.runtime is None:
+    state = request.app.state
+    if getattr(state, "failed", None):
+        raise HTTPException(503, f"the model cannot serve: {state.failed}")
+    if not state.ready or state.runtime is None:
         raise HTTPException(503, "the model is not loaded yet; GET /ready answers 200 once it is")
-    return request.app.state.runtime
+    return state.runtime
 
 
 async def _settings(request: Request) -> Settings:
     return settings_of(request)
 
 
+async def warmed(request: Request) -> None:
+    """Returns once the model's warm-up is over: a request that comes while it runs (a page opened at once, a client
+    that did not wait for /ready) waits for it (service.app._warm_then_serve)."""
+    warming = getattr(request.app.state, "warming", None)  # an app built without the lifespan's state has none
+    if warming is not None and not warming.done():
+        await asyncio.shield(warming)
+
+
 async def _runtime(request: Request) -> CurveRuntime:
+    await warmed(request)
     return runtime_of(request)
 
 

@@ -24,6 +24,7 @@ from pydantic import BaseModel, ValidationError
 
 from curve_vae.inference.errors import InputError
 from curve_vae.service import limits
+from curve_vae.service.deps import warmed
 from curve_vae.service.settings import Settings
 
 MEDIA_TYPE = "application/x-npy"
@@ -70,6 +71,7 @@ async def dispatch(request: Request, route: NpyRoute) -> Response:
         errors = [{**err, "loc": ("query", *err["loc"])} for err in e.errors() if err["loc"][:1] != ("curves",)]
         raise RequestValidationError(errors or e.errors()) from None
     limits.check_request(req, settings, curves, skip=("curves",))
+    await warmed(request)
     return await route.handler(request, req, curves)
 
 

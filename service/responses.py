@@ -186,7 +186,8 @@ class ErrorResponse(BaseModel):
 
 
 class StatusResponse(BaseModel):
-    status: str
+    status: str = Field(description='"ok" or "ready"; with a 503: "warming up", "failed" or "stopping"')
+    detail: str | None = Field(None, description="what a 503 means and what to do")
 
 
 class FileInfo(BaseModel):

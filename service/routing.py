@@ -19,6 +19,7 @@ from fastapi.responses import Response
 from pydantic import BaseModel
 
 from curve_vae.service import limits
+from curve_vae.service.deps import warmed
 from curve_vae.service.npy_bodies import OPENAPI_BODY, NpyRoute
 
 Handler = Callable[[Request, Any, list[np.ndarray]], Awaitable[Response]]
@@ -42,6 +43,7 @@ def model_route(
         async def endpoint(request: Request, req: Any) -> Response:
             curves = limits.curves_of(req) if takes_curves else []
             limits.check_request(req, request.app.state.settings, curves)
+            await warmed(request)
             return await handler(request, req, curves)
 
         endpoint.__name__, endpoint.__doc__ = handler.__name__, handler.__doc__

@@ -53,6 +53,12 @@ _GROUPS: dict[str, list[_Option]] = {
             int,
             "bytes of the encoding cache (curves posted again skip the encoder); 0: off",
         ),
+        (
+            "--kernel-cache-seed",
+            "kernel_cache_seed",
+            str,
+            "a numba cache compiled at build (curve-vae warm-up), copied into an empty NUMBA_CACHE_DIR at start",
+        ),
     ],
     "limits (what one request may ask; beyond them a 4xx or 5xx that says which)": [
         ("--max-curves", "max_curves", int, "most curves, latents or interpolants per request"),
@@ -69,7 +75,7 @@ _GROUPS: dict[str, list[_Option]] = {
             "--max-refine-work",
             "max_refine_work",
             int,
-            "most refine work in one request: steps × (input points + 300 per curve)",
+            "most refine work in one request: refine × (input points + 300 per curve) + looks × 80 per curve",
         ),
         ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
         ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
@@ -341,6 +347,12 @@ def run(args: argparse.Namespace) -> int:
     except ModelLoadError as e:
         print(f"curve-vae serve: error: {e}", file=sys.stderr)
         return 2
+    if settings.kernel_cache_seed is not None:  # before the workers start: they load what it holds
+        from curve_vae.inference.opening import seed_kernel_cache
+
+        seeded = seed_kernel_cache(settings.kernel_cache_seed)
+        if seeded:
+            logging.getLogger("service").info("%s", seeded)
     common = _ServerOptions(
         host=settings.host,
         port=settings.port,

@@ -74,6 +74,10 @@ class Settings(BaseSettings):
     # Bytes the encoding cache may hold (inference/cache.py): curves posted again — the page's slider, a pipeline's
     # seed curves and retries — skip the encoder; 0 turns it off. ~3.4 KB a curve of 161 points.
     cache_bytes: int = Field(default=64 << 20, ge=0)
+    # A numba cache compiled at an image's build (`curve-vae warm-up` with NUMBA_CACHE_DIR set to it), copied into
+    # NUMBA_CACHE_DIR at start where that holds none: a new container or pod loads the reading's kernels instead of
+    # compiling them (docs/DEPLOYMENT.md measures both)
+    kernel_cache_seed: Path | None = None
     # Priors fitted to users' curves (`curve-vae prior -o DIR/NAME.npz`), loaded at start: /sample's prior "NAME".
     # One fitted to another model than the one served stops the start with a message naming both.
     priors_dir: Path | None = None

@@ -24,7 +24,7 @@ from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.live import LiveServer
 from curve_vae.service.settings import Settings
-from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves, shipped_live_server
+from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves, shipped_live_server, wait_ready
 
 #: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
 SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}
@@ -121,6 +121,7 @@ def make_client(model_dir: Path, runtime: CurveRuntime) -> Iterator[Callable[...
         client = TestClient(create_app(settings, runtime=runtime if share_runtime else None))
         client.__enter__()
         clients.append(client)
+        wait_ready(client)  # a runtime of its own warms up in the background (service.app._warm_then_serve)
         return client
 
     yield make

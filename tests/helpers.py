@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -78,3 +79,13 @@ def together(fn, args):
 #: How exactly each of the page's file formats gives its curves back, as relative tolerance: SVG writes 10 significant
 #: digits, as the command line does; the others the numbers themselves.
 EXPORT_TOLERANCE = {"json": 0.0, "csv": 0.0, "svg": 1e-9, "dxf": 0.0}
+
+
+def wait_ready(client, timeout: float = 120.0) -> None:
+    """Poll a started TestClient's /ready until 200: an app that loads its own model warms it up in the background
+    (service.app._warm_then_serve), answering 503 "warming up" meanwhile."""
+    deadline = time.monotonic() + timeout
+    while client.get("/ready").status_code != 200:
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"not ready after {timeout} s: {client.get('/ready').json()}")
+        time.sleep(0.05)

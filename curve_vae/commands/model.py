@@ -282,7 +282,33 @@ def _add_triton(sub: argparse._SubParsersAction) -> None:
     s.set_defaults(func=cmd_triton)
 
 
+def cmd_warm_up(a: argparse.Namespace) -> None:
+    """Compile the reading's kernels into numba's cache, as a first start of the service would."""
+    import time
+
+    from curve_vae.inference.opening import compiled_kernels
+    from curve_vae.inference.runtime import CurveRuntime
+    from curve_vae.inference.shipped import model_directory
+
+    where, missing = compiled_kernels()
+    start = time.perf_counter()
+    CurveRuntime.load(model_directory(a.model_dir), providers="cpu", cache_bytes=0)
+    what = f"compiled {', '.join(missing)} into" if missing else "found every kernel compiled already in"
+    print(f"curve-vae warm-up: {what} {where} ({time.perf_counter() - start:.1f} s)")
+
+
+def _add_warm_up(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser(
+        "warm-up",
+        help="compile the reading's kernels into numba's cache (NUMBA_CACHE_DIR), as the service's first start does: "
+        "at an image's build, so that its containers start warm (CURVE_VAE_KERNEL_CACHE_SEED; docs/DEPLOYMENT.md)",
+    )
+    s.add_argument("--model-dir", default="", help="exported model directory (default: the shipped model, models/)")
+    s.set_defaults(func=cmd_warm_up)
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     _add_export(sub)
     _add_evaluate(sub)
     _add_triton(sub)
+    _add_warm_up(sub)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from fastapi import APIRouter, Request
-from fastapi.responses import Response
+from fastapi.responses import JSONResponse, Response
 from starlette.exceptions import HTTPException
 
 from curve_vae import __version__
@@ -15,28 +15,53 @@ from curve_vae.service.deps import (
     RuntimeDep,
     SettingsDep,
     execution_of,
-    runtime_of,
 )
 
 ops_router = APIRouter(tags=["operations"])
 
 
-@ops_router.get("/health", response_model=r.StatusResponse, summary="Liveness", openapi_extra=curl_sample("/health"))
-async def health() -> dict[str, str]:
-    """200 while the process serves requests, model loaded or not."""
+@ops_router.get(
+    "/health",
+    response_model=r.StatusResponse,
+    response_model_exclude_none=True,
+    responses=error_docs(503),
+    summary="Liveness",
+    openapi_extra=curl_sample("/health"),
+)
+async def health(request: Request) -> Any:
+    """200 while the process serves requests, warming up or ready; 503 where the model's warm-up failed (the
+    process cannot serve it: restart it)."""
+    failed = request.app.state.failed
+    if failed:
+        return JSONResponse({"status": "failed", "detail": f"the model cannot serve: {failed}"}, status_code=503)
     return {"status": "ok"}
+
+
+#: What /ready says while the model warms up.
+WARMING_UP = (
+    "warming up: the reading's compiled kernels load from numba's cache, or compile into it on a first start "
+    "(15-30 s); requests sent now wait for it"
+)
 
 
 @ops_router.get(
     "/ready",
     response_model=r.StatusResponse,
-    responses=error_docs(503),
+    response_model_exclude_none=True,
+    responses={503: {"description": "Warming up, failed or stopping", "model": r.StatusResponse}},
     summary="Readiness",
     openapi_extra=curl_sample("/ready"),
 )
-async def ready(request: Request) -> dict[str, str]:
-    """200 once the model is loaded and a warm-up inference succeeded; 503 before that and while shutting down."""
-    runtime_of(request)
+async def ready(request: Request) -> Any:
+    """200 once the model is loaded and warm; 503 before that (status "warming up"), where its warm-up failed
+    ("failed") and while shutting down ("stopping"), with `detail` saying which."""
+    state = request.app.state
+    if state.failed:
+        return JSONResponse({"status": "failed", "detail": f"the model cannot serve: {state.failed}"}, 503)
+    if state.warming is not None and not state.warming.done():
+        return JSONResponse({"status": "warming up", "detail": WARMING_UP}, 503)
+    if not state.ready or state.runtime is None:
+        return JSONResponse({"status": "stopping", "detail": "the model is not loaded"}, 503)
     return {"status": "ready"}
 
 

@@ -108,24 +108,31 @@ def test_the_paper_curves_come_back_closer_with_a_look(shipped_runtime: CurveRun
     assert looked < read / 1.5, (read, looked)
 
 
-def test_a_looked_at_answer_that_cannot_be_untangled_gives_way_to_the_reading(shipped_runtime, monkeypatch):
-    """A thin closed section whose decoded trailing edge crosses after the look: where the untangler cannot free the
-    looked-at answer, the answer is the one read before the looks, untangled."""
+@pytest.mark.parametrize(
+    ("asked", "instead"),
+    [(Reading(), Reading(looks=0)), (Reading(refine=2), Reading())],
+    ids=["a look gives way to the reading", "refine gives way to the look"],
+)
+def test_an_answer_that_cannot_be_untangled_gives_way_to_the_one_before_its_last_step(
+    shipped_runtime, monkeypatch, asked, instead
+):
+    """A thin closed section whose decoded trailing edge crosses: where the untangler cannot free the answer, the
+    answer is the row before its last step (before refine, before the looks), finished in turn."""
     from curve_vae.geometry.validity import new_crossings
     from curve_vae.inference import untangling
 
     section = naca(0.0, 0.10, 81)  # crosses after the default look (tests/inference/test_untangling.py)
-    plain = _plain(shipped_runtime, [section], Reading())
+    plain = _plain(shipped_runtime, [section], asked)
     assert new_crossings([section], plain.curves).tolist() == [True]
     real, calls = untangling.untangled, []
 
-    def first_fails(ctrl, params, target, **kw):  # the first call is the looked-at answer's
+    def first_fails(ctrl, params, target, **kw):  # the first call is the answer's: it comes back as it was
         calls.append(1)
         return (np.asarray(ctrl, np.float64), False) if len(calls) == 1 else real(ctrl, params, target, **kw)
 
     monkeypatch.setattr(untangling, "untangled", first_fails)
-    answer = shipped_runtime.reconstruct([section])
+    answer = shipped_runtime.reconstruct([section], asked)
     monkeypatch.setattr(untangling, "untangled", real)
-    read = shipped_runtime.reconstruct([section], Reading(looks=0))
+    before = shipped_runtime.reconstruct([section], instead)
     assert not new_crossings([section], answer.curves).any()
-    np.testing.assert_array_equal(answer.curves[0], read.curves[0])
+    np.testing.assert_array_equal(answer.curves[0], before.curves[0])

@@ -24,7 +24,7 @@ def test_not_ready_before_the_model_is_loaded(model_dir):
 
 
 def test_the_lifespan_loads_the_model_and_fails_loudly(make_client, tmp_path):
-    client = make_client(share_runtime=False, providers="cpu")
+    client = make_client(share_runtime=False, providers="cpu")  # waits for the warm-up: tests/helpers.wait_ready
     assert client.get("/ready").status_code == 200
     with pytest.raises(ModelLoadError, match="manifest.json is missing"):
         with TestClient(create_app(Settings(model_dir=tmp_path))):
@@ -45,3 +45,20 @@ def test_the_shipped_model_is_served_by_default(shipped_runtime, curves):
         np.testing.assert_allclose(
             np.array(moved["curves"]), np.array(base["curves"]) * 0.01 - 7, atol=1e-6 * 128 * 0.01
         )
+
+
+def test_a_warm_up_that_fails_is_stated_by_health_and_ready(model_dir, monkeypatch):
+    """The server answers while the model warms up; where the warm-up fails, /health and /ready answer 503 saying
+    why (an orchestrator restarts the process) and model requests are refused, not left waiting."""
+    from curve_vae.inference.runtime import CurveRuntime
+
+    def broken(self, *, graphs: bool = True) -> None:
+        raise ModelLoadError("warm-up request failed: the reading broke")
+
+    monkeypatch.setattr(CurveRuntime, "warm_up", broken)
+    with TestClient(create_app(Settings(model_dir=model_dir, providers="cpu"))) as client:
+        r = client.post("/encode", json={"curves": [CURVE]})  # waits for the warm-up, then is refused
+        assert r.status_code == 503 and "the reading broke" in r.json()["detail"]
+        for path in ("/health", "/ready"):
+            r = client.get(path)
+            assert r.status_code == 503 and r.json()["status"] == "failed" and "the reading broke" in r.json()["detail"]
