@@ -59,20 +59,29 @@ def crossing_segments(points: np.ndarray) -> np.ndarray:
     return np.stack([j[keep], k[keep]], axis=1)
 
 
-def untangled(ctrl: np.ndarray, params: np.ndarray, target: np.ndarray, *, degree: int = 3) -> tuple[np.ndarray, bool]:
+def untangled(
+    ctrl: np.ndarray,
+    params: np.ndarray,
+    target: np.ndarray,
+    *,
+    degree: int = 3,
+    free_ends: bool = False,
+    closed: bool = False,
+) -> tuple[np.ndarray, bool]:
     """A clamped uniform B-spline's control points (n_ctrl, 2) with those around its crossings refitted so that the
     spline at `params` (n,) passes close to `target` (n, 2), and whether it is now free of crossings.
 
     The spline at `params` is the answer (the caller's points placed on it). Each round frees the control points
     whose spans hold a crossing's segments, one span beyond on either side (a span wider each round), and solves
-    for them by least squares against `target` with every other control point held; the two end control points
-    (the answer's ends, a closed spline's one closing point) are always held. Returned unchanged (and True) when it
-    does not cross."""
+    for them by least squares against `target` with every other control point held. The two end control points (the
+    answer's ends, kept where its input's are: inference.ends) are held too, unless `free_ends` (the last resort:
+    a closed spline's two ends then move as one point). Returned unchanged (and True) when it does not cross."""
     c = np.array(ctrl, np.float64)
     u = np.clip(np.asarray(params, np.float64), 0.0, 1.0)
     n_ctrl = len(c)
     basis = basis_and_slope(u, n_ctrl, degree)[0]  # (n, n_ctrl)
     spans = n_ctrl - degree
+    lo, hi = (0, n_ctrl - 1) if free_ends else (1, n_ctrl - 2)
     free: set[int] = set()
     for margin in range(1, UNTANGLE_ROUNDS + 1):
         pairs = crossing_segments(basis @ c)
@@ -80,19 +89,30 @@ def untangled(ctrl: np.ndarray, params: np.ndarray, target: np.ndarray, *, degre
             return c, True
         at = u[np.concatenate([pairs.ravel(), pairs.ravel() + 1])]
         for s in np.unique(np.minimum((at * spans).astype(np.int64), spans - 1)):
-            # the end control points are the answer's ends, kept where its input's are (inference.ends): held
-            free.update(range(max(int(s) - margin, 1), min(int(s) + degree + margin, n_ctrl - 2) + 1))
+            free.update(range(max(int(s) - margin, lo), min(int(s) + degree + margin, hi) + 1))
         if not free:
             break
-        unknown = sorted(free)
+        groups = _unknowns(sorted(free), n_ctrl, closed)
         held = np.ones(n_ctrl, bool)
-        held[unknown] = False
+        held[[i for g in groups for i in g]] = False
         rhs = target - basis[:, held] @ c[held]
         # a little pull to where each free point was: a control point whose spans hold few of the points is still
         # decided (and the answer the same, to rounding, whatever the curve's scale or pose)
-        columns = np.vstack([basis[:, unknown], STEADY * np.eye(len(unknown))])
-        solved = np.linalg.lstsq(columns, np.vstack([rhs, STEADY * c[unknown]]), rcond=None)[0]
+        columns = np.hstack([basis[:, g].sum(axis=1, keepdims=True) for g in groups])
+        columns = np.vstack([columns, STEADY * np.eye(len(groups))])
+        now = np.stack([c[g].mean(axis=0) for g in groups])
+        solved = np.linalg.lstsq(columns, np.vstack([rhs, STEADY * now]), rcond=None)[0]
         if not np.isfinite(solved).all():
             break
-        c[unknown] = solved
+        for g, value in zip(groups, solved):
+            c[g] = value
     return c, not len(crossing_segments(basis @ c))
+
+
+def _unknowns(free: list[int], n_ctrl: int, closed: bool) -> list[list[int]]:
+    """Which control points each unknown sets: each free one its own, but a closed spline's two ends one (its loop
+    stays joined)."""
+    ends = [0, n_ctrl - 1]
+    if closed and (0 in free or n_ctrl - 1 in free):
+        return [ends] + [[f] for f in free if f not in ends]
+    return [[f] for f in free]

@@ -290,6 +290,7 @@ class Reader:
         """`read[i]` for each i in `fresh`, in place: its ends kept (inference.ends) and untangled (inference.
         untangling). Where an answer still crosses itself, the row before its last step (refine, the looks: `earlier`,
         latest first), finished so, in its place where that one does not."""
+        unfinished = {i: read[i] for i in fresh}
         rows, tangled = self._finished([inputs[i] for i in fresh], [read[i] for i in fresh])
         for i, row in zip(fresh, rows):
             read[i] = row
@@ -301,15 +302,21 @@ class Reader:
                 if not still:  # repaired, and says so: another latent than the steps asked for
                     read[i] = row if row.repair is not None or row.ctrl is None else replace_repair(row)
                     break
+            else:  # the last resort: the answer's ends free to move where holding them leaves it crossing
+                (row,), _ = self._finished([inputs[i]], [unfinished[i]], free_ends=True)
+                read[i] = row
 
-    def _finished(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], list[int]]:
-        """The rows with their ends kept and untangled, and which of them still cross themselves."""
+    def _finished(
+        self, inputs: list[np.ndarray], rows: list[ReadCurve], *, free_ends: bool = False
+    ) -> tuple[list[ReadCurve], list[int]]:
+        """The rows with their ends kept and untangled, and which of them still cross themselves; `free_ends`: the
+        untangling may move the ends where holding them leaves an answer crossing."""
         size, degree = self.graphs.model_size, self.graphs.spline_degree
         if self.keep_ends:
             rows = self._placed_again(inputs, pinned_rows(inputs, rows, model_size=size, degree=degree))
         if not self.untangle:
             return rows, []
-        return untangle_rows(inputs, rows, model_size=size, degree=degree)
+        return untangle_rows(inputs, rows, model_size=size, degree=degree, free_ends=free_ends or not self.keep_ends)
 
     # ----------------------------------------------------------------------------------- decoding, placement
 

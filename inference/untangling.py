@@ -29,10 +29,16 @@ class _Indexed(Protocol):
 
 
 def untangle_rows(
-    inputs: Sequence[np.ndarray], rows: Sequence[ReadCurve], *, model_size: float, degree: int
+    inputs: Sequence[np.ndarray],
+    rows: Sequence[ReadCurve],
+    *,
+    model_size: float,
+    degree: int,
+    free_ends: bool = False,
 ) -> tuple[list[ReadCurve], list[int]]:
     """The rows whose answers (their splines at their points' parameters) cross themselves where the inputs do not,
-    untangled against the inputs' own points; the rest as they are; and which rows still cross after it. Rows without
+    untangled against the inputs' own points, their ends held (and, with `free_ends`, where that fails, free to
+    move: a valid answer before kept ends); the rest as they are; and which rows still cross after it. Rows without
     a spline or placed points (a model without a B-spline head or closest placement) are returned as they are."""
     out = list(rows)
     tangled: list[int] = []
@@ -47,17 +53,22 @@ def untangle_rows(
         spline_values(np.stack(ctrl), np.concatenate(feet), owner, degree=degree)[0], np.cumsum(lengths)[:-1]
     )
     bad = np.flatnonzero(new_crossings([inputs[i] for i in placed], answers))
-    fixed_answers = []
     for j in bad:
         i = placed[j]
         row = rows[i]
         target = row.frame.to_model(inputs[i], model_size) if row.frame is not None else np.asarray(inputs[i])
-        fixed, _ = untangled(ctrl[j], feet[j], target, degree=degree)
+        closed = is_closed(inputs[i])
+        fixed = ctrl[j]
+        # the ends held (kept where the input's are), then, as the last resort, free to move: a valid answer first
+        for ends in (False, True) if free_ends else (False,):
+            fixed, _ = untangled(ctrl[j], feet[j], target, degree=degree, free_ends=ends, closed=closed)
+            answer = spline_values(fixed, feet[j], degree=degree)[0]
+            # checked as the answer is (geometry.validity.new_crossings), not only as the fit saw it
+            if not new_crossings([inputs[i]], [answer])[0]:
+                break
+        else:
+            tangled.append(i)
         out[i] = dataclasses.replace(row, ctrl=fixed, repair=fixed - ctrl[j])  # float64: the fit's own digits
-        fixed_answers.append(spline_values(fixed, feet[j], degree=degree)[0])
-    if len(bad):  # still crossing as the answer is checked (geometry.validity.new_crossings), not only as the fit saw
-        still = new_crossings([inputs[placed[j]] for j in bad], fixed_answers)
-        tangled = [placed[int(j)] for j in bad[still]]
     return out, tangled
 
 
