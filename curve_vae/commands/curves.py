@@ -50,9 +50,35 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
     else:
         rec = model_runtime(a).reconstruct(curves, Reading(**reading), n_points=a.n_points)
         body = reconstruct_body(rec, metrics=a.metrics, output=a.output_as)
-    write_output(a.output, body, array_key="curves" if "curves" in body else None)
+    if Path(a.output).suffix.lower() in DRAWINGS:  # a drawing: the inputs beside their reconstructions, as the page
+        drawing, marks = with_inputs(curves, body)
+        write_output(a.output, drawing, marks=marks)
+    else:
+        write_output(a.output, body, array_key="curves" if "curves" in body else None)
     print(f"{a.output}: {reconstruct_summary(body)}", file=sys.stderr)
     return 0
+
+
+#: Outputs that are drawings (curvefiles.writing): they hold the inputs too.
+DRAWINGS = (".svg", ".dxf")
+
+
+def with_inputs(inputs: list[np.ndarray], body: dict[str, Any]) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """A reconstruction's answer as a drawing the page would export: each input, named A, B, … (role input), then its
+    reconstruction (role reconstruction, of its input), a B-spline where the answer holds splines; and the marks."""
+    from curve_vae.curvefiles.roles import curve_name
+
+    names = [curve_name(k) for k in range(len(inputs))]
+    recon = body.get("curves")
+    splines = body.get("splines")
+    curves = [np.asarray(c, np.float64).tolist() for c in inputs] + (list(recon) if recon is not None else [])
+    drawing: dict[str, Any] = {"curves": curves}
+    if splines:
+        drawing["splines"] = [None] * len(inputs) + list(splines)
+    marks = [{"role": "input", "name": n} for n in names] + [
+        {"role": "reconstruction", "name": f"{n} reconstructed", "of": n} for n in names
+    ]
+    return drawing, marks
 
 
 def reconstruct_summary(body: dict[str, Any]) -> str:

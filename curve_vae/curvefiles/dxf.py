@@ -18,7 +18,7 @@ from ezdxf.disassemble import recursive_decompose
 from ezdxf.entities import DXFGraphic
 
 from curve_vae.curvefiles.common import CurveFileError, drawn_curves
-from curve_vae.curvefiles.roles import ROLES, Found, the_inputs
+from curve_vae.curvefiles.roles import INTERPOLANT_ACI, PALETTE_ACI, ROLES, Found, colour_index, the_inputs
 from curve_vae.curvefiles.svg import weights_text
 
 KINDS = ("LWPOLYLINE", "POLYLINE", "SPLINE")
@@ -94,28 +94,31 @@ def _points(e: Any) -> np.ndarray:
 def write_dxf(
     target: Path,
     *,
-    splines: list[dict[str, Any]] | None,
+    splines: list[dict[str, Any] | None] | None,
     curves: list[np.ndarray] | None,
     marks: list[Mapping[str, Any]] | None = None,
 ) -> None:
-    """A DXF (R2010) with a SPLINE per B-spline, or else an LWPOLYLINE per curve; `marks`, one an entity, put each on
-    its role's layer with its XDATA."""
+    """A DXF (R2010) with a SPLINE per B-spline and an LWPOLYLINE per other curve (`splines[i]` None, or no splines:
+    `curves[i]`); `marks`, one an entity, put each on its role's layer, in the page's colour, with its XDATA."""
     doc = ezdxf.new("R2010")
     msp = doc.modelspace()
-    entities: list[DXFGraphic] = [
-        msp.add_open_spline(
-            [(float(x), float(y), 0.0) for x, y in s["control_points"]], degree=int(s["degree"]), knots=s["knots"]
-        )
-        for s in splines or []
-    ]
-    if splines is None:
-        entities = [msp.add_lwpolyline([(float(x), float(y)) for x, y in c], format="xy") for c in curves or []]
+    count = len(splines) if splines is not None else len(curves or [])
+    entities: list[DXFGraphic] = []
+    for i in range(count):
+        s = splines[i] if splines is not None else None
+        if s is not None:
+            ctrl = [(float(x), float(y), 0.0) for x, y in s["control_points"]]
+            entities.append(msp.add_open_spline(ctrl, degree=int(s["degree"]), knots=s["knots"]))
+        else:
+            entities.append(msp.add_lwpolyline([(float(x), float(y)) for x, y in (curves or [])[i]], format="xy"))
     if marks:
         doc.appids.new(APPID)
         for e, mark in zip(entities, marks):
             layer = layer_name(mark)
             if layer not in doc.layers:
-                doc.layers.add(layer)
+                k = colour_index(dict(mark))
+                aci = INTERPOLANT_ACI if mark.get("role") == "interpolant" else PALETTE_ACI[k] if k is not None else 7
+                doc.layers.add(layer, color=aci)
             e.dxf.layer = layer
             e.set_xdata(APPID, xdata(mark))
     doc.saveas(target)

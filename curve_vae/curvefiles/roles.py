@@ -13,6 +13,38 @@ from curve_vae.curvefiles.common import warn
 
 ROLES = ("input", "reconstruction", "interpolant")
 
+#: The page's colours, a curve's by the order of its name (A, B, …, Z, AA, …) for life; the same list is the page's
+#: (service/static/files.js, `PALETTE`; a test keeps the two equal). DXF has no RGB on a layer's colour index: ACI,
+#: the nearest of AutoCAD's colours to each.
+PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#bcbd22", "#7f7f7f", "#393b79")
+PALETTE_ACI = (5, 3, 6, 30, 4, 34, 221, 52, 8, 176)
+INTERPOLANT_COLOUR, INTERPOLANT_ACI = "#d62728", 1
+
+
+def curve_name(k: int) -> str:
+    """The k-th curve's name, from 0: A, B, …, Z, AA, AB, … (as the page names curves)."""
+    name, k = "", k + 1
+    while k > 0:
+        k, r = divmod(k - 1, 26)
+        name = chr(65 + r) + name
+    return name
+
+
+def name_index(name: str) -> int | None:
+    """The order of a curve's name (`curve_name`'s inverse), or None for a name of another kind."""
+    if not name or not name.isascii() or not name.isalpha() or not name.isupper():
+        return None
+    k = 0
+    for c in name:
+        k = 26 * k + ord(c) - 64
+    return k - 1
+
+
+def colour_index(mark: dict[str, Any]) -> int | None:
+    """Where a marked curve's colour is in PALETTE: its own name's, or its input's (`of`) for a reconstruction."""
+    k = name_index(str(mark.get("of") or mark.get("name") or ""))
+    return None if k is None else k % len(PALETTE)
+
 
 class Found(NamedTuple):
     """One curve of a file: a label for messages (`path#id`, `SPLINE #1A`), its points and its role (None: unmarked)."""

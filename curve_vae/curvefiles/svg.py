@@ -16,7 +16,7 @@ import numpy as np
 import svgelements as se
 
 from curve_vae.curvefiles.common import CurveFileError, drawn_curves
-from curve_vae.curvefiles.roles import Found, role_of, the_inputs
+from curve_vae.curvefiles.roles import INTERPOLANT_COLOUR, PALETTE, Found, colour_index, role_of, the_inputs
 
 #: The longer side of a written drawing, in CSS pixels: its curves keep their own coordinates in the viewBox, and a
 #: browser shows an airfoil of chord 1 at this width, not at one pixel.
@@ -26,9 +26,8 @@ STROKE_PX = 1.5
 
 #: Points per curved segment (cubic, quadratic, arc) of a drawing's path.
 SAMPLES_PER_SEGMENT = 16
-#: The page's colours: each input's (a reconstruction takes its input's), the interpolants', a curve without a role.
-COLOURS = {"A": "#1f77b4", "B": "#2ca02c", "C": "#9467bd"}
-INTERPOLANT, UNMARKED = "#d62728", "#1f77b4"
+#: The interpolants' colour and that of a curve without a role or name; the others': roles.PALETTE by their names.
+INTERPOLANT, UNMARKED = INTERPOLANT_COLOUR, PALETTE[0]
 #: How a role is drawn: inputs as pale bands under the rest, reconstructions dashed, interpolants solid.
 STYLES = {
     "input": 'stroke-width="6" stroke-opacity="0.3" stroke-linecap="round" stroke-linejoin="round"',
@@ -118,13 +117,17 @@ def _marked(mark: Mapping[str, Any] | None) -> str:
         attrs.append(f"data-of={quoteattr(str(mark['of']))}")
     if mark.get("weights"):
         attrs.append(f"data-weights={quoteattr(weights_text(mark['weights']))}")
-    colour = INTERPOLANT if role == "interpolant" else COLOURS.get(str(mark.get("of") or mark.get("name")), UNMARKED)
+    k = colour_index(dict(mark))
+    colour = INTERPOLANT if role == "interpolant" else PALETTE[k] if k is not None else UNMARKED
     return " ".join([*attrs, f'stroke="{colour}"', STYLES[role]]).strip()
 
 
-def svg_text(paths: list[np.ndarray], *, beziers: bool, marks: list[Mapping[str, Any]] | None = None) -> str:
-    """An SVG document with one path per item: points (n, 2), or with `beziers` cubic segments (m, 4, 2); `marks`,
-    one a path, give each its role, `name`, `of` (a reconstruction's input) and `weights` (an interpolant's)."""
+def svg_text(
+    paths: list[np.ndarray], *, beziers: bool | list[bool], marks: list[Mapping[str, Any]] | None = None
+) -> str:
+    """An SVG document with one path per item: points (n, 2), or with `beziers` (for all, or one flag an item) cubic
+    segments (m, 4, 2); `marks`, one a path, give each its role, `name`, `of` (a reconstruction's input) and
+    `weights` (an interpolant's)."""
     allpts = np.concatenate([p.reshape(-1, 2) for p in paths])
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     size = float(max(hi[0] - lo[0], hi[1] - lo[1], 1e-9))
@@ -138,8 +141,9 @@ def svg_text(paths: list[np.ndarray], *, beziers: bool, marks: list[Mapping[str,
         f"<desc>{DESC}</desc>",
         f'<g fill="none" stroke-width="{STROKE_PX}">',
     ]
-    for i, p in enumerate(paths):
-        d = _d_beziers(p) if beziers else _d_points(p)
+    flags = beziers if isinstance(beziers, list) else [beziers] * len(paths)
+    for i, (p, bezier) in enumerate(zip(paths, flags)):
+        d = _d_beziers(p) if bezier else _d_points(p)
         mark = _marked(marks[i] if marks else None)
         lines.append(f'<path id="curve-{i}" {mark} vector-effect="non-scaling-stroke" d="{d}"/>')
     lines += ["</g>", "</svg>", ""]

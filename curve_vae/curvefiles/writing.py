@@ -90,12 +90,16 @@ def _write_drawing(
     from curve_vae.curvefiles.dxf import write_dxf
     from curve_vae.curvefiles.svg import svg_text
 
-    splines = _splines(payload)
-    curves = None if splines else [np.asarray(c, dtype=np.float64) for c in _points(payload, path, array_key)]
+    splines = _splines(payload)  # where some entries are None (a drawing's inputs), those curves are points
+    points_needed = not splines or any(s is None for s in splines)
+    curves = [np.asarray(c, dtype=np.float64) for c in _points(payload, path, array_key)] if points_needed else None
     if suffix == ".svg":
         if splines:
-            beziers = [spline_beziers(s["control_points"], s["knots"], s["degree"]) for s in splines]
-            text = svg_text(beziers, beziers=True, marks=marks)
+            paths = [
+                spline_beziers(s["control_points"], s["knots"], s["degree"]) if s is not None else (curves or [])[i]
+                for i, s in enumerate(splines)
+            ]
+            text = svg_text(paths, beziers=[s is not None for s in splines], marks=marks)
         else:
             text = svg_text(curves or [], beziers=False, marks=marks)
         atomic_write_text(path, text)

@@ -198,23 +198,40 @@ def test_reconstruct_gives_one_curve_back_per_curve_in(name, tmp_path, capsys):
 
 
 @NEEDS_SHIPPED
-def test_reconstruct_draws_its_splines_as_svg_and_dxf(tmp_path):
+def test_reconstruct_draws_its_inputs_and_splines_as_svg_and_dxf_as_the_page_does(tmp_path):
+    """A reconstruction drawn as SVG or DXF holds what the page's export holds: each input named A, B, C (role input,
+    the page's colour), then its reconstruction (of its input, in its colour), a B-spline drawn exactly; opened
+    again, the inputs are read (the reconstructions are derived)."""
+    from curve_vae.curvefiles.roles import PALETTE, PALETTE_ACI
+
     page = str(FILES / "page-export.json")
+    inputs = read_curves(page)
     spl = tmp_path / "splines.json"
     assert main(["reconstruct", page, "--output-as", "bspline", "-o", str(spl)]) == 0
     splines = json.loads(spl.read_text())["splines"]
     assert main(["reconstruct", page, "--output-as", "bspline", "-o", str(tmp_path / "out.svg")]) == 0
     paths = [e for e in se.SVG.parse(str(tmp_path / "out.svg")).elements() if isinstance(e, se.Path)]
-    assert len(paths) == len(splines) == 3  # the drawing's inputs, reconstructed
-    for path, s in zip(paths, splines):  # a cubic Bézier per knot span of the spline
+    assert len(paths) == 2 * len(splines) == 6
+    for k, path in enumerate(paths[:3]):  # the inputs, as given
+        assert path.values["class"] == "input" and path.values["data-name"] == "ABC"[k]
+        assert path.values["stroke"] == PALETTE[k]
+    for k, (path, s) in enumerate(zip(paths[3:], splines)):  # a cubic Bézier per knot span of the spline
+        assert path.values["class"] == "reconstruction" and path.values["data-of"] == "ABC"[k]
+        assert path.values["stroke"] == PALETTE[k]
         cubics = [seg for seg in path.segments() if isinstance(seg, se.CubicBezier)]
         assert len(cubics) == len(np.unique(s["knots"])) - 1
+    with pytest.warns(UserWarning, match="its 3 input curve"):
+        again = read_curves(tmp_path / "out.svg")
+    for got, want in zip(again, inputs):
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
     assert main(["reconstruct", page, "--output-as", "bspline", "-o", str(tmp_path / "out.dxf")]) == 0
-    entities = list(ezdxf.readfile(tmp_path / "out.dxf").modelspace().query("SPLINE"))
-    assert len(entities) == 3
-    for e, s in zip(entities, splines):
+    doc = ezdxf.readfile(tmp_path / "out.dxf")
+    entities = list(doc.modelspace().query("SPLINE"))
+    assert len(entities) == 3 and len(doc.modelspace().query("LWPOLYLINE")) == 3
+    for k, (e, s) in enumerate(zip(entities, splines)):
         np.testing.assert_allclose(np.asarray(e.control_points)[:, :2], s["control_points"], atol=1e-9)
         np.testing.assert_allclose(e.knots, s["knots"], atol=1e-12)
+        assert doc.layers.get(e.dxf.layer).color == PALETTE_ACI[k]
 
 
 @NEEDS_SHIPPED

@@ -136,3 +136,31 @@ def test_the_rule(found, kept, recwarn):
 )
 def test_an_svg_class_names_the_role_among_its_words(marks, role):
     assert role_of(marks) == role
+
+
+def test_names_run_a_to_z_then_aa_and_back():
+    from curve_vae.curvefiles.roles import curve_name, name_index
+
+    assert [curve_name(k) for k in (0, 1, 25, 26, 27, 51, 52, 701, 702)] == [
+        "A", "B", "Z", "AA", "AB", "AZ", "BA", "ZZ", "AAA"
+    ]  # fmt: skip
+    assert all(name_index(curve_name(k)) == k for k in range(1000))
+    assert name_index("mix") is None and name_index("A reconstructed") is None
+
+
+def test_the_pages_palette_and_names_are_the_command_lines():
+    """The page names and colours curves as curvefiles.roles does (service/static/files.js): the same list, the same
+    order; its DXF writer's colour indices are roles.PALETTE_ACI."""
+    import re
+
+    from curve_vae.curvefiles.roles import PALETTE, PALETTE_ACI
+    from tests.helpers import ROOT
+
+    static = ROOT / "service" / "static"
+    js = (static / "files.js").read_text()
+    page_palette = re.search(r"const PALETTE = \[([^\]]*)\]", js)
+    assert page_palette is not None
+    assert tuple(re.findall(r'"(#[0-9a-f]{6})"', page_palette.group(1))) == PALETTE
+    aci = re.search(r"const PALETTE_ACI = \[([^\]]*)\]", (static / "files-out.js").read_text())
+    assert aci is not None and tuple(int(v) for v in aci.group(1).split(",")) == PALETTE_ACI
+    assert len(PALETTE_ACI) == len(PALETTE)
