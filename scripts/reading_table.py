@@ -165,11 +165,12 @@ def verdict(table: dict[str, dict]) -> dict[str, dict[str, float]]:
 def plot(table: dict[str, dict], path: str) -> None:
     """Error (the sets' geometric mean) against cost a curve, a panel a group; a line joins a reading's looks."""
     import matplotlib
+    import matplotlib.ticker
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8), sharex=True)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.6), sharex=True)
     bases: dict[str, list[str]] = {}
     for row in ROWS:
         if row.name in table:
@@ -188,13 +189,20 @@ def plot(table: dict[str, dict], path: str) -> None:
                         label=label)  # fmt: skip
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xticks([3, 5, 7, 10, 15, 20, 30, 40])
+        ax.set_yticks([0.03, 0.04, 0.05, 0.07, 0.1, 0.15, 0.2])
         ax.set_xlabel("ms of one core a curve, read in a set (log)")
         ax.set_ylabel("error, % of the diagonal (geometric mean of the sets, log)")
         ax.set_title(title)
         ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8, loc="upper right")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=9)
     fig.suptitle("Readings: closeness against cost (numbers: looks again)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.12, 1, 1))
     fig.savefig(path, dpi=110)
 
 
@@ -226,7 +234,11 @@ def main() -> None:
     p.add_argument("--plot", default="", help="also draw the frontier here (PNG)")
     p.add_argument("--readings", nargs="*", default=[r.name for r in ROWS], help="rows (default: all)")
     p.add_argument("--morphs", type=int, default=0, help="pairs of the morph suite for the default (default: none)")
+    p.add_argument("--replot", default="", help="draw --plot from a table written with --json, measuring nothing")
     a = p.parse_args()
+    if a.replot:
+        plot(json.loads(open(a.replot).read())["readings"], a.plot)
+        return
     rt = CurveRuntime.load(a.model_dir, intra_op_threads=1, cache_bytes=0)
     suite = {name: curves for name, (_, curves) in suite_sets(paper_test_split(), a.count).items()}
     groups = {"users": table_sets(), "suite": suite}
