@@ -1,6 +1,7 @@
 """docs/figures/page.png: the page as it is, in Chromium at 1440×900 against `curve-vae serve` on the shipped model.
 
-Three curves drawn in triplet mode, the mix near B, curve A selected with its neighbours, the vase revolved.
+Five curves (four strokes and an in-between taken), the mix of two picked in the list (A and C), the view zoomed in on
+them, curve A selected with its control points as handles and its neighbours, the vase revolved.
 Needs Debian's chromium (`apt-get install chromium`) and the test extra (Playwright).
 
     .venv/bin/python scripts/page_figure.py                # writes docs/figures/page.png
@@ -38,24 +39,29 @@ def main() -> None:
             browser = p.chromium.launch(executable_path=chromium, args=ARGS)
             page = browser.new_context(viewport={"width": 1440, "height": 900}).new_page()
             page.goto(server.url + "/")
-            page.check("#mode-triplet")
-            draw(page, arc(250, 420, 160, 1.05 * np.pi, 1.95 * np.pi))  # a bowl
+            bowl = arc(250, 420, 160, 1.05 * np.pi, 1.95 * np.pi)
             t = np.linspace(0, 1, 40)
-            draw(page, list(zip(560 + 330 * t, 330 - 110 * np.sin(np.pi * t) + 60 * t)))  # a wave
-            draw(page, arc(480, 520, 120, 0.05 * np.pi, 0.95 * np.pi))  # a hump
-            page.wait_for_function("window.curveVae.result !== null && window.curveVae.strip.length === 10")
-            box = page.locator("#triangle").bounding_box()
-            assert box is not None
-            page.mouse.click(box["x"] + 80 / 220 * box["width"], box["y"] + 130 / 200 * box["height"])
-            page.wait_for_timeout(500)
-            page.click("#vase")
-            page.wait_for_function("window.curveVae.vase !== null")
-            page.wait_for_function("window.curveVae.recon.every((r) => r)")
-            page.check("#show-ctrl")
-            bowl = arc(250, 420, 160, 1.05 * np.pi, 1.95 * np.pi)[15]
+            draw(page, bowl)  # A, a bowl
+            draw(page, list(zip(560 + 330 * t, 330 - 110 * np.sin(np.pi * t) + 60 * t)))  # B, a wave
+            draw(page, arc(480, 520, 120, 0.05 * np.pi, 0.95 * np.pi))  # C, a hump
+            draw(page, list(zip(150 + 300 * t, 150 + 60 * np.sin(2 * np.pi * t))))  # D, an S
+            page.wait_for_function("window.curveVae.items.length === 4 && window.curveVae.recon.every((r) => r)")
+            page.wait_for_function("window.curveVae.strip.length === 5")
+            page.locator("#strip .thumb").nth(1).click()  # E, an in-between of C and D
+            page.wait_for_function("window.curveVae.items.length === 5 && window.curveVae.recon.every((r) => r)")
+            for name in ("A", "C"):  # the mix: A and C, picked in the list
+                page.locator(f"#curve-list li[data-name='{name}'] .mix-pick").check()
+            page.wait_for_function("window.curveVae.result && window.curveVae.result.of.join() === 'A,C'")
+            page.locator("#weight").fill("0.35")
+            page.wait_for_function("window.curveVae.result.weights[1] === 0.35")
             board = page.locator("#board").bounding_box()
             assert board is not None
-            page.mouse.click(board["x"] + bowl[0] / 1000 * board["width"], board["y"] + bowl[1] / 700 * board["height"])
+            page.mouse.move(board["x"] + 0.42 * board["width"], board["y"] + 0.62 * board["height"])
+            page.mouse.wheel(0, -260)  # zoomed in on the mix
+            page.wait_for_timeout(300)
+            page.click("#vase")
+            page.wait_for_function("window.curveVae.vase !== null")
+            page.locator("#curve-list li[data-name='A'] .curve-name").click()  # A selected: handles, neighbours
             page.wait_for_function("window.curveVae.neighbours !== null")
             page.mouse.move(0, 0)
             with atomic_path(args.out) as tmp:

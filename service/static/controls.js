@@ -16,32 +16,24 @@ for (const mode of ["pair", "triplet"]) {
   });
 }
 $("show-ctrl").addEventListener("change", () => { save(); render(); });
-$("fit-closely").addEventListener("change", curvesChanged);
+$("fit-closely").addEventListener("change", () => curvesChanged({ keepVase: true }));
 
 $("undo").addEventListener("click", undo);
 $("redo").addEventListener("click", redo);
 $("delete").addEventListener("click", deleteSelected);
 function deleteSelected() {
-  if (state.selected === null) return;
-  remember();
-  state.curves.splice(state.selected, 1);
-  state.recon.splice(state.selected, 1);
-  state.selected = null;
-  state.result = null;
-  state.neighbours = null;
-  renderNeighbours();
-  curvesChanged();
+  if (state.selected !== null) deleteCurve(state.selected);
 }
 
+// Clear: an empty drawing, a step like any other (Undo brings the curves back, after a reload too).
 $("clear").addEventListener("click", () => {
-  if (state.curves.length) remember();  // Clear can be undone, in this visit
-  Object.assign(state, { curves: [], recon: [], result: null, strip: [], stripWeights: [], vase: null,
-    lastRequest: null, selected: null, neighbours: null });
+  if (state.items.length) remember();
+  Object.assign(state, { items: [], mixOf: null, result: null, strip: [], stripWeights: [], stripValid: [],
+    vase: null, lastRequest: null, selected: null, neighbours: null });
   $("curl").textContent = "";
   for (const id of ["board-error", "mix-error", "strip-error", "vase-error", "around-error"]) $(id).textContent = "";
   renderNeighbours();
   curvesChanged();
-  forget();
 });
 
 document.addEventListener("keydown", (ev) => {
@@ -54,42 +46,50 @@ document.addEventListener("keydown", (ev) => {
   else if (ev.key === "Escape" && state.selected !== null) select(null);
 });
 
+// Samples: two (three) new curves side by side across the view, the ones mixed next.
 $("sample").addEventListener("click", async () => {
   try {
-    const k = needed(), size = Math.min((0.8 * W) / k, 0.75 * H);
+    const k = needed(), v = state.view, size = Math.min((0.8 * v.w) / k, 0.75 * v.h);
     const body = { count: k, n_points: N_POINTS, frame: { center: [0, 0], size } };
     if ($("prior").value) body.prior = $("prior").value;
     const r = await api("/sample", body, $("board-error"));
     remember();
-    // side by side, each in its own slot of the board, not all about its centre
-    state.curves = r.curves.map((c, i) => placed(c, [(W * (i + 0.5)) / k, H / 2]));
-    state.recon = r.curves.map(() => null);
+    const names = r.curves.map((c, i) => {
+      const at = toApi([v.x + (v.w * (i + 0.5)) / k, v.y + v.h / 2]);
+      return state.items[addCurve(placed(c, at, [v.w / k, v.h]))].name;
+    });
+    state.mixOf = names;
     state.selected = null;
     await curvesChanged();
   } catch (e) { /* shown next to the board */ }
 });
 
 // The curve moved so that its bounding box is centred on `center`, and scaled down where it would not fit `box`.
-function placed(curve, center, box = [W / needed(), H]) {
+function placed(curve, center, box) {
   const xs = curve.map((p) => p[0]), ys = curve.map((p) => p[1]);
   const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
   const s = Math.min(1, (0.9 * box[0]) / (x1 - x0 || 1), (0.9 * box[1]) / (y1 - y0 || 1));
   return curve.map(([x, y]) => [center[0] + s * (x - (x0 + x1) / 2), center[1] + s * (y - (y0 + y1) / 2)]);
 }
 
-// The barycentric triangle: A at the top, B bottom left, C bottom right.
-const TRI = [[110, 12], [12, 185], [208, 185]];
+// The barycentric triangle of the mixed curves: the first at the top, the second bottom left, the third bottom right,
+// each corner in its curve's colour and name.
+const TRI = [[110, 22], [16, 185], [204, 185]];
 function renderTriangle() {
   const svg = $("triangle");
   svg.replaceChildren();
   el("path", { d: pathOf(TRI) + " Z", fill: "#f4f6fb", stroke: "#889" }, svg);
+  const mixed = mixIndices().map((i) => state.items[i]);
   TRI.forEach(([x, y], i) => {
-    el("text", { x: x + [8, -12, -8][i], y: y + (i ? 15 : 8), fill: COLORS[i], "font-size": 22, "font-weight": 600 }, svg)
-      .textContent = NAMES[i];
+    const c = mixed[i];
+    el("text", { x: x + [0, -2, 2][i], y: y + [-6, 20, 20][i], "text-anchor": ["middle", "start", "end"][i],
+      fill: c ? c.color : "#889", "font-size": 18, "font-weight": 600, class: "corner" }, svg)
+      .textContent = c ? c.name : "?";
   });
   const [x, y] = [0, 1].map((k) => state.bary.reduce((s, w, i) => s + w * TRI[i][k], 0));
-  el("circle", { cx: x, cy: y, r: 6, fill: MIX_COLOR, id: "bary-dot" }, svg);
-  $("bary-value").textContent = state.bary.map((w) => w.toFixed(2)).join(", ");
+  el("circle", { cx: x, cy: y, r: 7, fill: MIX_COLOR, id: "bary-dot" }, svg);
+  $("bary-value").textContent = state.bary.map((w, i) => `${mixed[i] ? mixed[i].name : "?"} ${Math.round(100 * w)}%`)
+    .join(", ");
 }
 function pickBary(ev) {
   const r = $("triangle").getBoundingClientRect();
@@ -139,8 +139,8 @@ $("copy-curl").addEventListener("click", async () => {
 // ------------------------------------------------------------------------------------------ files in
 
 // Curves from a file picked or dropped on the board (files.js reads them here, in the browser): its inputs (a file
-// of this page's or the command line's marks them; derived curves are not made inputs), up to three, in pair or
-// triplet mode as many as there are; one joins the drawn curves.
+// of this page's or the command line's marks them; derived curves are not made inputs), each a new curve of the
+// drawing, the last two (three) of them mixed.
 async function openFile(file) {
   $("board-error").textContent = "";
   let read;
@@ -152,15 +152,13 @@ async function openFile(file) {
     return;
   }
   remember();
-  const curves = onBoard(read.curves.slice(0, 3));
-  if (curves.length > 1) {
-    setMode(curves.length === 3 ? "triplet" : "pair");
-    Object.assign(state, { curves: [], recon: [] });
-  }
+  const curves = onBoard(read.curves);
+  if (curves.length === 3) setMode("triplet");
+  else if (curves.length === 2) setMode("pair");
+  state.mixOf = null;
   curves.forEach(addCurve);
   const done = curvesChanged();
-  $("hint").textContent = [`${file.name}: ${curves.length} of its ${read.curves.length} curve(s) opened.`,
-    ...read.notes].join(" ");
+  $("hint").textContent = [`${file.name}: its ${curves.length} curve(s) opened.`, ...read.notes].join(" ");
   await done;
 }
 
@@ -188,15 +186,7 @@ $("board").addEventListener("drop", (ev) => {
 
 // ------------------------------------------------------------------------------------------ the vase
 
-$("vase").addEventListener("click", async () => {
-  try {
-    const r = await revolve("obj");
-    if (!r) return;
-    state.vase = curveVase.parseObj(await r.text());
-    state.vase.faces_header = Number(r.headers.get("X-Mesh-Faces"));
-    drawVase();
-  } catch (e) { /* shown next to the vase */ }
-});
+$("vase").addEventListener("click", showVase);
 for (const format of ["obj", "stl"]) {
   $(`download-${format}`).addEventListener("click", async () => {
     try {
@@ -216,8 +206,11 @@ $("api-key").addEventListener("change", () => {
 
 // ------------------------------------------------------------------------------------------ start
 
+$("board").addEventListener("mousedown", (ev) => { if (ev.button === 1) ev.preventDefault(); });  // no autoscroll
+loadView();
 renderTriangle();
 if (load()) curvesChanged();
 else { render(); updateHint(); }
 updateUndoButtons();
+watchReady();
 listPriors();

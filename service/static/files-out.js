@@ -8,7 +8,7 @@
 "use strict";
 
 (() => {
-  const { CurveFileError, ROLES, _shared: { item, weightsText, APPID } } = window.curveFiles;
+  const { CurveFileError, ROLES, colourOf, nameIndex, _shared: { item, weightsText, APPID } } = window.curveFiles;
 
   const item0 = (c) => item({ ...c, role: c.role || "input" });
   const csvCell = (s) => (/[",\n]/.test(s) ? `"${s.replace(/"/g, '""')}"` : s);
@@ -25,7 +25,7 @@
   // SVG as the command line writes it (curve_vae/curvefiles/svg.py): the curves' own coordinates in the viewBox, a
   // point (x, y) at (x, -y), DISPLAY_PX on the longer side, a STROKE_PX stroke at any scale.
   const DISPLAY_PX = 800, STROKE_PX = 1.5;
-  const COLOURS = { A: "#1f77b4", B: "#2ca02c", C: "#9467bd" }, INTERPOLANT = "#d62728", UNMARKED = "#1f77b4";
+  const INTERPOLANT = "#d62728";
   const STYLES = {
     input: 'stroke-width="6" stroke-opacity="0.3" stroke-linecap="round" stroke-linejoin="round"',
     reconstruction: 'stroke-dasharray="6 4"',
@@ -42,7 +42,7 @@
     const attrs = [`id="${id}"`, `class="${esc(c.role)}"`, `data-name="${esc(c.name ?? "")}"`];
     if (c.of !== undefined) attrs.push(`data-of="${esc(c.of)}"`);
     if (c.weights) attrs.push(`data-weights="${esc(weightsText(c.weights))}"`);
-    const colour = c.role === "interpolant" ? INTERPOLANT : COLOURS[c.of ?? c.name] || UNMARKED;
+    const colour = c.role === "interpolant" ? INTERPOLANT : colourOf(c.of ?? c.name);
     attrs.push(`stroke="${colour}"`, STYLES[c.role] ?? "", 'vector-effect="non-scaling-stroke"');
     const d = "M" + c.points.map(([x, y]) => `${fmt(x)},${fmt(-y)}`).join(" L");
     return `<path ${attrs.filter(Boolean).join(" ")} d="${d}"/>`;
@@ -93,7 +93,7 @@
   // LWPOLYLINE per other curve, each on the layer `<role>-<name>` (what AutoCAD refuses in a layer's name as "_")
   // with its role, name, input and weights as XDATA strings of the application CURVE_VAE. DXF's y points up too.
   const NOT_IN_LAYERS = /[<>/\\":;?*|,=`]/g;
-  const LAYER_COLOURS = { A: 5, B: 3, C: 6 };
+  const PALETTE_ACI = [5, 3, 6, 30, 4, 34, 221, 52, 8, 176];  // AutoCAD's nearest to each of PALETTE (roles.py)
   const layerName = (c) => `${c.role}-${c.name ?? ""}`.replace(NOT_IN_LAYERS, "_");
 
   function toDxf(drawing) {
@@ -111,7 +111,8 @@
     const layers = [...new Set(["0", ...items.map(layerName)])];
     const colour = (layer) => {
       const c = items.find((i) => layerName(i) === layer);
-      return !c ? 7 : c.role === "interpolant" ? 1 : LAYER_COLOURS[c.of ?? c.name] || 7;
+      const k = c ? nameIndex(c.of ?? c.name) : null;
+      return !c ? 7 : c.role === "interpolant" ? 1 : k === null ? 7 : PALETTE_ACI[k % PALETTE_ACI.length];
     };
     table("LAYER", layers, (n) => ["100", "AcDbLayerTableRecord", "2", n, "70", "0", "62", String(colour(n)), "6", "Continuous"]);
     out.push("0", "ENDSEC", "0", "SECTION", "2", "ENTITIES");

@@ -287,5 +287,19 @@
   // page keeps it, weights as text and back, the rule for a drawing's curves, the readers by extension.
   const _shared = { item, weightsText, weightsOf, roleOf, drawn, readers };
 
-  window.curveFiles = { parse, CurveFileError, ROLES, _shared };
+  // A curve's name by the order it was made (A, B, …, Z, AA, …) and its colour for life, the command line's
+  // (curve_vae/curvefiles/roles.py: PALETTE, curve_name; a test keeps the two equal).
+  const PALETTE = ["#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#bcbd22", "#7f7f7f", "#393b79"];
+  function curveName(k) {
+    let name = "";
+    for (let n = k + 1; n > 0; n = Math.floor((n - 1) / 26)) name = String.fromCharCode(65 + ((n - 1) % 26)) + name;
+    return name;
+  }
+  function nameIndex(name) {
+    if (!/^[A-Z]+$/.test(name || "")) return null;
+    return [...name].reduce((k, c) => 26 * k + c.charCodeAt(0) - 64, 0) - 1;
+  }
+  const colourOf = (name) => { const k = nameIndex(name); return k === null ? PALETTE[0] : PALETTE[k % PALETTE.length]; };
+
+  window.curveFiles = { parse, CurveFileError, ROLES, PALETTE, curveName, nameIndex, colourOf, _shared };
 })();

@@ -1,12 +1,18 @@
-// curve-vae's page: undo and redo of every change to the drawing (its curves, mode and weights), and the drawing
-// with its settings kept in this browser (localStorage) so that a reload brings it back; Clear starts afresh.
+// curve-vae's page: undo and redo of every change to the drawing (its curves, their names and colours, which are
+// mixed, the mode and the weights), kept with the drawing in this browser (localStorage), so that a reload brings
+// back the drawing and its history; Clear is a step like any other. The view is not a step (view.js keeps it).
 "use strict";
 
 const STORE = "curve-vae-drawing";
-const KEEP = 100;  // steps of undo
+const KEEP = 60;  // steps of undo and redo kept
+const STORED_BYTES = 2_000_000;  // the history kept across reloads gives up its oldest steps beyond this
 const undoStack = { past: [], future: [] };
 
-const snapshot = () => JSON.stringify({ curves: state.curves, mode: state.mode, weight: state.weight, bary: state.bary });
+const drawingNow = () => ({
+  items: state.items.map(({ name, color, points, hidden }) => ({ name, color, points, hidden })),
+  made: state.made, mixOf: state.mixOf, mode: state.mode, weight: state.weight, bary: state.bary,
+});
+const snapshot = () => JSON.stringify(drawingNow());
 
 // Call before a change: the drawing as it was becomes the step Undo goes back to.
 function remember() {
@@ -16,14 +22,29 @@ function remember() {
   updateUndoButtons();
 }
 
-function restore(text) {
-  const s = JSON.parse(text);
+// A drawing (a snapshot's, or the kept one's) put on the page; false where it is not one.
+function put(s) {
+  if (!drawingFine(s)) return false;
   setMode(s.mode);
-  state.curves = s.curves;
-  state.recon = s.curves.map(() => null);
+  state.items = s.items.map((c) => ({ name: c.name, color: c.color, points: c.points, hidden: !!c.hidden, recon: null }));
+  state.made = Math.max(s.made || 0, state.items.length);
+  state.mixOf = Array.isArray(s.mixOf) ? s.mixOf.filter((n) => typeof n === "string") : null;
   state.result = null;
   state.neighbours = null;
-  setWeights(s.weight, s.bary);
+  state.selected = null;
+  setWeights(Number.isFinite(s.weight) ? s.weight : 0.5,
+    Array.isArray(s.bary) && s.bary.length === 3 ? s.bary : [1 / 3, 1 / 3, 1 / 3]);
+  return true;
+}
+
+const isCurve = (c) => Array.isArray(c) && c.length >= 4 && c.every((p) => p.length === 2 && p.every(Number.isFinite));
+function drawingFine(s) {
+  return s && ["pair", "triplet"].includes(s.mode) && Array.isArray(s.items)
+    && s.items.every((c) => c && typeof c.name === "string" && typeof c.color === "string" && isCurve(c.points));
+}
+
+function restore(text) {
+  put(JSON.parse(text));
   curvesChanged();
 }
 
@@ -53,30 +74,30 @@ function setWeights(weight, bary) {
   renderTriangle();
 }
 
-// The drawing and its settings, as they are now, for the next visit.
+// The drawing, its settings and its history, as they are now, for the next visit: the oldest steps go first where
+// the whole would not fit.
 function save() {
-  const kept = { curves: state.curves, mode: state.mode, weight: state.weight, bary: state.bary,
-    fitClosely: $("fit-closely").checked, showControl: $("show-ctrl").checked };
-  try { localStorage.setItem(STORE, JSON.stringify(kept)); } catch (e) { /* private mode or full: nothing kept */ }
+  const kept = { ...drawingNow(), fitClosely: $("fit-closely").checked, showControl: $("show-ctrl").checked,
+    history: { past: undoStack.past.slice(), future: undoStack.future.slice() } };
+  for (;;) {
+    const text = JSON.stringify(kept);
+    if (text.length <= STORED_BYTES || (!kept.history.past.length && !kept.history.future.length)) {
+      try { localStorage.setItem(STORE, text); } catch (e) { /* private mode or full: nothing kept */ }
+      return;
+    }
+    if (kept.history.past.length) kept.history.past.shift(); else kept.history.future.shift();
+  }
 }
 
-// The drawing kept from the last visit, if any (a broken entry is dropped, not shown as an error).
+// The drawing kept from the last visit, with its history, if any (a broken entry is dropped, not shown as an error).
 function load() {
   let kept;
   try { kept = JSON.parse(localStorage.getItem(STORE) || "null"); } catch (e) { kept = null; }
-  const fine = kept && Array.isArray(kept.curves) && ["pair", "triplet"].includes(kept.mode)
-    && kept.curves.every((c) => Array.isArray(c) && c.length >= 4 && c.every((p) => p.length === 2 && p.every(Number.isFinite)));
-  if (!fine) { localStorage.removeItem(STORE); return false; }
+  if (!kept || !put(kept)) { try { localStorage.removeItem(STORE); } catch (e) { /* nothing kept */ } return false; }
   $("fit-closely").checked = !!kept.fitClosely;
   $("show-ctrl").checked = !!kept.showControl;
-  setMode(kept.mode);
-  state.curves = kept.curves.slice(-needed());
-  state.recon = state.curves.map(() => null);
-  setWeights(Number.isFinite(kept.weight) ? kept.weight : 0.5,
-    Array.isArray(kept.bary) && kept.bary.length === 3 ? kept.bary : [1 / 3, 1 / 3, 1 / 3]);
-  return state.curves.length > 0;
-}
-
-function forget() {
-  try { localStorage.removeItem(STORE); } catch (e) { /* nothing kept */ }
+  const steps = (list) => (Array.isArray(list) ? list.filter((t) => typeof t === "string").slice(-KEEP) : []);
+  undoStack.past = steps(kept.history && kept.history.past);
+  undoStack.future = steps(kept.history && kept.history.future);
+  return state.items.length > 0 || undoStack.past.length > 0;
 }

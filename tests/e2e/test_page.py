@@ -124,18 +124,21 @@ def _check_pair(page: Page, url: str) -> None:
     del strip_body["weights"]
     strip = httpx.post(url + "/interpolate", json=strip_body, timeout=30).json()
     np.testing.assert_allclose(s["strip"], strip["curves"], atol=1e-9)
-    assert float(page.locator("dd[data-metric='mix roughness']").inner_text().rstrip("°")) >= 0
-    # each reconstruction says how close it came relative to its curve's size: the API's closeness
+    smooth = page.locator("dd[data-metric='mix smoothness']").inner_text()
+    assert re.fullmatch(r"\d+\.\d\d° a point on average, \d+\.\d° at the sharpest", smooth), smooth
+    # each curve's row in the list says how close the model read it, relative to its size: the API's closeness
     again = httpx.post(url + "/reconstruct", json={"curves": s["curves"], "refine": s["recon"][0]["refine"]}).json()
     for i, name in enumerate("AB"):
         near = again["closeness"][i]
-        shown = page.locator(f"dd[data-metric='{name} reconstructed within']").inner_text()
-        assert shown.startswith(f"RMS {100 * near['rms']:.2f}%, worst {100 * near['max']:.2f}% of its size"), shown
+        shown = page.locator(f"#curve-list li[data-name='{name}'] .closeness").inner_text()
+        want = f"{100 * near['rms']:.2f}% off, {100 * near['max']:.2f}% at most"
+        assert shown.startswith(want), shown
 
     page.check("#show-ctrl")
     assert page.locator(".control-polygon").count() == 3  # two reconstructions and the mix
     assert len(s["result"]["spline"]["control_points"]) == 31
-    assert page.locator("dd[data-metric='mix shape']").inner_text() == "no self-crossing, 31 control points"
+    shape = page.locator("dd[data-metric='mix shape']").inner_text()
+    assert shape == "no self-crossing; 31 control points"
 
 
 def _check_triplet(page: Page, url: str) -> dict:

@@ -313,8 +313,9 @@ def test_a_drawing_an_airfoil_and_a_dropped_file_open_on_the_page(browser, serve
     xs = np.concatenate([np.asarray(c)[:, 0] for c in s["curves"]])
     assert xs.min() >= 0 and xs.max() <= 1000
 
-    page.set_input_files("#open-file", str(FILES / "selig_notes.dat"))  # one curve: it replaces the oldest
-    page.wait_for_function("window.curveVae.curves.some((c) => c.length === 69)")
+    page.set_input_files("#open-file", str(FILES / "selig_notes.dat"))  # one curve: a fourth, D
+    page.wait_for_function("window.curveVae.curves.length === 4 && window.curveVae.curves[3].length === 69")
+    assert state(page)["names"] == ["A", "B", "C", "D"]
 
     text = (FILES / "page-export.csv").read_text()
     drop = page.evaluate_handle(
@@ -324,10 +325,10 @@ def test_a_drawing_an_airfoil_and_a_dropped_file_open_on_the_page(browser, serve
     )
     page.dispatch_event("#board", "drop", {"dataTransfer": drop})
     saved = json.loads((FILES / "page-export.json").read_text())["curves"]
-    page.wait_for_function("document.getElementById('hint').textContent.startsWith('dropped.csv: 3 of its 3 curve')")
+    page.wait_for_function("document.getElementById('hint').textContent.startsWith('dropped.csv: its 3 curve')")
     got = state(page)["curves"]
-    assert len(got) == 3
-    for g, c in zip(got, saved[:3]):
+    assert len(got) == 7 and state(page)["names"][4:] == ["E", "F", "G"]  # added, none dropped
+    for g, c in zip(got[4:], saved[:3]):
         np.testing.assert_array_equal(g, c["points"])
     assert errors == []
 
@@ -366,7 +367,7 @@ def test_names_stay_apart_and_reconstructions_show_over_the_strokes(browser, ser
     assert len(labels) >= 3  # A, B, C (and the mix's)
     n = len(labels)
     assert not any(_overlap(labels[i], labels[j]) for i in range(n) for j in range(i + 1, n)), labels
-    order = page.eval_on_selector_all("#board path", "els => els.map((e) => e.getAttribute('class'))")
+    order = page.eval_on_selector_all("#board path", "els => els.map((e) => e.getAttribute('class').split(' ')[0])")
     assert max(i for i, c in enumerate(order) if c == "input") < min(
         i for i, c in enumerate(order) if c == "reconstruction"
     )
