@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -63,7 +64,7 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
 DRAWINGS = (".svg", ".dxf")
 
 
-def with_inputs(inputs: list[np.ndarray], body: dict[str, Any]) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+def with_inputs(inputs: list[np.ndarray], body: dict[str, Any]) -> tuple[dict[str, Any], list[Mapping[str, Any]]]:
     """A reconstruction's answer as a drawing the page would export: each input, named A, B, … (role input), then its
     reconstruction (role reconstruction, of its input), a B-spline where the answer holds splines; and the marks."""
     from curve_vae.curvefiles.roles import curve_name
@@ -75,9 +76,8 @@ def with_inputs(inputs: list[np.ndarray], body: dict[str, Any]) -> tuple[dict[st
     drawing: dict[str, Any] = {"curves": curves}
     if splines:
         drawing["splines"] = [None] * len(inputs) + list(splines)
-    marks = [{"role": "input", "name": n} for n in names] + [
-        {"role": "reconstruction", "name": f"{n} reconstructed", "of": n} for n in names
-    ]
+    marks: list[Mapping[str, Any]] = [{"role": "input", "name": n} for n in names]
+    marks += [{"role": "reconstruction", "name": f"{n} reconstructed", "of": n} for n in names]
     return drawing, marks
 
 

@@ -19,8 +19,9 @@ from curve_vae.curvefiles.common import CurveFileError
 from curve_vae.files import atomic_path, atomic_write_text
 
 
-def _splines(payload: dict[str, Any]) -> list[dict[str, Any]] | None:
-    """The B-splines of an answer: `splines` (--output-as bspline or both) or `fits` (curve-vae fit)."""
+def _splines(payload: dict[str, Any]) -> list[dict[str, Any] | None] | None:
+    """The B-splines of an answer: `splines` (--output-as bspline or both) or `fits` (curve-vae fit); a drawing's
+    entries are None for its curves of points."""
     return payload.get("splines") or payload.get("fits")
 
 
