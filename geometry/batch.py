@@ -24,12 +24,9 @@ from curve_vae.geometry.frame import (
     MODEL_CENTER,
     POSE_CHORDS,
     Frame,
-    chord_heading,
     pose_candidates,
     posed_frame,
     resample,
-    signed_turning,
-    turns_clockwise,
 )
 
 T = TypeVar("T")
@@ -147,7 +144,7 @@ def arc_grids(curves: Sequence[np.ndarray], n_points: int, *, upright: bool = Fa
         a, b = np.take_along_axis(pts, seg[..., None], 1), np.take_along_axis(pts, seg[..., None] + 1, 1)
         out = a + (b - a) * w
         if upright:
-            out[_turns_clockwise(pts), :, 0] *= -1.0
+            out[turns_clockwise_of(pts), :, 0] *= -1.0
         return list(out)
 
     rows: list[np.ndarray] = _by_length(curves, grids)
@@ -175,10 +172,10 @@ def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
     extent = np.ptp(pts, axis=1).max(axis=1)  # (k,)
     if not (extent > 0).all():
         raise ValueError("all points coincide: a curve needs at least 2 distinct points")
-    mirror = _turns_clockwise(pts)
+    mirror = turns_clockwise_of(pts)
     flip = np.stack([np.where(mirror, -1.0, 1.0), np.ones(len(pts))], axis=-1)  # (k, 2)
-    centroid = _arc_centroid(pts)  # (k, 2): a wire's centroid moves with every linear map of it
-    heading = _chord_heading(pts * flip[:, None, :], centroid * flip)
+    centroid = arc_centroids(pts)  # (k, 2): a wire's centroid moves with every linear map of it
+    heading = chord_headings(pts * flip[:, None, :], centroid * flip)
     target = POSE_CHORDS[0]
     turn = np.angle(np.exp(1j * (target - heading)))
     drawn = _linear(turn, mirror)  # (k, 2, 2)
@@ -221,9 +218,9 @@ def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[F
     """Pose frames of curves of one length (k, n, 2); see frame.pose_frames and frame.pose_candidates."""
     if not (np.ptp(pts, axis=1).max(axis=1) > 0).all():
         raise ValueError("all points coincide: a curve needs at least 2 distinct points")
-    mirror = _turns_clockwise(pts)
+    mirror = turns_clockwise_of(pts)
     flip = np.stack([np.where(mirror, -1.0, 1.0), np.ones(len(pts))], axis=-1)  # (k, 2)
-    heading = _chord_heading(pts * flip[:, None, :], _arc_centroid(pts) * flip)
+    heading = chord_headings(pts * flip[:, None, :], arc_centroids(pts) * flip)
     poses: list[tuple[np.ndarray, np.ndarray, bool]] = []  # (rotation (k,), mirror (k,), reverse), in pose order
     for target in POSE_CHORDS[:chords]:
         turn = np.angle(np.exp(1j * (target - heading)))
@@ -263,14 +260,15 @@ def _box(pts: np.ndarray, linear: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (linear @ ((lo + hi) / 2)[..., None])[..., 0], (hi - lo).max(axis=1)
 
 
-def _turns_clockwise(pts: np.ndarray) -> np.ndarray:
-    """frame.turns_clockwise of each curve (k, n, 2) -> (k,): by the signed turning, or the signed area where that
-    is zero to rounding."""
+def signed_turnings(pts: np.ndarray) -> np.ndarray:
+    """Total signed turning of each polyline (k, n, 2) -> (k,), radians: positive where it turns counter-clockwise
+    overall. A segment of zero length is skipped (the turn between the moving segments on either side of it counts
+    once); a polyline with fewer than two moving segments turns 0."""
     d = np.diff(pts, axis=1)  # (k, n - 1, 2)
     moving = (d != 0).any(axis=2)
     if not moving.all():
-        # a segment of zero length is skipped: each takes the last moving segment before it (or the first after
-        # it), so the turn between the moving segments on either side is counted once and the repeats add nothing
+        # each zero-length segment takes the last moving segment before it (or the first after it), so the repeats
+        # add nothing
         j = np.arange(d.shape[1])
         last = np.maximum.accumulate(np.where(moving, j, -1), axis=1)
         first = np.argmax(moving, axis=1)
@@ -278,7 +276,14 @@ def _turns_clockwise(pts: np.ndarray) -> np.ndarray:
     cross = d[:, :-1, 0] * d[:, 1:, 1] - d[:, :-1, 1] * d[:, 1:, 0]
     dot = d[:, :-1, 0] * d[:, 1:, 0] + d[:, :-1, 1] * d[:, 1:, 1]
     turning = np.arctan2(cross, dot).sum(axis=1)
-    turning = np.where(moving.sum(axis=1) >= 2, turning, 0.0)
+    return np.where(moving.sum(axis=1) >= 2, turning, 0.0)
+
+
+def turns_clockwise_of(pts: np.ndarray) -> np.ndarray:
+    """Whether each curve (k, n, 2) turns clockwise overall (k,), the side a posed curve is mirrored from: by its
+    signed turning, or where that is zero to rounding (straight lines, S-bends) by the signed area it encloses with
+    its chord. Both change sign with the point order and with a mirror image, and neither with a turn."""
+    turning = signed_turnings(pts)
     clockwise = turning < 0
     level = np.abs(turning) <= 1e-9
     if level.any():  # straight lines, S-bends: the signed area the curve encloses with its chord
@@ -287,8 +292,9 @@ def _turns_clockwise(pts: np.ndarray) -> np.ndarray:
     return clockwise
 
 
-def _arc_centroid(pts: np.ndarray) -> np.ndarray:
-    """frame.arc_centroid of each curve (k, n, 2) -> (k, 2)."""
+def arc_centroids(pts: np.ndarray) -> np.ndarray:
+    """Centre of mass of each polyline (k, n, 2) -> (k, 2) as a wire: its segments' midpoints weighted by their
+    lengths, so it does not depend on how the points are spaced along it (the points' mean where it has no length)."""
     seg = np.linalg.norm(np.diff(pts, axis=1), axis=2)
     total = seg.sum(axis=1)
     mid = (pts[:, 1:] + pts[:, :-1]) / 2
@@ -296,12 +302,15 @@ def _arc_centroid(pts: np.ndarray) -> np.ndarray:
     return np.where((total > 0)[:, None], wire, pts.mean(axis=1))
 
 
-def _chord_heading(pts: np.ndarray, centroid: np.ndarray | None = None) -> np.ndarray:
-    """frame.chord_heading of each curve (k, n, 2) -> (k,); `centroid`: their arc centroids, where known."""
+def chord_headings(pts: np.ndarray, centroid: np.ndarray | None = None) -> np.ndarray:
+    """Direction (radians) of each curve's chord (k, n, 2) -> (k,), first point -> last. For a closed or nearly closed
+    loop (an airfoil: a chord shorter than CLOSED of the curve's extent) the direction its opening would have: a
+    counter-clockwise loop that starts on its right has its chord pointing down, as the paper's curves do.
+    `centroid`: their arc centroids, where known."""
     chord = pts[:, -1] - pts[:, 0]
-    centroid = _arc_centroid(pts) if centroid is None else centroid
-    reach = 2 * np.linalg.norm(pts - centroid[:, None], axis=2).max(axis=1)
-    out = (pts[:, 0] + pts[:, -1]) / 2 - centroid
+    centroid = arc_centroids(pts) if centroid is None else centroid
+    reach = 2 * np.linalg.norm(pts - centroid[:, None], axis=2).max(axis=1)  # the extent, however it is turned
+    out = (pts[:, 0] + pts[:, -1]) / 2 - centroid  # alike for the loop listed either way, at any spacing
     return np.where(
         np.hypot(chord[:, 0], chord[:, 1]) >= CLOSED * reach,
         np.arctan2(chord[:, 1], chord[:, 0]),
@@ -332,13 +341,13 @@ def shared_pose_frames(curves: Sequence[np.ndarray], *, chords: int = 3, flips: 
             raise ValueError("all points coincide: a curve needs at least 2 distinct points")
     against = _against_first(pts)
     aligned = [c[::-1] if a else c for c, a in zip(pts, against)]
-    turning = sum(signed_turning(c) for c in aligned)
+    turning = float(sum(signed_turnings(c[None])[0] for c in aligned))
     if abs(turning) > 1e-9:
         mirror = turning < 0
     else:
-        mirror = sum(float(turns_clockwise(c)) - 0.5 for c in aligned) > 0
+        mirror = sum(float(turns_clockwise_of(c[None])[0]) - 0.5 for c in aligned) > 0
     flip = np.array([-1.0, 1.0]) if mirror else np.ones(2)
-    headings = np.array([chord_heading(c * flip) for c in aligned])
+    headings = np.array([chord_headings((c * flip)[None])[0] for c in aligned])
     heading = float(np.arctan2(np.sin(headings).sum(), np.cos(headings).sum()))
     poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
     return [
@@ -381,6 +390,6 @@ def shared_canonical_frames(curves: Sequence[np.ndarray]) -> list[Frame]:
     total = 0.0
     for c, (drawn, _) in zip(curves, candidates):
         posed = np.asarray(c, np.float64) @ drawn._linear()
-        centroid = _arc_centroid(posed[None])[0]
+        centroid = arc_centroids(posed[None])[0]
         total += ((posed[0, 1] + posed[-1, 1]) / 2 - centroid[1]) / drawn.size
     return [drawn if total >= 0 else flipped for drawn, flipped in candidates]

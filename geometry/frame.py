@@ -113,64 +113,46 @@ CLOSED = 0.05
 
 
 def signed_turning(points: np.ndarray) -> float:
-    """Total signed turning of a polyline (n, 2), radians: positive when it turns counter-clockwise overall."""
-    d = np.diff(np.asarray(points, np.float64), axis=0)
-    d = d[np.linalg.norm(d, axis=1) > 0]
-    if len(d) < 2:
-        return 0.0
-    cross = d[:-1, 0] * d[1:, 1] - d[:-1, 1] * d[1:, 0]
-    dot = (d[:-1] * d[1:]).sum(axis=1)
-    return float(np.arctan2(cross, dot).sum())
+    """Total signed turning of a polyline (n, 2), radians: a batch of one of geometry.batch.signed_turnings."""
+    from curve_vae.geometry.batch import signed_turnings  # batch builds on this module
+
+    return float(signed_turnings(np.asarray(points, np.float64)[None])[0])
 
 
 def turns_clockwise(points: np.ndarray) -> bool:
-    """Whether a curve turns clockwise overall, the side a posed curve is mirrored from: by its signed turning, or
-    where that is zero to rounding (straight lines, S-bends) by the signed area it encloses with its chord. Both
-    change sign with the point order and with a mirror image, and neither with a turn."""
-    turning = signed_turning(points)
-    if abs(turning) > 1e-9:
-        return turning < 0
-    x, y = np.asarray(points, np.float64).T
-    return float((x * np.roll(y, -1) - np.roll(x, -1) * y).sum()) < 0
+    """Whether a curve turns clockwise overall: a batch of one of geometry.batch.turns_clockwise_of."""
+    from curve_vae.geometry.batch import turns_clockwise_of
+
+    return bool(turns_clockwise_of(np.asarray(points, np.float64)[None])[0])
 
 
 def chord_heading(points: np.ndarray) -> float:
-    """Direction (radians) of a curve's chord, first point -> last. For a closed or nearly closed loop (an airfoil)
-    the direction its opening would have: a counter-clockwise loop that starts on its right has its chord pointing
-    down, as the paper's curves do."""
-    pts = np.asarray(points, np.float64)
-    chord = pts[-1] - pts[0]
-    reach = 2 * np.linalg.norm(pts - arc_centroid(pts), axis=1).max()  # the curve's extent, however it is turned
-    if np.hypot(*chord) >= CLOSED * reach:
-        return float(np.arctan2(chord[1], chord[0]))
-    out = (pts[0] + pts[-1]) / 2 - arc_centroid(pts)  # alike for the loop listed either way, at any spacing
-    return float(np.arctan2(out[1], out[0])) - np.pi / 2
+    """Direction (radians) of a curve's chord, or a loop's opening: a batch of one of geometry.batch.chord_headings."""
+    from curve_vae.geometry.batch import chord_headings
+
+    return float(chord_headings(np.asarray(points, np.float64)[None])[0])
 
 
 def arc_centroid(points: np.ndarray) -> np.ndarray:
-    """Centre of mass (2,) of a polyline (n, 2) as a wire: its segments' midpoints weighted by their lengths, so it
-    does not depend on how the points are spaced along it."""
-    pts = np.asarray(points, np.float64)
-    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    if not seg.sum() > 0:
-        return pts.mean(axis=0)
-    return (((pts[1:] + pts[:-1]) / 2) * seg[:, None]).sum(axis=0) / seg.sum()
+    """Centre of mass (2,) of a polyline as a wire: a batch of one of geometry.batch.arc_centroids."""
+    from curve_vae.geometry.batch import arc_centroids
+
+    return arc_centroids(np.asarray(points, np.float64)[None])[0]
 
 
 def pose_frames(points: np.ndarray, *, chords: int = 3, flips: bool = True) -> list[Frame]:
-    """Candidate frames that bring a curve into the model's pose, best guess first.
+    """Candidate frames that bring a curve into the model's pose, best guess first: a batch of one of
+    geometry.batch.pose_frames_of.
 
     Each mirrors a clockwise curve, then turns its chord to one of the first `chords` of
     `POSE_CHORDS`. With `flips`, each also comes reversed and mirrored across its chord's
     normal: the same two moves leave chord and turning as they were, so only with both
     does a curve and its reversal, mirror image or rotation get the same set of candidates.
+    Raises ValueError where all points coincide.
     """
-    fit_frame(points)  # raises ValueError when all points coincide
-    pts = np.asarray(points, np.float64)
-    mirror = turns_clockwise(pts)
-    heading = chord_heading(pts * ([-1.0, 1.0] if mirror else 1.0))
-    poses = pose_candidates(heading, mirror, chords=chords, flips=flips)
-    return [posed_frame(pts, turn, mirror=mir, reverse=rev) for turn, mir, rev in poses]
+    from curve_vae.geometry.batch import pose_frames_of
+
+    return pose_frames_of([np.asarray(points, np.float64)], chords=chords, flips=flips)[0]
 
 
 def pose_candidates(
