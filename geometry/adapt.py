@@ -19,6 +19,9 @@ Pure numpy: the service's runtime (inference/runtime.py) calls these around its 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 
 from curve_vae.errors import InvalidInput
@@ -42,11 +45,22 @@ def is_closed(points: np.ndarray) -> bool:
     return bool(np.abs(pts[-1] - pts[0]).max() <= 1e-9 * np.ptp(pts, axis=0).max())
 
 
+#: What a curve whose points all coincide is told, wherever curves are read (the request schema, a .npy body, the
+#: reader): `COINCIDENT.format(n=points)`.
+COINCIDENT = "all {n} points coincide: a curve needs at least 2 distinct points"
+
+
+def coincident(curves: Sequence[Any]) -> np.ndarray:
+    """(B,) whether each curve's points (n_i, 2) all coincide: no curve to read."""
+    return np.array([bool((np.asarray(c) == np.asarray(c)[:1]).all()) for c in curves], bool)
+
+
 def joined_ends(points: np.ndarray) -> np.ndarray:
-    """A copy of (n, 2) points or control points whose first and last rows are both their mean: the reconstruction
-    of a closed curve closed again (for a clamped B-spline, its end control points are its end points)."""
+    """A copy of points or control points, (n, 2) or a batch (..., n, 2), whose first and last rows are both their
+    mean: the reconstruction of a closed curve closed again (for a clamped B-spline, its end control points are its
+    end points)."""
     out = np.array(points, np.float64)
-    out[0] = out[-1] = (out[0] + out[-1]) / 2
+    out[..., 0, :] = out[..., -1, :] = (out[..., 0, :] + out[..., -1, :]) / 2
     return out
 
 

@@ -82,7 +82,7 @@ def _ends_kept(
         if shares is not None:
             ctrl += shares
     if closed:
-        ctrl = np.stack([joined_ends(c) for c in ctrl])
+        ctrl = joined_ends(ctrl)
     if not prep.ends_kept:
         return ctrl
     return pinned_mixes(ctrl, prep.inputs, prep.frames, w, frames, model_size=g.model_size, degree=g.spline_degree)

@@ -67,7 +67,7 @@ def placed_to_caller(g: ModelGraphs, prep: Prepared) -> tuple[list[np.ndarray], 
     closed = np.abs(pts[ends] - pts[starts]).max(axis=1) <= 1e-9 * extent  # geometry.adapt.is_closed, per curve
     # every row has its frame, control points and feet (checked above): the `is not None`s only narrow the types
     ctrl = np.stack([r.ctrl for r in rows if r.ctrl is not None]).astype(np.float64)
-    ctrl[closed, 0] = ctrl[closed, -1] = (ctrl[closed, 0] + ctrl[closed, -1]) / 2  # joined: a loop comes back a loop
+    ctrl[closed] = joined_ends(ctrl[closed])  # a loop comes back a loop
     frames = FrameRows.of([r.frame for r in rows if r.frame is not None])
     feet = np.concatenate([r.feet for r in rows if r.feet is not None])
     model = spline_values(ctrl, feet, curves.owner, degree=g.spline_degree)[0]

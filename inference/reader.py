@@ -27,6 +27,7 @@ from curve_vae.geometry import (
     ordered_closest_params,
     pose_frames,
 )
+from curve_vae.geometry.adapt import COINCIDENT, coincident
 from curve_vae.geometry.batch import (
     FrameRows,
     Ragged,
@@ -237,7 +238,7 @@ class Reader:
                     else:
                         spaced = [(reading.spacing, None)]
                 except ValueError as e:  # all points coincide
-                    raise InputError(("curves", i), str(e)) from e
+                    raise InputError(("curves", i), COINCIDENT.format(n=len(pts))) from e
                 stage += [Candidate(c, f, s, n, p) for p, f in enumerate(frames) for s, n in spaced]
         return stage
 
@@ -264,12 +265,10 @@ class Reader:
             try:
                 out += natural_readings_of(part, **fit)
             except ValueError:  # all points of one coincide: name it
-                for k, pts in enumerate(part):
-                    if not np.ptp(pts, axis=0).max() > 0:
-                        raise InputError(
-                            ("curves", index[start + k]),
-                            "all points coincide: a curve needs at least 2 distinct points",
-                        ) from None
+                bad = coincident(part)
+                if bad.any():
+                    k = int(np.argmax(bad))
+                    raise InputError(("curves", index[start + k]), COINCIDENT.format(n=len(part[k]))) from None
                 raise
         return out
 

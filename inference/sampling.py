@@ -139,10 +139,8 @@ class Sampler:
         if not closed:
             return out
         if ctrl is None:
-            return np.stack([joined_ends(c) for c in out])
-        joined = np.array(ctrl, np.float64)
-        joined[:, 0] = joined[:, -1] = (joined[:, 0] + joined[:, -1]) / 2
-        return sample_bspline(joined, out.shape[1], self.graphs.spline_degree)
+            return joined_ends(out)
+        return sample_bspline(joined_ends(ctrl), out.shape[1], self.graphs.spline_degree)
 
     def plausible(self, curves: np.ndarray) -> np.ndarray:
         """(B, n, 2) model-plane curves -> (B,) bool: finite, free of self-intersections and inside the disc."""

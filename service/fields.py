@@ -9,6 +9,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validat
 from pydantic_core import PydanticCustomError
 
 from curve_vae.geometry import Frame
+from curve_vae.geometry.adapt import COINCIDENT, coincident
 from curve_vae.inference import choices
 from curve_vae.inference.reading import ReadingOption
 
@@ -18,11 +19,8 @@ Point = Annotated[tuple[FiniteFloat, FiniteFloat], Field(description="[x, y]")]
 
 
 def _distinct(curve: list[tuple[float, float]]) -> list[tuple[float, float]]:
-    first = curve[0]
-    if all(p == first for p in curve):
-        raise PydanticCustomError(
-            "distinct_points", "all {n} points coincide: a curve needs at least 2 distinct points", {"n": len(curve)}
-        )
+    if coincident([curve])[0]:
+        raise PydanticCustomError("distinct_points", COINCIDENT, {"n": len(curve)})
     return curve
 
 

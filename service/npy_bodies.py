@@ -22,6 +22,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import Response
 from pydantic import BaseModel, ValidationError
 
+from curve_vae.geometry.adapt import COINCIDENT, coincident
 from curve_vae.inference.errors import InputError
 from curve_vae.service import limits
 from curve_vae.service.deps import warmed
@@ -114,8 +115,7 @@ def read_curves(body: bytes, model: str, settings: Settings) -> list[np.ndarray]
     if not finite.all():
         i, j, k = np.argwhere(~finite)[0]
         raise InputError(("curves", int(i), int(j), int(k)), "not a finite number")
-    coincide = (a == a[:, :1]).all(axis=(1, 2))
+    coincide = coincident(list(a))
     if coincide.any():
-        i = int(np.argmax(coincide))
-        raise InputError(("curves", i), f"all {points} points coincide: a curve needs at least 2 distinct points")
+        raise InputError(("curves", int(np.argmax(coincide))), COINCIDENT.format(n=points))
     return list(a)

@@ -299,7 +299,7 @@ READINGS = {
 @pytest.mark.parametrize("reading", READINGS.values(), ids=READINGS.keys())
 def test_a_curve_whose_points_coincide_is_named_in_every_reading(runtime, reading):
     good = list(bspline_curves(2, 60, seed=50))
-    with pytest.raises(InputError, match=r"^curves\[2\]: all points coincide") as caught:
+    with pytest.raises(InputError, match=r"^curves\[2\]: all 60 points coincide: a curve needs at least 2") as caught:
         runtime.reconstruct([*good, np.full((60, 2), 7.0)], reading)
     assert caught.value.loc == ("curves", 2)
 
