@@ -20,6 +20,13 @@ from curve_vae.service.deps import (
 ops_router = APIRouter(tags=["operations"])
 
 
+#: What /health and /ready say while the model warms up.
+WARMING_UP = (
+    "warming up: the reading's compiled kernels load from numba's cache, or compile into it on a first start "
+    "(15-30 s); requests sent now wait for it"
+)
+
+
 @ops_router.get(
     "/health",
     response_model=r.StatusResponse,
@@ -29,19 +36,15 @@ ops_router = APIRouter(tags=["operations"])
     openapi_extra=curl_sample("/health"),
 )
 async def health(request: Request) -> Any:
-    """200 while the process serves requests, warming up or ready; 503 where the model's warm-up failed (the
-    process cannot serve it: restart it)."""
-    failed = request.app.state.failed
-    if failed:
-        return JSONResponse({"status": "failed", "detail": f"the model cannot serve: {failed}"}, status_code=503)
+    """200 while the process serves requests: "ok", or "warming up" while the model warms up (a page asks here, where
+    a 200 logs nothing in a browser's console); 503 where the model's warm-up failed (the process cannot serve it:
+    restart it)."""
+    state = request.app.state
+    if state.failed:
+        return JSONResponse({"status": "failed", "detail": f"the model cannot serve: {state.failed}"}, status_code=503)
+    if state.warming is not None and not state.warming.done():
+        return {"status": "warming up", "detail": WARMING_UP}
     return {"status": "ok"}
-
-
-#: What /ready says while the model warms up.
-WARMING_UP = (
-    "warming up: the reading's compiled kernels load from numba's cache, or compile into it on a first start "
-    "(15-30 s); requests sent now wait for it"
-)
 
 
 @ops_router.get(

@@ -65,15 +65,16 @@ function showCurl() {
   $("curl").textContent = `curl -s ${origin}${r.path} -H 'Content-Type: application/json' \\\n  -d '${JSON.stringify(r.body)}'`;
 }
 
-// Whether the service is warming up (its first start compiles the reading's kernels): said above the board until
-// GET /ready answers 200; the page can be drawn on meanwhile, and its requests are answered once it is ready.
+// Whether the service is warming up (its first start compiles the reading's kernels): said above the board while
+// GET /health says so (a 200, which no browser logs as an error); the page can be drawn on meanwhile, and its
+// requests are answered once it is ready.
 async function watchReady() {
   for (;;) {
     let r;
-    try { r = await fetch(API + "/ready", { headers: keyHeader() }); } catch (e) { return; }
+    try { r = await fetch(API + "/health", { headers: keyHeader() }); } catch (e) { return; }
     let body = {};
     try { body = await r.json(); } catch (e) { /* not JSON */ }
-    state.warming = r.status === 503 && body.status === "warming up";
+    state.warming = body.status === "warming up";
     $("status").hidden = !state.warming;
     if (!state.warming) return;
     $("status").textContent = "The service is warming up: it compiles the reading's kernels on its first start " +

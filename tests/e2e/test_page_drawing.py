@@ -165,14 +165,13 @@ def test_a_crossing_in_between_is_marked_and_taken_only_when_asked_again(browser
 
 def test_a_service_warming_up_is_said_so_until_it_is_ready(browser, server):  # noqa: F811
     page = browser.new_context().new_page()
-    answers = iter([503, 503])
+    answers = iter(["warming", "warming"])
 
-    def warming(route):
-        status = next(answers, 200)
-        body = {"status": "warming up", "detail": "compiling"} if status == 503 else {"status": "ready"}
-        route.fulfill(status=status, json=body)
+    def warming(route):  # GET /health as a service warming up answers it, twice, then as a warm one
+        warm = next(answers, None) is None
+        route.fulfill(status=200, json={"status": "ok"} if warm else {"status": "warming up", "detail": "compiling"})
 
-    page.route("**/ready", warming)
+    page.route("**/health", warming)
     page.goto(server.url + "/")
     page.wait_for_function("!document.getElementById('status').hidden")
     assert "warming up" in page.locator("#status").inner_text()
