@@ -102,20 +102,26 @@ class LiveServer:
 
     def wait_ready(self, timeout: float = READY_TIMEOUT, *, listeners: int = 1) -> None:
         """Poll /ready until 200 and until `listeners` sockets listen on the port (each worker its own: a client
-        that connects before a worker listens stays with the others); RuntimeError (with the server's output) if it
-        exits, TimeoutError if it is slow."""
+        that connects before a worker listens stays with the others). Each worker warms up on its own, and a new
+        connection reaches any one of them: with several, 4 × `listeners` new connections in a row must each answer
+        200 (a worker still warming up is missed by all of them once in 2^8 starts, for two). RuntimeError (with the
+        server's output) if it exits, TimeoutError if it is slow."""
         deadline = time.monotonic() + timeout
+        in_a_row = 0
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
                 raise RuntimeError(f"server exited with {self.proc.returncode}: {' '.join(self.cmd)}\n{self.output()}")
             try:
                 with urllib.request.urlopen(f"{self.url}/ready", timeout=1) as r:
                     listening = listening_sockets(self.port)
-                    if r.status == 200 and (listening is None or listening >= listeners):
-                        return
+                    ready = r.status == 200 and (listening is None or listening >= listeners)
             except OSError:
-                pass
-            time.sleep(0.1)
+                ready = False
+            in_a_row = in_a_row + 1 if ready else 0
+            if in_a_row >= (1 if listeners <= 1 else 4 * listeners):
+                return
+            if not ready:
+                time.sleep(0.1)
         raise TimeoutError(f"{self.url} not ready after {timeout:g} s")
 
     def pids(self) -> list[int]:
