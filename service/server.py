@@ -14,8 +14,10 @@ import json
 import logging
 import os
 import shutil
+import signal
 import sys
 import tempfile
+import threading
 from collections.abc import Iterator
 from typing import Any, TypedDict
 
@@ -177,27 +179,35 @@ def where(host: str, port: int) -> str:
     return f"the page: {base}/ · the API docs: {base}/docs · metrics: {base}/metrics"
 
 
-def _graceful_server_class() -> type:
+def _server_class() -> type:
     import uvicorn
 
-    class GracefulServer(uvicorn.Server):
-        """uvicorn's server, but a stop by SIGTERM or SIGINT, once in-flight requests have finished, is a success
-        (exit 0): uvicorn would raise the signal again after shutting down, and exit -15 looks like a crash to an
-        orchestrator. Once it listens, it says where the page, the API docs and the metrics are."""
+    class Server(uvicorn.Server):
+        """uvicorn's server, which once it listens says where the page, the API docs and the metrics are."""
 
-        def _log_started_message(self, listeners: Any) -> None:
-            super()._log_started_message(listeners)
-            if listeners and self.config.uds is None and self.config.fd is None:
-                port = self.config.port or listeners[0].getsockname()[1]
+        async def startup(self, sockets: list[Any] | None = None) -> None:
+            await super().startup(sockets=sockets)
+            if self.started and self.servers and self.config.uds is None and self.config.fd is None:
+                port = self.config.port or self.servers[0].sockets[0].getsockname()[1]
                 logging.getLogger("uvicorn.error").info(where(self.config.host, port))
 
-        @contextlib.contextmanager
-        def capture_signals(self):
-            with super().capture_signals():
-                yield
-                self._captured_signals.clear()
+    return Server
 
-    return GracefulServer
+
+@contextlib.contextmanager
+def _stops_succeed() -> Iterator[None]:
+    """A stop by SIGTERM or SIGINT, once in-flight requests have finished, is a success (exit 0). uvicorn hands the
+    signal that stopped it, after shutting down, to the handler it found installed (Python's: exit -15 or
+    KeyboardInterrupt, which look like a crash to an orchestrator); this one lets it go."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    found = {sig: signal.signal(sig, lambda *_: None) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in found.items():
+            signal.signal(sig, handler)
 
 
 class _ServerOptions(TypedDict):
@@ -232,8 +242,7 @@ def _run_workers(settings: Settings, common: _ServerOptions) -> None:
             listeners.log.info(where(settings.host, settings.port))
             uvicorn.run(app, factory=True, workers=settings.workers, **common)
             return
-        # each worker's connections counted (service.balance), so that a crowded one asks a client to reconnect
-        config = uvicorn.Config(app, factory=True, workers=settings.workers, http=balance.PROTOCOL, **common)
+        config = uvicorn.Config(app, factory=True, workers=settings.workers, **common)
         try:
             listener = listeners.PerWorkerListener(settings.host, settings.port)
         except OSError as e:
@@ -278,8 +287,6 @@ def supervised_app() -> Any:
     worker when its supervisor is gone: a supervisor killed outright (SIGKILL, the OOM killer) cannot stop its
     workers, and they would go on holding the port, the model's memory and a share of the connections that no one
     restarts. The worker asks itself to stop (SIGTERM: requests in flight finish) once its parent is another."""
-    import signal
-    import threading
     import time
 
     from curve_vae.service import balance
@@ -366,8 +373,9 @@ def run(args: argparse.Namespace) -> int:
             from curve_vae.service.app import create_app
 
             config = uvicorn.Config(create_app(settings), **common)
-            server = _graceful_server_class()(config)
-            server.run()
+            server = _server_class()(config)
+            with _stops_succeed():
+                server.run()
             if not server.started:
                 return 3  # the app failed to start (uvicorn's own code for it)
         else:  # the workers rebuild the settings from the environment: the count they are, not 0

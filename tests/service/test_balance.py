@@ -6,9 +6,11 @@ from __future__ import annotations
 import http.client
 import os
 import re
+import socket
 import struct
 import subprocess
 import sys
+import time
 
 import pytest
 from starlette.applications import Starlette
@@ -17,7 +19,7 @@ from starlette.routing import Route
 from starlette.testclient import TestClient
 
 from curve_vae.service import balance
-from curve_vae.service.balance import REBALANCE_MARGIN, Peers, Rebalance
+from curve_vae.service.balance import REBALANCE_MARGIN, RECOUNT_S, Peers, Rebalance
 
 
 def _finished_pid() -> int:
@@ -124,6 +126,7 @@ def test_few_keep_alive_clients_end_up_shared_out_evenly(server_factory, model_d
     27% of the time; with the moves, every wave ends four and four (a client reconnects when it is told to)."""
     server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
     server.wait_ready(listeners=2)
+    time.sleep(2 * RECOUNT_S)  # wait_ready's connections, closed, leave the counts (and /metrics) within RECOUNT_S
     moved = 0
     for wave in range(2):
         conns = [http.client.HTTPConnection("127.0.0.1", server.port, timeout=30) for _ in range(8)]
@@ -151,8 +154,36 @@ def test_few_keep_alive_clients_end_up_shared_out_evenly(server_factory, model_d
         assert sorted(counts.values()) == [4.0, 4.0], (wave, counts)
         for c in conns:
             c.close()
+        time.sleep(2 * RECOUNT_S)  # a connection its client closed leaves the count within RECOUNT_S
     conns = [http.client.HTTPConnection("127.0.0.1", server.port, timeout=30)]
     conns[0].request("GET", "/metrics")
     total = re.search(r"^curve_vae_connections_moved_total ([\d.]+)$", conns[0].getresponse().read().decode(), re.M)
     assert total is not None and float(total.group(1)) == moved
     assert server.stop() == 0
+
+
+def test_a_worker_counts_the_connections_its_sockets_hold(tmp_path):
+    """balance.held reads the process's own accepted sockets on the port; Connections counts a client at its first
+    request, uncounts one asked to reconnect at once, and one whose connection is gone at the next recount."""
+    with socket.create_server(("127.0.0.1", 0)) as listening:
+        port = listening.getsockname()[1]
+        clients = [socket.create_connection(("127.0.0.1", port)) for _ in range(3)]
+        accepted = [listening.accept()[0] for _ in clients]
+        try:
+            assert balance.held(port) == {c.getsockname() for c in clients}
+            peers = Peers(tmp_path)
+            connections = balance.Connections(peers)
+            scopes = [{"client": c.getsockname(), "server": ("127.0.0.1", port)} for c in clients]
+            for scope in scopes + scopes:  # a second request on a connection counts it once
+                connections.seen(scope)
+            assert peers.mine == 3
+            connections.closing(scopes[0])
+            assert peers.mine == 2
+            connections.recount()  # still open: asked to leave, it is not counted again
+            assert peers.mine == 2
+            accepted[1].close()  # the server side of a connection its client closed
+            connections.recount()
+            assert peers.mine == 1 and connections.clients == {clients[2].getsockname()}
+        finally:
+            for s in clients + accepted:
+                s.close()
