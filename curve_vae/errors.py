@@ -6,7 +6,7 @@ still a `ValueError`), so code that caught those before still does.
     CurveVaeError
     ├── InvalidInput (ValueError)   inference.errors.InputError, geometry.adapt.BeyondFloat32, curvefiles CurveFileError
     ├── ModelError (RuntimeError)   inference.manifest.ModelLoadError
-    ├── CancelledWork               inference.cancel.Cancelled
+    ├── CancelledWork               inference.graphs.Cancelled
     ├── ProtocolError               service.oip.OipError
     └── ClientError (RuntimeError)  client.errors.ApiError, RetriesExhausted
 

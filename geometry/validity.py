@@ -74,7 +74,7 @@ def untangled(
     The spline at `params` is the answer (the caller's points placed on it). Each round frees the control points
     whose spans hold a crossing's segments, one span beyond on either side (a span wider each round), and solves
     for them by least squares against `target` with every other control point held. The two end control points (the
-    answer's ends, kept where its input's are: inference.ends) are held too, unless `free_ends` (the last resort:
+    answer's ends, kept where its input's are: inference.placing) are held too, unless `free_ends` (the last resort:
     a closed spline's two ends then move as one point). Returned unchanged (and True) when it does not cross."""
     c = np.array(ctrl, np.float64)
     u = np.clip(np.asarray(params, np.float64), 0.0, 1.0)

@@ -87,7 +87,7 @@ def augmented(
     g: ModelGraphs, plan: AugmentPlan, start: int, stop: int, *, n_points: int | None, spacing: str, length: int
 ) -> Augmented:
     """Items start … stop-1 of the plan's sequence, each a valid curve: a mix that crosses itself (after
-    inference.untangling) is drawn again from its item's own generator, up to MAX_REDRAWS draws; one still crossing
+    inference.placing) is drawn again from its item's own generator, up to MAX_REDRAWS draws; one still crossing
     then is returned and counted `invalid`."""
     sources, weights = plan.draw(start, stop)
     made = _mixed(g, plan, sources, weights, n_points=n_points, spacing=spacing, length=length)

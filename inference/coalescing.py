@@ -18,7 +18,7 @@ nothing is added to its latency — and under load the batches grow with the que
   sharing one core cost more than one of both (measured: single-curve requests on 16 connections, 132 requests/s
   with a batch per inference thread, 156 with one per worker; docs/BENCHMARKS.md).
 - A failing batch (a bad curve in one job) is run again job by job, so an error names its own request's curve.
-- A batch is cancelled only when every job in it is (each job's token, inference.cancel); a job abandoned before it
+- A batch is cancelled only when every job in it is (each job's token, inference.graphs); a job abandoned before it
   was taken is never read.
 - Answers equal the lone request's to rounding: onnxruntime may round a batch's rows differently, so where two
   candidate readings tie to float32 rounding either may be kept.
@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Generic, TypeAlias, TypeVar, cast
 
 import numpy as np
 
-from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable
+from curve_vae.inference.graphs import Cancelled, CancelToken, cancellable
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import Encoding, Reconstruction, split_encoding, split_reconstruction
 

@@ -1,5 +1,5 @@
 """Curves mixed from prepared curves' latents (paper eqs. 9, 10): the decoding of each weight row, brought to the
-caller's frame, carrying its ends' repairs and untangled where it crosses itself (inference.untangling)."""
+caller's frame, carrying its ends' repairs and untangled where it crosses itself (inference.placing)."""
 
 from __future__ import annotations
 
@@ -9,12 +9,18 @@ from curve_vae.geometry import Frame, blend_frames
 from curve_vae.geometry.adapt import is_closed, joined_ends, spline_params
 from curve_vae.geometry.bspline import spline_values
 from curve_vae.geometry.validity import crosses
-from curve_vae.inference.ends import pinned_mixes
 from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.placing import check_finite, check_range, joined, to_caller
+from curve_vae.inference.placing import (
+    check_finite,
+    check_range,
+    joined,
+    mixed_repairs,
+    pinned_mixes,
+    to_caller,
+    untangle_mixes,
+)
 from curve_vae.inference.prepared import Prepared
 from curve_vae.inference.results import Interpolation, head_splines
-from curve_vae.inference.untangling import mixed_repairs, untangle_mixes
 
 
 def mix(
@@ -75,7 +81,7 @@ def _ends_kept(
 ) -> np.ndarray:
     """The rows' control points (float64) carrying their ends' moves in proportion, onto their inputs' ends and out of
     crossings (a row [1, 0] is its first end's answer), joined where every input is closed, and moved onto the blend
-    of the inputs' matching ends (inference.ends)."""
+    of the inputs' matching ends (inference.placing)."""
     ctrl = ctrl.astype(np.float64)
     for what in ("pin", "repair"):
         shares = mixed_repairs(prep.rows, w, what=what)
@@ -99,7 +105,7 @@ def _valid_ctrl(
     spacing: str,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The rows' control points with those that cross untangled against the blend of their ends
-    (inference.untangling); and which rows carry a repair, their ends' or their own."""
+    (inference.placing); and which rows carry a repair, their ends' or their own."""
     shares = mixed_repairs(prep.rows, w)
     carried = np.zeros(len(w), bool) if shares is None else np.abs(shares).reshape(len(w), -1).max(axis=1) > 0
     if not len(w):

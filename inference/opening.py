@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.cache import EncodingCache
 from curve_vae.inference.choices import Placement, choices
 from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.manifest import Manifest, ModelLoadError
 from curve_vae.inference.named_priors import load_priors
+from curve_vae.inference.prepared import EncodingCache
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.sessions import SessionConfig

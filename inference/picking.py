@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from curve_vae.inference.candidates import Candidate
 from curve_vae.inference.ranker import Ranker
+from curve_vae.inference.reading import Candidate
 
 #: Candidates whose model-plane points all lie within this (plane units; the plane is 128 across) are one reading:
 #: a symmetric curve reversed and mirrored end for end is itself again.

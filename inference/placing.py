@@ -1,9 +1,13 @@
 """Model-plane results back to the caller: a decoded curve (and its B-spline) at the caller's points or at a count
-spaced as asked, through the caller's frame (geometry.adapt), checked for what float64 can hold."""
+spaced as asked, through the caller's frame (geometry.adapt), checked for what float64 can hold; its ends kept where
+its inputs' are, and untangled where it crosses itself and its input does not. Three sections: placing, ends,
+valid shapes."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 
@@ -11,9 +15,11 @@ from curve_vae.geometry import Frame, mse_per_curve, polyline_to_caller, spline_
 from curve_vae.geometry.adapt import F32_MAX, is_closed, joined_ends
 from curve_vae.geometry.batch import FrameRows, Ragged
 from curve_vae.geometry.bspline import spline_values
+from curve_vae.geometry.ends import pinned_ends
+from curve_vae.geometry.validity import crosses, new_crossings, untangled
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.prepared import Prepared
+from curve_vae.inference.prepared import Prepared, ReadCurve
 from curve_vae.inference.results import Curves, Spline, head_splines
 
 
@@ -172,3 +178,187 @@ def closed_rows(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, n
     rows = [joined(o, None if ctrl is None else ctrl[i]) for i, o in enumerate(out)]
     closed_out = np.stack([o for o, _ in rows]).astype(np.float32)
     return closed_out, None if ctrl is None else np.stack([c for _, c in rows if c is not None]).astype(np.float32)
+
+
+# Answers that keep their inputs' ends (geometry.ends): a reconstruction starts and ends where its input does, an
+# in-between at the weighted blend of its inputs' matching ends, so an end the inputs share is shared by every curve
+# between them; a closed input's answer closes at its input's closing point.
+#
+# Ends match as the set is read, in one pose: each input's end at the model's parameter 0 (its first point, or its last
+# where its pose reverses it) with the others' there. Blends are taken in the caller's plane, where the inputs are.
+#
+
+#: geometry.ends' reach per move for a reconstruction, whose end is a few thousandths of its size off: the end control
+#: point alone moves, which reads closest (the users' sets 0.95–1.00× of not moving it; 4: 0.97–1.02×, 8: 0.98–1.08×).
+READ_REACH = 1.0
+#: The same for an in-between (besides the share of its ends' own moves it carries), whose end may be a few hundredths
+#: off: a longer fade, so its end shifts rather than hooks (docs/figures/ends.png).
+MIX_REACH = 8.0
+
+
+def model_order_ends(inputs: Sequence[np.ndarray], frames: Sequence[Frame | None]) -> np.ndarray:
+    """(B, 2, 2) each input's two end points, in the caller's plane, in the model's order: the point at the model's
+    parameter 0 first."""
+    out = np.stack([np.stack([p[0], p[-1]]) for p in inputs]) if len(inputs) else np.zeros((0, 2, 2))
+    reverse = np.array([f is not None and f.reverse for f in frames], bool)
+    out[reverse] = out[reverse, ::-1]
+    return out
+
+
+def to_model_ends(ends: np.ndarray, frames: Sequence[Frame | None], model_size: float) -> np.ndarray:
+    """(B, 2, 2) model-order end points in the caller's plane -> the model plane, through each curve's frame (none:
+    already there)."""
+    out = np.array(ends, np.float64)
+    have = np.array([f is not None for f in frames], bool)
+    if have.any():
+        rows = FrameRows.of([f for f in frames if f is not None])
+        listed = out[have]  # in the order to_model_rows reverses back for a reversed frame
+        listed[rows.reverse] = listed[rows.reverse, ::-1]
+        out[have] = rows.to_model_rows(listed, model_size)
+    return out
+
+
+def pinned_rows(
+    inputs: Sequence[np.ndarray], rows: Sequence[ReadCurve], *, model_size: float, degree: int
+) -> list[ReadCurve]:
+    """Each decoded row with control points moved onto its input's ends (a closed input's: its closing point at both);
+    rows without control points as they are. Points placed on the spline are to be placed again (Reader)."""
+    out = list(rows)
+    have = [i for i, r in enumerate(rows) if r.ctrl is not None]
+    if not have:
+        return out
+    ends = to_model_ends(
+        model_order_ends([inputs[i] for i in have], [rows[i].frame for i in have]),
+        [rows[i].frame for i in have],
+        model_size,
+    )
+    for b, i in enumerate(have):
+        if is_closed(inputs[i]):
+            ends[b, 1] = ends[b, 0]
+    before = np.stack([np.asarray(rows[i].ctrl, np.float64) for i in have])
+    ctrl = pinned_ends(before, ends[:, 0], ends[:, 1], degree=degree, per_move=READ_REACH)
+    for b, i in enumerate(have):
+        out[i] = dataclasses.replace(rows[i], ctrl=ctrl[b], pin=ctrl[b] - before[b])
+    return out
+
+
+def pinned_mixes(
+    ctrl: np.ndarray,
+    inputs: Sequence[np.ndarray],
+    in_frames: Sequence[Frame | None],
+    weights: np.ndarray,
+    out_frames: Sequence[Frame | None],
+    *,
+    model_size: float,
+    degree: int,
+) -> np.ndarray:
+    """In-betweens' control points (rows, n_ctrl, 2), each moved onto the blend (its weight row) of the inputs'
+    matching ends, in the caller's plane, then into its own frame (already there for a row that carries its ends'
+    own moves in full: a row [1, 0] is its first end's answer)."""
+    # row by row, never a matrix product: BLAS sums in an order that depends on the number of rows, and a curve must
+    # not change with the batch or page it is made in
+    w = np.asarray(weights, np.float64)
+    ends = (w[:, :, None, None] * model_order_ends(inputs, in_frames)[None]).sum(axis=1)  # (rows, 2, 2)
+    model = to_model_ends(ends, out_frames, model_size)
+    return pinned_ends(ctrl, model[:, 0], model[:, 1], degree=degree, per_move=MIX_REACH)
+
+
+# Answers that are valid shapes: a reconstruction or an in-between that crosses itself where its input does not is
+# untangled (geometry.validity.untangled) before it is returned, and says so.
+#
+# A reconstruction placed on its spline (a B-spline head, closest placement or refine: the shipped model's) is the
+# spline at its points' parameters; where it crosses itself and its input does not, the control points around the
+# crossing are refitted to the input's own points. The change of control points is kept with the row
+# (`ReadCurve.repair`), so that curves mixed from it carry it in proportion: an in-between's control points get the
+# weighted sum of its ends' repairs, and a row [1, 0] is its first end's answer to the bit. An in-between that still
+# crosses is refitted the same way near its crossings, to the blend of its ends' answers at its points (what the
+# point-wise blend of two valid, similar shapes is: valid where they are alike).
+#
+
+
+class _Indexed(Protocol):
+    def __getitem__(self, k: int) -> np.ndarray: ...
+
+
+def untangle_rows(
+    inputs: Sequence[np.ndarray],
+    rows: Sequence[ReadCurve],
+    *,
+    model_size: float,
+    degree: int,
+    free_ends: bool = False,
+) -> tuple[list[ReadCurve], list[int]]:
+    """The rows whose answers (their splines at their points' parameters) cross themselves where the inputs do not,
+    untangled against the inputs' own points, their ends held (and, with `free_ends`, where that fails, free to
+    move: a valid answer before kept ends); the rest as they are; and which rows still cross after it. Rows without
+    a spline or placed points (a model without a B-spline head or closest placement) are returned as they are."""
+    out = list(rows)
+    tangled: list[int] = []
+    placed = [i for i, r in enumerate(rows) if r.ctrl is not None and r.feet is not None]
+    if not placed:
+        return out, tangled
+    ctrl = [_closed_ctrl(inputs[i], rows[i]) for i in placed]
+    feet = [np.asarray(rows[i].feet, np.float64) for i in placed]
+    lengths = np.array([len(f) for f in feet])
+    owner = np.repeat(np.arange(len(placed)), lengths)
+    answers = np.split(
+        spline_values(np.stack(ctrl), np.concatenate(feet), owner, degree=degree)[0], np.cumsum(lengths)[:-1]
+    )
+    bad = np.flatnonzero(new_crossings([inputs[i] for i in placed], answers))
+    for j in bad:
+        i = placed[j]
+        row = rows[i]
+        target = row.frame.to_model(inputs[i], model_size) if row.frame is not None else np.asarray(inputs[i])
+        closed = is_closed(inputs[i])
+        fixed = ctrl[j]
+        # the ends held (kept where the input's are), then, as the last resort, free to move: a valid answer first
+        for ends in (False, True) if free_ends else (False,):
+            fixed, _ = untangled(ctrl[j], feet[j], target, degree=degree, free_ends=ends, closed=closed)
+            answer = spline_values(fixed, feet[j], degree=degree)[0]
+            # checked as the answer is (geometry.validity.new_crossings), not only as the fit saw it
+            if not new_crossings([inputs[i]], [answer])[0]:
+                break
+        else:
+            tangled.append(i)
+        out[i] = dataclasses.replace(row, ctrl=fixed, repair=fixed - ctrl[j])  # float64: the fit's own digits
+    return out, tangled
+
+
+def _closed_ctrl(points: np.ndarray, row: ReadCurve) -> np.ndarray:
+    """The row's control points (float64) as its answer draws them: joined for a closed input."""
+    c = np.asarray(row.ctrl, np.float64)
+    return joined_ends(c) if is_closed(points) else c
+
+
+def mixed_repairs(rows: Sequence[ReadCurve], weights: np.ndarray, *, what: str = "repair") -> np.ndarray | None:
+    """Each weight row's share of the rows' repairs (or of another move of their control points, `what`: "pin"),
+    (len(weights), n_ctrl, 2); None where no row has one."""
+    repairs = [getattr(r, what) for r in rows]
+    if all(r is None for r in repairs):
+        return None
+    like = next(r for r in repairs if r is not None)
+    stacked = np.stack([np.zeros_like(like) if r is None else r for r in repairs])  # (inputs, n_ctrl, 2)
+    return np.stack([(w[:, None, None] * stacked).sum(axis=0) for w in np.asarray(weights, np.float64)])
+
+
+def untangle_mixes(
+    ctrl: np.ndarray, params: Sequence[np.ndarray], targets: _Indexed, *, degree: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """In-betweens (rows, n_ctrl, 2) whose splines at their `params` (n_k,) cross themselves, untangled against
+    `targets[k]` (n_k, 2), the blend of their ends at those points (asked for only for the rows that cross): the
+    control points, and which rows were repaired.
+    A row whose target crosses itself too is left as it is (its ends cannot be joined there by a valid blend)."""
+    c = np.array(ctrl, np.float64)
+    lengths = np.array([len(u) for u in params])
+    owner = np.repeat(np.arange(len(c)), lengths)
+    flat = spline_values(c, np.concatenate(params), owner, degree=degree)[0] if len(c) else np.zeros((0, 2))
+    points = np.split(flat, np.cumsum(lengths)[:-1])
+    bad = crosses(points)
+    repaired = np.zeros(len(c), bool)
+    if bad.any():
+        rows = np.flatnonzero(bad)
+        aims = {int(k): targets[int(k)] for k in rows}
+        for k in (int(k) for k in rows[~crosses(list(aims.values()))]):
+            c[k], _ = untangled(c[k], params[k], aims[k], degree=degree)
+            repaired[k] = True
+    return c, repaired

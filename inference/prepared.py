@@ -1,9 +1,13 @@
 """A caller's curve as the model read it (`ReadCurve`: its frame, the model-plane points the encoder saw, its latent,
 the decoded spline and where the caller's points sit on it), and a batch of them (`Prepared`). The encoding cache
-keeps ReadCurves; the runtime fills in what a call needs (the decoding, the placement) and maps results back."""
+keeps ReadCurves (`EncodingCache`, below); the runtime fills in what a call needs (the decoding, the placement) and
+maps results back."""
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any, ClassVar
@@ -27,7 +31,7 @@ class ReadCurve:
     params: np.ndarray | None = None  # (n_points,) its points' spline parameters, with a head that learns them
     feet: np.ndarray | None = None  # with closest placement or refine: each caller point's spline parameter
     repair: np.ndarray | None = None  # (n_ctrl, 2) float64: how `ctrl` was moved to uncross the answer (untangling)
-    pin: np.ndarray | None = None  # (n_ctrl, 2) float64: how `ctrl` was moved onto the input's ends (inference.ends)
+    pin: np.ndarray | None = None  # (n_ctrl, 2) float64: how `ctrl` was moved onto the input's ends (inference.placing)
     distance: float | None = None  # the decoding's squared distance from the input in the model plane (Reader._decoded)
 
     ARRAYS: ClassVar[tuple[str, ...]] = (
@@ -78,7 +82,7 @@ class Prepared:
 
     inputs: list[np.ndarray]  # the caller's curves, float64
     rows: list[ReadCurve]
-    ends_kept: bool = True  # answers start and end where their inputs do; so do curves mixed of them (inference.ends)
+    ends_kept: bool = True  # answers start and end where their inputs do; so do curves mixed of them (inference.placing)
 
     @property
     def frames(self) -> list[Frame | None]:
@@ -108,3 +112,77 @@ class Prepared:
 
 def _stack(parts: Sequence[np.ndarray]) -> np.ndarray:
     return np.stack(parts) if parts else np.zeros((0, 0), np.float32)
+
+
+# The encoding cache: a curve read once is not read again. The page re-posts its two or three curves at every
+# slider move, an augmentation pipeline its seed curves with every page, a client its batch after a dropped
+# connection; each finds its curves here — frame, latent, decoding and placement — and skips the encoder.
+#
+# Keyed by the curve's exact bytes (float64 points) and the reading (frame, pose, spacing, refine, placement): the
+# same points read the same way give the same ReadCurve, so a hit returns exactly what a miss would compute. Bounded
+# by the bytes of what it holds (least recently used out first) and safe to share between inference threads.
+#
+
+#: The default bound: about 20,000 curves of 161 points with their decodings.
+DEFAULT_CACHE_BYTES = 64 << 20
+
+
+class EncodingCache:
+    """ReadCurves by (curve bytes, reading), least recently used evicted beyond `max_bytes` (0: keeps nothing)."""
+
+    def __init__(self, max_bytes: int = DEFAULT_CACHE_BYTES) -> None:
+        self.max_bytes = max_bytes
+        self._rows: OrderedDict[bytes, ReadCurve] = OrderedDict()
+        self._bytes = 0
+        self._lock = threading.Lock()
+        self.hits = 0
+        self.misses = 0
+
+    @staticmethod
+    def key(points: np.ndarray, reading: str) -> bytes:
+        pts = np.ascontiguousarray(points, np.float64)
+        h = hashlib.blake2b(pts.tobytes(), digest_size=20)
+        h.update(f"{pts.shape}|{reading}".encode())
+        return h.digest()
+
+    def get(self, key: bytes) -> ReadCurve | None:
+        with self._lock:
+            row = self._rows.get(key)
+            if row is None:
+                self.misses += 1
+                return None
+            self._rows.move_to_end(key)
+            self.hits += 1
+            return row
+
+    def put(self, key: bytes, row: ReadCurve) -> None:
+        size = row.nbytes()
+        if size > self.max_bytes:
+            return
+        row = row.owned()  # not a view into the request's batch arrays, which would stay alive with it
+        with self._lock:
+            old = self._rows.pop(key, None)
+            if old is not None:
+                self._bytes -= old.nbytes()
+            self._rows[key] = row
+            self._bytes += size
+            while self._bytes > self.max_bytes:
+                _, evicted = self._rows.popitem(last=False)
+                self._bytes -= evicted.nbytes()
+
+    def clear(self) -> None:
+        with self._lock:
+            self._rows.clear()
+            self._bytes = 0
+
+    @property
+    def size(self) -> int:
+        """Bytes held."""
+        return self._bytes
+
+    def __len__(self) -> int:
+        return len(self._rows)
+
+    def stats(self) -> dict[str, int]:
+        return {"entries": len(self), "bytes": self._bytes, "max_bytes": self.max_bytes, "hits": self.hits,
+                "misses": self.misses}  # fmt: skip

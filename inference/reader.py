@@ -37,19 +37,15 @@ from curve_vae.geometry.batch import (
     shared_pose_frames,
 )
 from curve_vae.inference import picking
-from curve_vae.inference.cache import EncodingCache
-from curve_vae.inference.cancel import checkpoint
-from curve_vae.inference.candidates import Candidate, model_points
-from curve_vae.inference.ends import pinned_rows
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
-from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.graphs import ModelGraphs, checkpoint
 from curve_vae.inference.looking import look_again
-from curve_vae.inference.prepared import Prepared, ReadCurve
+from curve_vae.inference.placing import pinned_rows, untangle_rows
+from curve_vae.inference.prepared import EncodingCache, Prepared, ReadCurve
 from curve_vae.inference.ranker import RANKED_READS, Ranker
-from curve_vae.inference.reading import Reading
+from curve_vae.inference.reading import Candidate, Reading, model_points
 from curve_vae.inference.spacer import Spacer
-from curve_vae.inference.untangling import untangle_rows
 
 #: A natural reading whose parameters are all within this of the points' index fractions reads the curve as given:
 #: spacing "search" does not try it beside "parameter".
@@ -97,7 +93,7 @@ class Reader:
         self.fitter = fitter
         self.cache = cache
         self.untangle = True  # answers that cross themselves where their inputs do not are untangled (untangling)
-        self.keep_ends = True  # answers start and end where their inputs do (inference.ends)
+        self.keep_ends = True  # answers start and end where their inputs do (inference.placing)
         #: pose "learned": how many of each curve's candidates the ranker's order reads, the closest kept. One, then
         #: a look again, reads closer than two at the cost of two (docs/RESULTS.md, "Readings").
         self.ranked_reads = RANKED_READS
@@ -286,7 +282,7 @@ class Reader:
     def _finish(
         self, inputs: list[np.ndarray], read: list[ReadCurve], fresh: list[int], earlier: dict[int, list[ReadCurve]]
     ) -> None:
-        """`read[i]` for each i in `fresh`, in place: its ends kept (inference.ends) and untangled (inference.
+        """`read[i]` for each i in `fresh`, in place: its ends kept (inference.placing) and untangled (inference.
         untangling). Where an answer still crosses itself, the row before its last step (refine, the looks: `earlier`,
         latest first), finished so, in its place where that one does not."""
         unfinished = {i: read[i] for i in fresh}
@@ -321,7 +317,7 @@ class Reader:
 
     def _placed_again(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> list[ReadCurve]:
         """Rows placed on their splines (closest placement), each caller point placed again on its spline as it is
-        now (its ends moved: inference.ends)."""
+        now (its ends moved: inference.placing)."""
         have = [i for i, r in enumerate(rows) if r.feet is not None and r.ctrl is not None]
         if not have:
             return rows

@@ -14,7 +14,7 @@ sessions (`inference.graphs`) and reads the learned prior. Its methods take nump
 
 How a curve is read is one `Reading` (frame, pose, spacing, refine): by default the model's own — one encoding per
 curve for a model trained in the canonical pose — or the search (`inference.reader`). Curves read before come from
-the encoding cache (`inference.cache`). Nothing here imports torch.
+the encoding cache (`inference.prepared`). Nothing here imports torch.
 """
 
 from __future__ import annotations
@@ -28,7 +28,6 @@ import numpy as np
 
 from curve_vae.geometry import Frame
 from curve_vae.inference.augmenting import AugmentPlan, augmented, neighbour_pools
-from curve_vae.inference.cache import DEFAULT_CACHE_BYTES, EncodingCache
 from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.exploring import Explored, explore
@@ -44,7 +43,7 @@ from curve_vae.inference.placing import (
     each_to_caller,
     placed_to_caller,
 )
-from curve_vae.inference.prepared import Prepared
+from curve_vae.inference.prepared import DEFAULT_CACHE_BYTES, EncodingCache, Prepared
 from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.reader import Reader

@@ -15,10 +15,10 @@ from fastapi import Depends, Request
 from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
-from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable
 from curve_vae.inference.coalescing import Coalescer, Read, read_alone
 from curve_vae.inference.cpus import blas_threads
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.graphs import Cancelled, CancelToken, cancellable
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.metrics import Metrics, multiprocess_mode
 from curve_vae.service.settings import Settings
@@ -94,7 +94,7 @@ def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
 
 async def in_executor(request: Request, fn: Callable[..., T], *args: Any, token: CancelToken | None = None) -> T:
     """`fn(*args)` on one of the app's inference threads (at most one inference per slot at once, first come
-    first served), under `token` when given: cancelled, the work stops at its next checkpoint (inference.cancel)."""
+    first served), under `token` when given: cancelled, the work stops at its next checkpoint (inference.graphs)."""
 
     def run() -> T:
         if token is None:

@@ -71,7 +71,7 @@ class Settings(BaseSettings):
     # check_refine): about 35 s of one CPU core here, under request_timeout; 256 curves of 161 points may take 10
     # steps.
     max_refine_work: int = Field(default=1_200_000, ge=0)
-    # Bytes the encoding cache may hold (inference/cache.py): curves posted again — the page's slider, a pipeline's
+    # Bytes the encoding cache may hold (inference/prepared.py): curves posted again — the page's slider, a pipeline's
     # seed curves and retries — skip the encoder; 0 turns it off. ~3.4 KB a curve of 161 points.
     cache_bytes: int = Field(default=64 << 20, ge=0)
     # A numba cache compiled at an image's build (`curve-vae warm-up` with NUMBA_CACHE_DIR set to it), copied into

@@ -21,8 +21,7 @@ import numpy as np
 from curve_vae.files import atomic_path
 from curve_vae.geometry.frame import resample, resample_index
 from curve_vae.geometry.metrics import diagonal
-from curve_vae.inference.candidates import model_points
-from curve_vae.inference.reading import Reading
+from curve_vae.inference.reading import Reading, model_points
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.families import RANKER_FAMILIES, TRAIN_FAMILIES, draw_family
 from curve_vae.training.suite import AIRFOIL_WHEEL, random_moves

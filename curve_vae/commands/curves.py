@@ -28,7 +28,7 @@ from curve_vae.inference.reading import Reading
 
 def cmd_reconstruct(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
-    from curve_vae.inference.bodies import reconstruct_body
+    from curve_vae.inference.results import reconstruct_body
 
     refuse_overwrite(a.output, a.force)
     reading = reading_fields(a)
@@ -103,7 +103,7 @@ def reconstruct_summary(body: dict[str, Any]) -> str:
 
 def cmd_encode(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
-    from curve_vae.inference.bodies import encode_body
+    from curve_vae.inference.results import encode_body
 
     refuse_overwrite(a.output, a.force)
     if a.output != "-" and Path(a.output).suffix.lower() not in ("", ".json"):

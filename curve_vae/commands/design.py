@@ -15,7 +15,7 @@ from curve_vae.inference.choices import Axis, FitParam, MeshFormat, choices
 
 def cmd_fit(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
-    from curve_vae.inference.bodies import fit_body
+    from curve_vae.inference.results import fit_body
 
     refuse_overwrite(a.output, a.force)
     curves = read_curves(a.input)
@@ -37,7 +37,7 @@ def cmd_revolve(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves
     from curve_vae.files import atomic_path
     from curve_vae.geometry import revolve
-    from curve_vae.inference.bodies import mesh_file
+    from curve_vae.inference.results import mesh_file
 
     refuse_overwrite(a.output, a.force)
     curves = read_curves(a.input)

@@ -28,7 +28,7 @@ from curve_vae.progress import bar, counted, shown
 
 def cmd_sample(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import write_output
-    from curve_vae.inference.bodies import sample_body, with_output
+    from curve_vae.inference.results import sample_body, with_output
     from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
@@ -139,7 +139,7 @@ def _remote_chunks(a: argparse.Namespace, c: Any, seeds: list, seed: int) -> Any
 
 def _write_augment(a: argparse.Namespace, chunks: Any, progress: Any, seed: int, write_npy: Any) -> tuple:
     """Write the chunks: streamed into a .npy file, or gathered into the JSON body /augment answers."""
-    from curve_vae.inference.bodies import frames_json
+    from curve_vae.inference.results import frames_json
 
     length, made = chunks
     shape = (a.count, length, 2)
@@ -176,7 +176,7 @@ def _frames(parts: list, frames_json: Any) -> Any:
 
 
 def _metrics(made: Any) -> list:
-    from curve_vae.inference.bodies import curve_metrics
+    from curve_vae.inference.results import curve_metrics
 
     return curve_metrics(made.curves)
 

@@ -59,7 +59,7 @@ def write_output(
 
 
 def _listed(value: Any) -> Any:
-    """numpy in an endpoint's body (inference.bodies keeps arrays for the service's orjson) as lists and numbers."""
+    """numpy in an endpoint's body (inference.results keeps arrays for the service's orjson) as lists and numbers."""
     if isinstance(value, np.ndarray | np.generic):
         return value.tolist()
     raise TypeError(f"{type(value).__name__} is not JSON serialisable")

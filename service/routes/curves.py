@@ -1,6 +1,6 @@
 """The model's curve routes: encode, decode, reconstruct, interpolate. Each is built by service.routing.model_route
 (the request validated and within its limits; curves as JSON or, but for decode, a .npy body), calls the runtime in a
-worker thread (deps.run_inference) and answers the body inference.bodies builds; the OpenAPI examples are
+worker thread (deps.run_inference) and answers the body inference.results builds; the OpenAPI examples are
 service.api_docs'."""
 
 from __future__ import annotations
@@ -9,10 +9,9 @@ import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
-from curve_vae.inference.bodies import decode_body, encode_body, interpolate_body, reconstruct_body
 from curve_vae.inference.coalescing import encode_key, reconstruct_key
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.results import Reconstruction
+from curve_vae.inference.results import Reconstruction, decode_body, encode_body, interpolate_body, reconstruct_body
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s

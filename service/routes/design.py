@@ -8,8 +8,8 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
 from curve_vae.geometry import revolve
-from curve_vae.inference.bodies import fit_body, mesh_file
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.results import fit_body, mesh_file
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example

@@ -1,7 +1,7 @@
 """The generating routes: /sample (new curves from a latent distribution), /explore (curves around one) and /augment
 (new curves between given ones, as seeded JSON pages or one streamed .npy file). Each is built by
 service.routing.model_route (the request validated and within its limits), runs the runtime in a worker thread and
-answers the body inference.bodies builds, shared with the command line."""
+answers the body inference.results builds, shared with the command line."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response, StreamingResponse
 
 from curve_vae.inference.augmenting import AugmentPlan
-from curve_vae.inference.bodies import augment_body, explore_body, sample_body, with_output
+from curve_vae.inference.results import augment_body, explore_body, sample_body, with_output
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.inference.sampling import fresh_seed
 from curve_vae.npy import MEDIA_TYPE as NPY_MEDIA_TYPE

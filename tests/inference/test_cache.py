@@ -1,10 +1,10 @@
-"""inference.cache: curves read once are read from the cache, the same answer, bounded in bytes."""
+"""inference.prepared: curves read once are read from the cache, the same answer, bounded in bytes."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from curve_vae.inference.cache import EncodingCache
+from curve_vae.inference.prepared import EncodingCache
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from tests.helpers import bspline_curves

@@ -1,10 +1,10 @@
-"""inference.cancel: a cancelled request stops at its next graph run."""
+"""inference.graphs: a cancelled request stops at its next graph run."""
 
 from __future__ import annotations
 
 import pytest
 
-from curve_vae.inference.cancel import Cancelled, CancelToken, cancellable, checkpoint
+from curve_vae.inference.graphs import Cancelled, CancelToken, cancellable, checkpoint
 from tests.helpers import bspline_curves
 
 

@@ -1,4 +1,4 @@
-"""inference/candidates.py: each candidate reading's points in the model's plane, all of a request's candidates at
+"""inference/reading.py: each candidate reading's points in the model's plane, all of a request's candidates at
 once — exactly what geometry.to_model_plane gives each alone."""
 
 from __future__ import annotations
@@ -6,8 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from curve_vae.geometry import resample, to_model_plane
-from curve_vae.inference.candidates import model_points
-from curve_vae.inference.reading import Reading
+from curve_vae.inference.reading import Reading, model_points
 from tests.helpers import bspline_curves
 
 

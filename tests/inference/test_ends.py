@@ -1,4 +1,4 @@
-"""Answers keep their inputs' ends (inference.ends): a reconstruction starts and ends where its input does, every
+"""Answers keep their inputs' ends (inference.placing): a reconstruction starts and ends where its input does, every
 in-between — /interpolate, /augment — at the weighted blend of its inputs' matching ends, a closed curve closes."""
 
 from __future__ import annotations

@@ -98,7 +98,7 @@ def test_encode_returns_the_refined_latents_that_reconstruct_decodes(runtime, cu
     assert not np.allclose(mean, plain)
     decoded = runtime.decode(mean, frames=frames, n_points=50).curves
     # /decode draws a latent as the model does; /reconstruct's answer is that drawing with its ends moved onto the
-    # input's (inference.ends) and, where it crosses itself, untangled (the untrained model's curves cross)
+    # input's (inference.placing) and, where it crosses itself, untangled (the untrained model's curves cross)
     runtime.reader.keep_ends = False
     try:
         rec = runtime.reconstruct(c, Reading(refine=3), n_points=50)

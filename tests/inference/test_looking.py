@@ -119,20 +119,20 @@ def test_an_answer_that_cannot_be_untangled_gives_way_to_the_one_before_its_last
     """A thin closed section whose decoded trailing edge crosses: where the untangler cannot free the answer, the
     answer is the row before its last step (before refine, before the looks), finished in turn."""
     from curve_vae.geometry.validity import new_crossings
-    from curve_vae.inference import untangling
+    from curve_vae.inference import placing
 
     section = naca(0.0, 0.10, 81)  # crosses after the default look (tests/inference/test_untangling.py)
     plain = _plain(shipped_runtime, [section], asked)
     assert new_crossings([section], plain.curves).tolist() == [True]
-    real, calls = untangling.untangled, []
+    real, calls = placing.untangled, []
 
     def first_fails(ctrl, params, target, **kw):  # the first call is the answer's: it comes back as it was
         calls.append(1)
         return (np.asarray(ctrl, np.float64), False) if len(calls) == 1 else real(ctrl, params, target, **kw)
 
-    monkeypatch.setattr(untangling, "untangled", first_fails)
+    monkeypatch.setattr(placing, "untangled", first_fails)
     answer = shipped_runtime.reconstruct([section], asked)
-    monkeypatch.setattr(untangling, "untangled", real)
+    monkeypatch.setattr(placing, "untangled", real)
     before = shipped_runtime.reconstruct([section], instead)
     assert not new_crossings([section], answer.curves).any()
     np.testing.assert_array_equal(answer.curves[0], before.curves[0])

@@ -11,11 +11,10 @@ import numpy as np
 import pytest
 
 from curve_vae.inference import picking
-from curve_vae.inference.candidates import model_points
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
 from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, ranker_inputs
-from curve_vae.inference.reading import Reading
+from curve_vae.inference.reading import Reading, model_points
 from curve_vae.inference.runtime import CurveRuntime
 from tests.helpers import bspline_curves
 from tests.parts import ranker_weights, save_npz, with_ranker

@@ -9,7 +9,7 @@ import pytest
 from curve_vae.client.design import Revolved
 from curve_vae.client.results import ModelRef
 from curve_vae.geometry import revolve
-from curve_vae.inference.bodies import mesh_file
+from curve_vae.inference.results import mesh_file
 
 MODEL = ModelRef("m", "1", "0.15.0", {})
 PROFILE = np.array([[0, 0], [3, 0], [4, 1], [3, 3], [0, 5]], np.float64)

@@ -59,7 +59,7 @@ def test_decode_in_the_model_plane_and_in_a_frame(client, runtime):
 
 def test_encode_then_decode_in_the_returned_frames_is_the_reconstruction_but_for_its_ends(client, runtime, curves):
     """/decode draws the latent /encode returns as the model does; /reconstruct's answer is that drawing with its ends
-    moved onto the input's (inference.ends)."""
+    moved onto the input's (inference.placing)."""
     c = (curves(2) * 3 - 11).tolist()  # read as given (spacing "parameter"): the returned points are the model's
     enc = client.post("/encode", json={"curves": c, "spacing": "parameter"}).json()
     dec = client.post("/decode", json={"latents": enc["mean"], "frames": enc["frames"]}).json()

@@ -18,7 +18,7 @@ from curve_vae.geometry import (
     self_intersects,
     smoothness,
 )
-from curve_vae.inference.bodies import curve_metrics
+from curve_vae.inference.results import curve_metrics
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
