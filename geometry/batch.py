@@ -82,7 +82,9 @@ class FrameRows:
         return cls(
             np.array([f.center for f in frames], np.float64).reshape(-1, 2),
             np.array([f.size for f in frames], np.float64),
-            np.array([f._linear() for f in frames], np.float64).reshape(-1, 2, 2),
+            pose_linears(
+                np.array([f.rotation for f in frames], np.float64), np.array([f.mirror for f in frames], bool)
+            ).reshape(-1, 2, 2),
             np.array([f.reverse for f in frames], bool),
         )
 
@@ -178,14 +180,14 @@ def _canonical_same_length(pts: np.ndarray) -> list[Frame]:
     heading = chord_headings(pts * flip[:, None, :], centroid * flip)
     target = POSE_CHORDS[0]
     turn = np.angle(np.exp(1j * (target - heading)))
-    drawn = _linear(turn, mirror)  # (k, 2, 2)
+    drawn = pose_linears(turn, mirror)  # (k, 2, 2)
     # the other candidate: reflected across the chord's normal and reversed (frame.pose_frames' `flips`)
     normal = np.array([np.cos(target), np.sin(target)])
     c, s = np.cos(turn), np.sin(turn)
     rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (k, 2, 2) column-vector rotations
     a = (np.eye(2) - 2 * np.outer(normal, normal)) @ rot @ np.diag([-1.0, 1.0])
     turn_flipped = np.arctan2(a[:, 1, 0], a[:, 0, 0])
-    flipped = _linear(turn_flipped, ~mirror)
+    flipped = pose_linears(turn_flipped, ~mirror)
     posed = pts @ drawn  # chord along −y (a translation changes no statistic below)
     centroid = (centroid[:, None] @ drawn)[:, 0]
     offset = (posed[:, 0, 1] + posed[:, -1, 1]) / 2 - centroid[:, 1]
@@ -231,7 +233,7 @@ def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[F
             poses.append((np.angle(np.exp(1j * (2 * target - turn))), ~mirror, True))
     turns, mirrors, reverses = zip(*poses)
     turn, mir = np.stack(turns, axis=1), np.stack(mirrors, axis=1)  # (k, poses)
-    linear = _linear(turn.ravel(), mir.ravel()).reshape(*turn.shape, 2, 2)
+    linear = pose_linears(turn.ravel(), mir.ravel()).reshape(*turn.shape, 2, 2)
     q = pts[:, None] @ linear  # every pose's bounding box at once (frame.posed_frame); (k, poses, n, 2)
     lo, hi = q.min(axis=2), q.max(axis=2)
     center, size = (linear @ ((lo + hi) / 2)[..., None])[..., 0].tolist(), (hi - lo).max(axis=2).tolist()
@@ -245,8 +247,8 @@ def _poses_same_length(pts: np.ndarray, chords: int, flips: bool) -> list[list[F
     ]
 
 
-def _linear(rotation: np.ndarray, mirror: np.ndarray) -> np.ndarray:
-    """(k, 2, 2) `Frame._linear` of each pose (row vectors, mirror first)."""
+def pose_linears(rotation: np.ndarray, mirror: np.ndarray) -> np.ndarray:
+    """The 2×2 map of each pose (k, 2, 2), row vectors (p @ M), mirror first: what a Frame's pose does to its points."""
     c, s = np.cos(rotation), np.sin(rotation)
     m = np.stack([np.stack([c, s], -1), np.stack([-s, c], -1)], -2)
     m[mirror] = np.array([[-1.0, 0.0], [0.0, 1.0]]) @ m[mirror]

@@ -40,10 +40,10 @@ class Frame:
         return bool(self.rotation or self.mirror or self.reverse)
 
     def _linear(self) -> np.ndarray:
-        """The 2×2 map of the pose (row vectors: p @ M), mirror first."""
-        c, s = np.cos(self.rotation), np.sin(self.rotation)
-        m = np.array([[c, s], [-s, c]])
-        return np.array([[-1.0, 0.0], [0.0, 1.0]]) @ m if self.mirror else m
+        """The 2×2 map of the pose (row vectors: p @ M), mirror first: geometry.batch.pose_linears of one."""
+        from curve_vae.geometry.batch import pose_linears  # batch builds on Frame
+
+        return pose_linears(np.array([self.rotation], np.float64), np.array([self.mirror], bool))[0]
 
     def to_model(self, pts: np.ndarray, model_size: float) -> np.ndarray:
         """Map points of this frame into the model plane, bounding box size `model_size`."""
