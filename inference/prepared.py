@@ -82,7 +82,7 @@ class Prepared:
 
     inputs: list[np.ndarray]  # the caller's curves, float64
     rows: list[ReadCurve]
-    ends_kept: bool = True  # answers start and end where their inputs do; so do curves mixed of them (inference.placing)
+    ends_kept: bool = True  # answers start and end where their inputs do, so do curves mixed of them (placing)
 
     @property
     def frames(self) -> list[Frame | None]:

@@ -38,7 +38,6 @@ from starlette.exceptions import HTTPException
 
 from curve_vae.inference.batching import GraphBatcher
 from curve_vae.inference.batching import attach as attach_batcher
-from curve_vae.inference.coalescing import runtime_coalescer
 from curve_vae.inference.cpus import (
     available_cpus,
     coalescing_readers,
@@ -51,12 +50,11 @@ from curve_vae.inference.errors import InputError
 from curve_vae.inference.manifest import ModelLoadError
 from curve_vae.inference.opening import compiled_kernels
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.service.access import ApiKeyMiddleware
-from curve_vae.service.cors import add_cors
+from curve_vae.service.deps import runtime_coalescer
 from curve_vae.service.errors import on_http_error, on_input_error, on_validation_error
 from curve_vae.service.limits import name_priors, state_bounds
 from curve_vae.service.metrics import Metrics, MetricsMiddleware
-from curve_vae.service.middleware import BodyLimitMiddleware
+from curve_vae.service.middleware import ApiKeyMiddleware, BodyLimitMiddleware, add_cors
 from curve_vae.service.oip import DEFAULT_SIGNATURES, signatures
 from curve_vae.service.oip_docs import describe
 from curve_vae.service.routes.curves import curves_router

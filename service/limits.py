@@ -19,6 +19,7 @@ from pydantic import BaseModel
 from curve_vae.geometry import simplex_grid, simplex_grid_size
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.reading import Reading
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.schemas import AugmentRequest, InterpolateRequest, RevolveRequest
 
 DEFAULT_STEPS = 5  # the paper interpolates in five steps (§4)
@@ -242,3 +243,13 @@ def _field_schema(comps: dict[str, Any], model: str, field: str) -> dict[str, An
     """A request field's schema; for `X | None` fields its non-null branch, where bounds and choices go."""
     p = comps[model]["properties"][field]
     return next((b for b in p.get("anyOf", []) if b.get("type") != "null"), p)
+
+
+def check_output(output: str, runtime: CurveRuntime) -> None:
+    """A spline output needs a model with a B-spline head."""
+    if output != "points" and not runtime.has_splines:
+        raise InputError(
+            ("output",),
+            f'"{output}" needs a model with a B-spline head, and this one has none (GET /model: spline is null); '
+            'ask for "points", or fit splines to the points with /fit',
+        )

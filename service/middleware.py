@@ -1,11 +1,17 @@
-"""The request body limit: 413 before a byte too many is kept."""
+"""What a request passes on its way to a route, each an ASGI middleware the app adds (service.app): the body limit
+(413 before a byte too many is kept), calls from other origins (CORS), and API keys. One section each, below."""
 
 from __future__ import annotations
 
+import hmac
+
+from fastapi import FastAPI
+from fastapi.middleware.cors import CORSMiddleware
 from fastapi.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from curve_vae.service.errors import error_response
+from curve_vae.service.settings import Settings
 
 #: How much of an oversized body is read and thrown away before the 413 goes out, as a multiple of the limit (and
 #: at least DRAIN_MIN bytes). Clients that send the whole body before reading the answer (Python's urllib, most
@@ -71,3 +77,115 @@ def _replay(messages: list[Message], receive: Receive) -> Receive:
         return messages.pop(0) if messages else await receive()
 
     return replayed
+
+
+# Calls from pages on other origins (CORS): starlette's CORSMiddleware for the origins the settings allow, and for
+# any other origin's preflight a 403 whose body says how to allow it (a preflight the service cannot answer would
+# otherwise meet a bare 405 from the routes, or starlette's plain-text 400).
+
+#: What a page on another origin needs to read (the .npy seed, the mesh counts, download names).
+EXPOSED = ["X-Augment-Seed", "X-Mesh-Vertices", "X-Mesh-Faces", "X-Mesh-Closed", "Content-Disposition"]
+
+
+class CorsRefusalMiddleware:
+    """403 for the preflight (OPTIONS with Origin and Access-Control-Request-Method) of an origin not allowed."""
+
+    def __init__(self, app: ASGIApp, *, origins: list[str]) -> None:
+        self.app, self.origins = app, origins
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "http" and scope["method"] == "OPTIONS":
+            headers = dict(scope["headers"])
+            origin = headers.get(b"origin", b"").decode("latin-1")
+            if origin and b"access-control-request-method" in headers and not self.allows(origin):
+                await self.refusal(origin, scope.get("path", ""))(scope, receive, send)
+                return
+        await self.app(scope, receive, send)
+
+    def allows(self, origin: str) -> bool:
+        return "*" in self.origins or origin in self.origins
+
+    def refusal(self, origin: str, path: str):
+        now = f"the server allows {', '.join(self.origins)}" if self.origins else "the server allows no other origin"
+        wanted = ",".join([*self.origins, origin])
+        msg = (
+            f"calls from {origin} are not allowed ({now}): start it with --cors-origins {wanted} "
+            f"or CURVE_VAE_CORS_ORIGINS={wanted}"
+        )
+        return error_response(403, [("origin", msg)], path=path)
+
+
+def add_cors(app: FastAPI, settings: Settings) -> None:
+    """CORS headers for the settings' origins; a preflight from any other origin gets the 403 that says how."""
+    if settings.cors_origins:
+        app.add_middleware(
+            CORSMiddleware,
+            allow_origins=settings.cors_origins,
+            allow_methods=["GET", "POST"],
+            allow_headers=["Content-Type", "Authorization", "X-API-Key"],
+            expose_headers=EXPOSED,
+            max_age=600,
+        )
+    app.add_middleware(CorsRefusalMiddleware, origins=settings.cors_origins)  # outside: refused before CORS
+
+
+# Optional API keys: with CURVE_VAE_API_KEYS set, every request needs one, except liveness and readiness.
+#
+# A key comes as `Authorization: Bearer <key>` or `X-API-Key: <key>` and is compared with each
+# configured key in constant time (hmac.compare_digest, all keys every time), so the answer's
+# timing tells nothing about how much of a key matched. A missing or wrong key gets a 401 that
+# says how to send one. The page and the API docs are the package's own static files (no data,
+# no model): they load without a key, and the page then sends the key the user types in.
+#
+
+#: Paths served without a key: probes must work for orchestrators, and the page must load to ask for the key.
+OPEN_PATHS = frozenset(
+    {"/health", "/ready", "/v2/health/live", "/v2/health/ready", "/", "/docs", "/redoc", "/openapi.json"}
+)
+OPEN_PREFIXES = ("/static/", "/docs-assets/")
+
+
+def key_of(headers: dict[bytes, bytes]) -> str | None:
+    """The key a request carries, from Authorization: Bearer or X-API-Key; None when it carries none."""
+    auth = headers.get(b"authorization", b"").decode("latin-1")
+    scheme, _, token = auth.partition(" ")
+    if scheme.lower() == "bearer" and token.strip():
+        return token.strip()
+    key = headers.get(b"x-api-key", b"").decode("latin-1").strip()
+    return key or None
+
+
+def accepted(key: str | None, keys: list[str]) -> bool:
+    """Whether `key` is one of `keys`, in time that depends on neither (every key compared, as bytes)."""
+    given = (key or "").encode()
+    match = False
+    for k in keys:
+        match |= hmac.compare_digest(given, k.encode())
+    return match and bool(key)  # an empty key never opens anything, whatever is configured
+
+
+class ApiKeyMiddleware:
+    def __init__(self, app: ASGIApp, *, keys: list[str]) -> None:
+        self.app, self.keys = app, keys
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        path = scope.get("path", "")
+        if (
+            scope["type"] != "http"
+            or scope["method"] == "OPTIONS"  # CORS preflights carry no credentials
+            or path in OPEN_PATHS
+            or path.startswith(OPEN_PREFIXES)
+            or accepted(key_of(dict(scope["headers"])), self.keys)
+        ):
+            await self.app(scope, receive, send)
+            return
+        missing = key_of(dict(scope["headers"])) is None
+        msg = (
+            "this service needs an API key: send Authorization: Bearer <key> or X-API-Key: <key>"
+            if missing
+            else "the API key is not valid for this service"
+        )
+        response = error_response(
+            401, [("headers.authorization", msg)], detail=msg, headers={"WWW-Authenticate": "Bearer"}, path=path
+        )
+        await response(scope, receive, send)

@@ -48,7 +48,7 @@ class Settings(BaseSettings):
     micro_batch_rows: int = Field(default=32, ge=1)
     micro_batch_wait_ms: float = Field(default=2.0, ge=0, le=1000)
     # Requests that queue for an inference thread at once read as one batch of at most this many curves, each
-    # answered its own part (inference/coalescing.py: /encode and /reconstruct of equal options, requests of at most
+    # answered its own part (service/deps.py: /encode and /reconstruct of equal options, requests of at most
     # half as many curves; one batch at a time a CPU of the worker); 0: each alone
     coalesce_curves: int = Field(default=32, ge=0)
     # milliseconds a thread runs Python before another waiting for the GIL takes it (sys.setswitchinterval, set in
@@ -87,7 +87,7 @@ class Settings(BaseSettings):
     placement: Placement = "model"
     # Origins allowed to call from a browser: a JSON list or comma-separated; empty = CORS off.
     cors_origins: Annotated[list[str], NoDecode] = Field(default_factory=list)
-    # API keys (service/access.py), comma-separated or a JSON list; empty = open. Set by environment only,
+    # API keys (service/middleware.py), comma-separated or a JSON list; empty = open. Set by environment only,
     # so that keys never show in a process list.
     api_keys: Annotated[list[str], NoDecode] = Field(default_factory=list, repr=False)
     metrics: bool = True  # GET /metrics; false answers 404, to keep the numbers off a public port

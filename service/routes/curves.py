@@ -9,16 +9,14 @@ import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
-from curve_vae.inference.coalescing import encode_key, reconstruct_key
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.results import Reconstruction, decode_body, encode_body, interpolate_body, reconstruct_body
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
-from curve_vae.service.deps import check_output, coalesced, run_inference, runtime_of, settings_of
-from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.limits import check_weights
-from curve_vae.service.routing import model_route
+from curve_vae.service.deps import coalesced, encode_key, reconstruct_key, run_inference, runtime_of, settings_of
+from curve_vae.service.limits import check_output, check_weights
+from curve_vae.service.routing import JSON, FastJSONRoute, model_route
 
 curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 

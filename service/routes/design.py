@@ -14,8 +14,7 @@ from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example
 from curve_vae.service.deps import run_inference
-from curve_vae.service.fastjson import JSON, FastJSONRoute
-from curve_vae.service.routing import model_route
+from curve_vae.service.routing import JSON, FastJSONRoute, model_route
 
 design_router = APIRouter(route_class=FastJSONRoute, tags=["design"])
 

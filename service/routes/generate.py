@@ -22,10 +22,10 @@ from curve_vae.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service import api_docs as docs
 from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
-from curve_vae.service.deps import check_output, in_executor, run_inference, runtime_of
-from curve_vae.service.fastjson import JSON, FastJSONRoute
+from curve_vae.service.deps import in_executor, run_inference, runtime_of
+from curve_vae.service.limits import check_output
 from curve_vae.service.metrics import Metrics
-from curve_vae.service.routing import model_route
+from curve_vae.service.routing import JSON, FastJSONRoute, model_route
 
 generate_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
 

@@ -24,8 +24,8 @@ from curve_vae.service import oip
 from curve_vae.service.api_docs import ERROR_EXAMPLES, curl_sample
 from curve_vae.service.deps import run_inference, runtime_of
 from curve_vae.service.errors import oip_error
-from curve_vae.service.fastjson import JSON
 from curve_vae.service.oip import OipError
+from curve_vae.service.routing import JSON
 
 TAG = "open inference protocol"
 oip_router = APIRouter(tags=[TAG])

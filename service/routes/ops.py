@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 from fastapi import APIRouter, Request
@@ -9,13 +10,12 @@ from fastapi.responses import JSONResponse, Response
 from starlette.exceptions import HTTPException
 
 from curve_vae import __version__
+from curve_vae.inference.cpus import blas_threads
+from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service import responses as r
 from curve_vae.service.api_docs import curl_sample, error_docs
-from curve_vae.service.deps import (
-    RuntimeDep,
-    SettingsDep,
-    execution_of,
-)
+from curve_vae.service.deps import RuntimeDep, SettingsDep, coalescer_of
+from curve_vae.service.settings import Settings
 
 ops_router = APIRouter(tags=["operations"])
 
@@ -151,3 +151,23 @@ async def metrics(request: Request) -> Response:
     metrics.mirror(request.app.state.runtime)
     body, content_type = metrics.render()
     return Response(body, media_type=content_type)
+
+
+def execution_of(request: Request, runtime: CurveRuntime) -> dict[str, Any]:
+    """What GET /model reports under `execution`: the sessions' applied options and the inference threads."""
+    settings: Settings = request.app.state.settings
+    batching = (
+        {"rows": settings.micro_batch_rows, "wait_ms": settings.micro_batch_wait_ms}
+        if getattr(request.app.state, "batcher", None) is not None
+        else None
+    )
+    return {
+        **runtime.graphs.pool.applied(),
+        "blas_threads": blas_threads(),
+        "inference_threads": request.app.state.slots,
+        "gil_switch_ms": round(sys.getswitchinterval() * 1e3, 6),
+        "micro_batch": batching,
+        "coalesce": None
+        if (coalescer := coalescer_of(request)) is None
+        else {"curves": coalescer.max_curves, "readers": coalescer.readers, "hold_ms": coalescer.hold * 1e3},
+    }

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from curve_vae.service.access import accepted, key_of
+from curve_vae.service.middleware import accepted, key_of
 
 CURVE = [[0, 0], [1, 2], [2.5, 3.2], [4, 3.5], [5.5, 3], [7, 1.5], [8, 0]]
 KEYS = ["k-one-0123456789", "k-two-abcdefghij"]

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from curve_vae.service.fastjson import JSON, loads
+from curve_vae.service.routing import JSON, loads
 
 
 @pytest.mark.parametrize(

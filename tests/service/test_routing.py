@@ -16,8 +16,7 @@ from fastapi.testclient import TestClient
 from curve_vae.inference.errors import InputError
 from curve_vae.service import schemas as s
 from curve_vae.service.errors import on_input_error, on_validation_error
-from curve_vae.service.fastjson import FastJSONRoute
-from curve_vae.service.routing import model_route
+from curve_vae.service.routing import FastJSONRoute, model_route
 from curve_vae.service.settings import Settings
 
 CURVE = [[0.0, 0.0], [1.0, 2.0], [2.0, 1.0], [3.0, 0.0]]

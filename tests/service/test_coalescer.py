@@ -10,10 +10,10 @@ import time
 import numpy as np
 import pytest
 
-from curve_vae.inference.coalescing import Coalescer, encode_key, reconstruct_key, runtime_coalescer
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.graphs import Cancelled
 from curve_vae.inference.reading import Reading
+from curve_vae.service.deps import Coalescer, encode_key, reconstruct_key, runtime_coalescer
 
 DEFAULT = reconstruct_key(Reading(), None)
 
