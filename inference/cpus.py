@@ -81,7 +81,7 @@ def inference_slots(settings: Any, cpus: int | None = None) -> int:
 
 
 def coalescing_readers(settings: Any, cpus: int | None = None) -> int:
-    """Batches of coalesced requests one worker reads at once (inference.coalescing): one a CPU of the worker, at
+    """Batches of coalesced requests one worker reads at once (service.deps): one a CPU of the worker, at
     most its inference slots. Fewer than the slots: two batches sharing a core cost more than one of both."""
     cpus = available_cpus() if cpus is None else cpus
     return max(1, min(inference_slots(settings, cpus), cpus // worker_count(settings, cpus)))

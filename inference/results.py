@@ -101,7 +101,7 @@ def _cuts(sizes: Sequence[int]) -> list[slice]:
 
 
 def split_encoding(enc: Encoding, sizes: Sequence[int]) -> list[Encoding]:
-    """`enc` cut into consecutive parts of `sizes` curves (inference.coalescing: each request's own)."""
+    """`enc` cut into consecutive parts of `sizes` curves (service.deps: each request's own)."""
     return [
         Encoding(enc.mean[c], enc.log_var[c], enc.frames[c], None if enc.closeness is None else enc.closeness.part(c))
         for c in _cuts(sizes)
@@ -141,7 +141,7 @@ class Reconstruction:
 
 
 def split_reconstruction(rec: Reconstruction, sizes: Sequence[int]) -> list[Reconstruction]:
-    """`rec` cut into consecutive parts of `sizes` curves (inference.coalescing: each request's own)."""
+    """`rec` cut into consecutive parts of `sizes` curves (service.deps: each request's own)."""
     return [
         Reconstruction(
             rec.curves[c],

@@ -1,4 +1,4 @@
-"""API keys (service.access): every route but liveness and readiness needs one when keys are set."""
+"""API keys (service.middleware): every route but liveness and readiness needs one when keys are set."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""Concurrent /reconstruct and /encode requests read together (inference.coalescing): each answered its own, as if
-alone; a bad one fails alone; off with CURVE_VAE_COALESCE_CURVES=0; the batches in /metrics; on a real server too."""
+"""Concurrent /reconstruct and /encode requests read together (service.deps, the coalescer): each answered its own, as
+if alone; a bad one fails alone; off with CURVE_VAE_COALESCE_CURVES=0; the batches in /metrics; on a real server too."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""Calls from pages on other origins (service.cors): CORS headers for the origins the settings allow, and a 403 that
-says how to allow any other origin's preflight."""
+"""Calls from pages on other origins (service.middleware): CORS headers for the origins the settings allow, and a 403
+that says how to allow any other origin's preflight."""
 
 from __future__ import annotations
 

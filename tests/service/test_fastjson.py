@@ -1,4 +1,4 @@
-"""JSON in and out with orjson (service.fastjson): bodies orjson refuses (NaN, Infinity) still read by the stdlib so
+"""JSON in and out with orjson (service.routing): bodies orjson refuses (NaN, Infinity) still read by the stdlib so
 that the schema names the point; and numbers written back at the precision the routes mean (float64 as float64, the
 encoder's float32 means exactly)."""
 
