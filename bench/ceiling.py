@@ -139,8 +139,8 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
     from curve_vae.inference.reading import Reading
     from curve_vae.inference.runtime import CurveRuntime
     from curve_vae.inference.sessions import SessionConfig
-    from curve_vae.service.routing import JSON
     from curve_vae.service.limits import check
+    from curve_vae.service.routing import JSON
     from curve_vae.service.schemas import ReconstructRequest
     from curve_vae.service.settings import Settings
 

@@ -62,7 +62,7 @@ class RevisionServer(LiveServer):
         models = ROOT / "models" if revision is None else root / "tree" / "models"
         super().__init__("--model-dir", str(models), "--providers", "cpu", env=env, cwd=root, capture=False)
         try:
-            self.wait_ready(listeners=available_cpus())
+            self.wait_ready(workers=available_cpus())
         except BaseException:
             self.stop()
             raise

@@ -72,7 +72,7 @@ class Server(LiveServer):
         workers = int(flags[flags.index("--workers") + 1]) if "--workers" in flags else 0
         workers = workers or available_cpus()  # the service's default: one per CPU
         try:
-            self.wait_ready(listeners=workers)  # wrk's connections are shared out as they open
+            self.wait_ready(workers=workers)  # wrk's connections are shared out as they open
         except BaseException:
             self.stop()
             raise

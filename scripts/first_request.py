@@ -52,7 +52,7 @@ def main() -> None:
             except OSError:
                 time.sleep(0.05)
         print(f"answering after {time.perf_counter() - start:.1f} s")
-        server.wait_ready(listeners=available_cpus())  # the service's default: a worker a CPU
+        server.wait_ready(workers=available_cpus())  # the service's default: a worker a CPU
         print(f"ready after {time.perf_counter() - start:.1f} s (numba cache {cache})")
         for k in range(a.requests):
             headers = {"Content-Type": "application/json", "Connection": "close"}

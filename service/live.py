@@ -100,12 +100,11 @@ class LiveServer:
         except subprocess.TimeoutExpired:
             self._printed = ""
 
-    def wait_ready(self, timeout: float = READY_TIMEOUT, *, listeners: int = 1) -> None:
-        """Poll /ready until 200 and until `listeners` sockets listen on the port (each worker its own: a client
-        that connects before a worker listens stays with the others). Each worker warms up on its own, and a new
-        connection reaches any one of them: with several, 4 × `listeners` new connections in a row must each answer
-        200 (a worker still warming up is missed by all of them once in 2^8 starts, for two). RuntimeError (with the
-        server's output) if it exits, TimeoutError if it is slow."""
+    def wait_ready(self, timeout: float = READY_TIMEOUT, *, workers: int = 1) -> None:
+        """Poll /ready until 200. Each of `workers` warms up on its own, and a new connection reaches any one of them:
+        with several, 4 × `workers` new connections in a row must each answer 200 (a worker still warming up is
+        missed by all of them once in 2^8 starts, for two). RuntimeError (with the server's output) if it exits,
+        TimeoutError if it is slow."""
         deadline = time.monotonic() + timeout
         in_a_row = 0
         while time.monotonic() < deadline:
@@ -113,12 +112,11 @@ class LiveServer:
                 raise RuntimeError(f"server exited with {self.proc.returncode}: {' '.join(self.cmd)}\n{self.output()}")
             try:
                 with urllib.request.urlopen(f"{self.url}/ready", timeout=1) as r:
-                    listening = listening_sockets(self.port)
-                    ready = r.status == 200 and (listening is None or listening >= listeners)
+                    ready = r.status == 200
             except OSError:
                 ready = False
             in_a_row = in_a_row + 1 if ready else 0
-            if in_a_row >= (1 if listeners <= 1 else 4 * listeners):
+            if in_a_row >= (1 if workers <= 1 else 4 * workers):
                 return
             if not ready:
                 time.sleep(0.1)

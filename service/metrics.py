@@ -48,7 +48,6 @@ class Metrics:
         self.registry = CollectorRegistry()
         self._http()
         self._inference()
-        self._connections()
         self._runtime_gauges()
 
     def _http(self) -> None:
@@ -92,20 +91,6 @@ class Metrics:
             "Requests whose inference stopped early: the client disconnected or the request timed out.",
             ["route"],
             registry=self.registry,
-        )
-
-    def _connections(self) -> None:
-        self.connections_moved = Counter(
-            "curve_vae_connections_moved",
-            "Responses that asked their client to connect again: this worker held two or more connections beyond "
-            "another (--workers N; service.balance).",
-            registry=self.registry,
-        )
-        self.open_connections = Gauge(
-            "curve_vae_open_connections",
-            "HTTP connections open to each worker (--workers N: one value a worker, by pid).",
-            registry=self.registry,
-            multiprocess_mode="liveall",
         )
 
     def _runtime_gauges(self) -> None:

@@ -221,42 +221,32 @@ class _ServerOptions(TypedDict):
 
 
 def _run_workers(settings: Settings, common: _ServerOptions) -> None:
-    """`settings.workers` processes under uvicorn's supervisor (restarts, SIGHUP, TTIN/TTOU), each with a listening
-    socket of its own where the platform shares connections out among them (service.listeners)."""
+    """`settings.workers` processes under uvicorn's supervisor (restarts, SIGHUP, TTIN/TTOU), all accepting from one
+    listening socket (uvicorn's `--workers`; docs/DEPLOYMENT.md "Workers" measures it against a socket a worker)."""
     import uvicorn
     from uvicorn.config import STARTUP_FAILURE
     from uvicorn.supervisors import Multiprocess
 
-    from curve_vae.service import balance, listeners
-
     # Workers are fresh processes: they rebuild the same settings from the environment.
     os.environ.update(_as_env(settings))
-    counts = (  # each worker's open connections (service.balance), where each worker has a socket of its own
-        _env_directory(balance.BALANCE_DIR, "curve-vae-connections-")
-        if listeners.balances_connections()
-        else contextlib.nullcontext()
-    )
-    with _shared_metrics(), counts:
-        app = "curve_vae.service.server:supervised_app"
-        if not listeners.balances_connections():
-            listeners.log.info(where(settings.host, settings.port))
-            uvicorn.run(app, factory=True, workers=settings.workers, **common)
-            return
-        config = uvicorn.Config(app, factory=True, workers=settings.workers, **common)
+    log = logging.getLogger("uvicorn.error")
+    config = uvicorn.Config("curve_vae.service.server:supervised_app", factory=True, workers=settings.workers, **common)
+    with _shared_metrics():
         try:
-            listener = listeners.PerWorkerListener(settings.host, settings.port)
-        except OSError as e:
-            listeners.log.error("cannot listen on %s:%d: %s", settings.host, settings.port, e)
-            raise SystemExit(3) from None
-        listeners.announce(settings.host, listener.port)
-        listeners.log.info(where(settings.host, listener.port))
-        supervisor = Multiprocess(config, sockets=[listener])  # type: ignore[list-item]  # a socket in a worker
+            sock = config.bind_socket()
+        except SystemExit:  # uvicorn logged the OSError
+            log.error(
+                "cannot listen on %s:%d: the address is in use, or not this machine's", settings.host, settings.port
+            )
+            raise SystemExit(STARTUP_FAILURE) from None
+        log.info(where(settings.host, sock.getsockname()[1]))
+        supervisor = Multiprocess(config, sockets=[sock])
         try:
             supervisor.run()
         except KeyboardInterrupt:
             pass
         finally:
-            listener.close()
+            sock.close()
         if any(p.exitcode == STARTUP_FAILURE for p in supervisor.processes):
             raise SystemExit(STARTUP_FAILURE)  # uvicorn's supervisor stops, but would exit 0
 
@@ -289,7 +279,6 @@ def supervised_app() -> Any:
     restarts. The worker asks itself to stop (SIGTERM: requests in flight finish) once its parent is another."""
     import time
 
-    from curve_vae.service import balance
     from curve_vae.service.app import create_app_from_env
 
     supervisor = os.getppid()
@@ -306,8 +295,7 @@ def supervised_app() -> Any:
         os.kill(os.getpid(), signal.SIGTERM)
 
     threading.Thread(target=watch, name="supervisor-watch", daemon=True).start()
-    app = create_app_from_env()
-    return balance.balanced(app, app.state.metrics)
+    return create_app_from_env()
 
 
 def _shared_metrics() -> contextlib.AbstractContextManager[None]:

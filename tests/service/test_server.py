@@ -88,7 +88,7 @@ def test_two_workers(server_factory, model_dir):
     log says once what is served and where the page, the API docs and the metrics are, not once per worker."""
     args = ("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2", "--max-curves", "3")
     server = server_factory(*args, "--log-level", "info")
-    server.wait_ready(listeners=2)
+    server.wait_ready(workers=2)
     r = httpx.post(f"{server.url}/encode", json={"curves": [C] * 4}, timeout=30)
     assert r.status_code == 422 and "at most 3 curves" in r.json()["detail"]
     assert server.stop() == 0
@@ -108,10 +108,10 @@ def test_one_process_says_where_the_page_is(server_factory, model_dir):
 
 
 def test_two_workers_share_the_connections_out(server_factory, model_dir, curves):
-    """Each worker listens on a socket of its own (service.listeners): keep-alive clients that open their
-    connections at once land on both workers, not all on the first to accept (uvicorn's one shared socket)."""
+    """The workers accept from uvicorn's one shared socket: keep-alive clients that open their connections at once
+    land on both workers, not all on the first to accept."""
     server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
-    server.wait_ready(listeners=2)
+    server.wait_ready(workers=2)
     before = server.cpu_seconds()
     body = {"curves": curves(32, 161).tolist()}
     start = threading.Barrier(32)
@@ -124,8 +124,7 @@ def test_two_workers_share_the_connections_out(server_factory, model_dir, curves
     with cf.ThreadPoolExecutor(32) as pool:
         assert all(code == 200 for codes in pool.map(client, range(32)) for code in codes)
     used = sorted(t - before.get(pid, 0.0) for pid, t in server.cpu_seconds().items())
-    # the two workers are the two busiest processes (the supervisor and multiprocessing's tracker are idle); with
-    # 32 connections hashed to 2 sockets, one worker getting 85% of the work has odds under 1 in 10,000
+    # the two workers are the two busiest processes (the supervisor and multiprocessing's tracker are idle)
     assert used[-2] >= 0.15 * (used[-1] + used[-2]), used
     assert server.stop() == 0
 
@@ -134,7 +133,7 @@ def test_workers_stop_when_their_supervisor_is_killed(server_factory, model_dir)
     """SIGKILL to the supervisor: it cannot stop its workers, so each stops itself within seconds (the port is free
     again for a restarted server), rather than serve on as orphans."""
     server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
-    server.wait_ready(listeners=2)
+    server.wait_ready(workers=2)
     workers = [pid for pid in server.pids() if pid != server.proc.pid]
     assert len(workers) >= 2  # the two workers (and multiprocessing's resource tracker)
     server.proc.kill()
@@ -155,10 +154,9 @@ def _gone(pid: int) -> bool:
 
 
 def test_workers_refuse_a_port_another_server_listens_on(server_factory, model_dir):
-    """Each worker's socket is SO_REUSEPORT, which would quietly join another server's workers on the same port and
-    split its connections with it: a second server on a port in use exits 3 instead, naming the address."""
+    """A second server on a port in use exits 3 (uvicorn's code for a failed start), naming the address."""
     first = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
-    first.wait_ready(listeners=2)
+    first.wait_ready(workers=2)
     second = _serve("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2", "--port", str(first.port))
     assert second.returncode == 3
     assert f"cannot listen on 127.0.0.1:{first.port}" in second.stdout + second.stderr
@@ -170,7 +168,7 @@ def test_with_workers_a_scrape_of_any_worker_counts_them_all(server_factory, mod
     """prometheus-client's multiprocess mode: requests answered by either worker show in /metrics wherever the
     scrape lands, the gauges summed over the live workers; the shared directory goes when the server stops."""
     server = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--workers", "2")
-    server.wait_ready(listeners=2)
+    server.wait_ready(workers=2)
     start = threading.Barrier(24)
 
     def client(_: int) -> int:
