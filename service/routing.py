@@ -154,8 +154,6 @@ OPENAPI_BODY = {
     }
 }
 
-Handler = Callable[[Request, Any, list[np.ndarray]], Awaitable[Response]]
-
 
 @dataclass(frozen=True)
 class NpyRoute:

@@ -19,134 +19,57 @@ import sys
 import tempfile
 import threading
 from collections.abc import Iterator
-from typing import Any, TypedDict
+from typing import Any, Literal, TypedDict, get_origin
 
 from pydantic import ValidationError
 
 from curve_vae.inference.choices import choices
 from curve_vae.service.settings import Settings
 
-# (flag, settings field, type, help) in `serve --help`'s groups; the default and variable are appended from Settings.
-_Option = tuple[str, str, Any, str]
-_GROUPS: dict[str, list[_Option]] = {
-    "what everyone sets": [
-        ("--host", "host", str, "interface to listen on; 0.0.0.0 for every interface"),
-        ("--port", "port", int, "TCP port; 0 picks a free one"),
-        (
-            "--model-dir",
-            "model_dir",
-            str,
-            "directory with encoder.onnx, decoder.onnx and manifest.json, or a shipped model's name: default, paper",
-        ),
-        ("--providers", "providers", str, "onnxruntime providers: cpu, cuda (an error where CUDA cannot load) or auto"),
-        ("--workers", "workers", int, "worker processes, each loading its own ONNX sessions; 0: one per CPU"),
-        ("--log-level", "log_level", str, "uvicorn and service log level"),
-        ("--access-log", "access_log", str, "true: log a line per request (uvicorn's access log)"),
-        (
-            "--cors-origins",
-            "cors_origins",
-            str,
-            "comma-separated origins allowed to call from a browser; empty: CORS off",
-        ),
-        ("--priors-dir", "priors_dir", str, "directory of priors fitted with `curve-vae prior` (NAME.npz: prior NAME)"),
-        (
-            "--cache-bytes",
-            "cache_bytes",
-            int,
-            "bytes of the encoding cache (curves posted again skip the encoder); 0: off",
-        ),
-        (
-            "--kernel-cache-seed",
-            "kernel_cache_seed",
-            str,
-            "a numba cache compiled at build (curve-vae warm-up), copied into an empty NUMBA_CACHE_DIR at start",
-        ),
-    ],
-    "limits (what one request may ask; beyond them a 4xx or 5xx that says which)": [
-        ("--max-curves", "max_curves", int, "most curves, latents or interpolants per request"),
-        ("--max-points", "max_points", int, "most points per curve, in and out"),
-        ("--max-body-bytes", "max_body_bytes", int, "larger request bodies are answered 413"),
-        (
-            "--max-stream-curves",
-            "max_stream_curves",
-            int,
-            "most curves in one streamed .npy (POST /augment format npy)",
-        ),
-        ("--max-mesh-triangles", "max_mesh_triangles", int, "most triangles in one POST /revolve mesh"),
-        (
-            "--max-refine-work",
-            "max_refine_work",
-            int,
-            "most refine work in one request: refine × (input points + 300 per curve) + looks × 80 per curve",
-        ),
-        ("--max-queue", "max_queue", int, "requests waiting for an inference slot; beyond them 503 with Retry-After"),
-        ("--request-timeout", "request_timeout", float, "seconds a request may take, queueing included (504); 0: none"),
-    ],
-    "tuning (the defaults suit most machines: measure before changing them, docs/BENCHMARKS.md)": [
-        ("--placement", "placement", str, "model: as the model's manifest says; closest or index whatever it says"),
-        ("--batch-size", "batch_size", int, "curves per ONNX run"),
-        (
-            "--intra-op-threads",
-            "intra_op_threads",
-            int,
-            "onnxruntime threads per inference; 0: the CPU quota shared out",
-        ),
-        ("--inter-op-threads", "inter_op_threads", int, "onnxruntime inter-op threads; 0: onnxruntime's default"),
-        ("--spinning", "spinning", str, "true: onnxruntime threads spin-wait between runs"),
-        (
-            "--inference-concurrency",
-            "inference_concurrency",
-            int,
-            "inferences at once; 0: one per CPU of a worker, at least 2",
-        ),
-        ("--sessions", "sessions", int, "onnxruntime session pairs per worker; 0: one per inference running at once"),
-        ("--micro-batch", "micro_batch", str, "true: gather concurrent requests' graph runs into one run"),
-        ("--micro-batch-rows", "micro_batch_rows", int, "most rows (curves, latents) of one micro-batched run"),
-        ("--micro-batch-wait-ms", "micro_batch_wait_ms", float, "most milliseconds a run waits for others to join it"),
-        (
-            "--coalesce-curves",
-            "coalesce_curves",
-            int,
-            "most curves of concurrent /encode and /reconstruct requests read as one batch; 0: each alone",
-        ),
-        (
-            "--gil-switch-ms",
-            "gil_switch_ms",
-            float,
-            "milliseconds a thread runs Python before another takes the GIL (Python's own: 5)",
-        ),
-    ],
+#: `serve --help`'s groups, by the `flag` each Settings field names (service.settings: EVERYONE, LIMITS, TUNING).
+GROUPS = {
+    "everyone": "what everyone sets",
+    "limits": "limits (what one request may ask; beyond them a 4xx or 5xx that says which)",
+    "tuning": "tuning (the defaults suit most machines: measure before changing them, docs/BENCHMARKS.md)",
 }
-_OPTIONS: list[_Option] = [option for group in _GROUPS.values() for option in group]
-_CHOICES = {
-    name: list(choices(Settings.model_fields[name].annotation)) for name in ("providers", "log_level", "placement")
-}
+
+
+def flagged() -> dict[str, list[str]]:
+    """The Settings fields that have a flag, by group, in the order Settings lists them."""
+    out: dict[str, list[str]] = {group: [] for group in GROUPS}
+    for name, field in Settings.model_fields.items():
+        extra = field.json_schema_extra
+        if isinstance(extra, dict) and extra.get("flag") in out:
+            out[str(extra["flag"])].append(name)
+    return out
+
+
+def _argument(name: str) -> dict[str, Any]:
+    """argparse's keywords for a Settings field's flag: its type, choices and help (default and variable appended)."""
+    field = Settings.model_fields[name]
+    kind = field.annotation if field.annotation in (int, float) else str  # the rest pydantic reads from text
+    default = field.get_default(call_default_factory=True)
+    default_text = ",".join(default) if isinstance(default, list) else default
+    default_text = "none" if default_text in ("", None) else default_text
+    values = list(choices(field.annotation)) if get_origin(field.annotation) is Literal else None
+    text = f"{field.description} (default: {default_text}; env CURVE_VAE_{name.upper()})"
+    return {"dest": name, "type": kind, "default": None, "choices": values, "help": text}
 
 
 def configure_parser(parser: argparse.ArgumentParser) -> None:
-    """Add the serve options to `parser` (the `serve` subcommand's parser)."""
+    """Add the serve options to `parser` (the `serve` subcommand's parser): a flag a Settings field that has one."""
     parser.usage = "%(prog)s [--host HOST] [--port PORT] [--model-dir DIR] [--workers N] [options]"
-    fields = Settings.model_fields
-    for title, options in _GROUPS.items():
-        group = parser.add_argument_group(title)
-        for flag, name, kind, text in options:
-            field = fields[name]
-            default = field.get_default(call_default_factory=True)
-            default_text = ",".join(default) if isinstance(default, list) else default
-            default_text = "none" if default_text in ("", None) else default_text
-            group.add_argument(
-                *([flag, "--model"] if name == "model_dir" else [flag]),
-                dest=name,
-                type=kind,
-                default=None,
-                choices=_CHOICES.get(name),
-                help=f"{text} (default: {default_text}; env CURVE_VAE_{name.upper()})",
-            )
+    for group_name, names in flagged().items():
+        group = parser.add_argument_group(GROUPS[group_name])
+        for name in names:
+            flag = "--" + name.replace("_", "-")
+            group.add_argument(*([flag, "--model"] if name == "model_dir" else [flag]), **_argument(name))
 
 
 def settings_from_args(args: argparse.Namespace) -> Settings:
     """Settings from the environment, overridden by the flags that were given."""
-    overrides = {name: getattr(args, name) for _, name, _, _ in _OPTIONS if getattr(args, name, None) is not None}
+    names = [name for group in flagged().values() for name in group]
+    overrides = {name: getattr(args, name) for name in names if getattr(args, name, None) is not None}
     return Settings(**overrides)
 
 

@@ -47,6 +47,21 @@ def lint(layout: Path) -> subprocess.CompletedProcess[str]:
     )
 
 
+def _checkout_modules() -> dict[str, Path]:
+    """Every module of the package in this checkout, by its dotted name: its file."""
+    mapped = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-dir"]
+    roots = {"curve_vae": ROOT / "curve_vae", **{n: ROOT / p for n, p in mapped.items()}}
+    out = {}
+    for name, root in roots.items():
+        for path in root.rglob("*.py"):
+            parts = [p for p in path.relative_to(root).with_suffix("").parts if p != "__init__"]
+            out.setdefault(".".join([name, *parts]), path)
+    return out
+
+
+MODULES = _checkout_modules()
+
+
 @pytest.fixture(scope="module")
 def layout(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return installed_layout(tmp_path_factory.mktemp("layout"))
