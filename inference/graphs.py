@@ -1,4 +1,6 @@
-"""One exported model's two ONNX graphs as the runtime runs them: opened, checked and warmed up, then run raw.
+"""One exported model's ONNX graphs as the runtime runs them, the encoder and decoder and the learned parts beside
+them (the reading ranker, the spacing guesser): opened, checked and warmed up, then run raw, each run counted and a
+cancellation checkpoint.
 
 `ModelGraphs.open(model_dir, manifest)` opens one encoder/decoder session pair per inference thread
 (`inference.sessions`), checks the graphs' signatures against the manifest and runs a warm-up. `encode_model` and
@@ -29,7 +31,7 @@ from typing import Self
 import numpy as np
 import onnxruntime as ort
 
-from curve_vae.errors import CancelledWork
+from curve_vae.errors import CancelledWork, InvalidInput
 from curve_vae.geometry import clamped_uniform_knots
 from curve_vae.inference import batching
 from curve_vae.inference.manifest import ENCODER_OUTPUTS, Manifest, ModelLoadError, decoder_outputs
@@ -60,6 +62,7 @@ class ModelGraphs:
         self.n_ctrl = spline.n_ctrl if spline else 0
         self.has_params = bool(spline and spline.learned_params)
         self.rows = {"encoder": 0, "decoder": 0}  # rows each graph has run: what requests cost, for /metrics
+        self.parts: dict[str, tuple[ort.InferenceSession, str]] = {}  # learned parts: one shared session each
         encoder, decoder = pool.pairs[0]
         self._enc_in = encoder.get_inputs()[0].name
         self._dec_in = decoder.get_inputs()[0].name
@@ -178,6 +181,37 @@ class ModelGraphs:
             return batcher.run(graph, x, outputs)
         return session.run(outputs, {self._enc_in if graph == "encoder" else self._dec_in: x})
 
+    def add_part(self, name: str, path: str | Path, *, shape: tuple[int | None, ...], sessions: SessionConfig) -> None:
+        """Open a learned part's graph (the reading ranker, the spacing guesser: exported by training/parts.py) beside
+        the model's, on the providers they run on: one session every inference thread shares, whose input must be
+        (batch, *shape) (None: any size); else InvalidInput saying what it takes. A numpy .npz of weights (a model
+        from before 0.14.0) is refused with how to convert it."""
+        path = Path(path)
+        if path.suffix == ".npz":
+            raise InvalidInput(
+                "numpy weights, which this runtime no longer reads: convert them to ONNX with "
+                f"`curve-vae {path.stem} export {path} --model-dir {path.parent} --force` (the training extra)"
+            )
+        try:
+            session = ort.InferenceSession(str(path), sess_options=sessions.options(), providers=self.providers)
+        except Exception as e:  # onnxruntime raises its own exception types
+            raise InvalidInput(f"onnxruntime cannot open it: {e}") from e
+        inp = session.get_inputs()[0]
+        got = [d if isinstance(d, int) else None for d in inp.shape]
+        want = [None, *shape]
+        if len(got) != len(want) or any(w is not None and g != w for g, w in zip(got, want)):
+            raise InvalidInput(f"its graph takes {_shape(got)}; this part takes {_shape(want)}")
+        self.parts[name] = (session, inp.name)
+        self.rows[name] = 0
+
+    def run_part(self, name: str, inputs: np.ndarray) -> np.ndarray:
+        """A learned part's output for (batch, …) float32 inputs; as every run of a graph, counted in `rows` and, first,
+        a cancellation checkpoint."""
+        checkpoint()
+        session, input_name = self.parts[name]
+        self.rows[name] += len(inputs)
+        return session.run(None, {input_name: np.ascontiguousarray(inputs, np.float32)})[0]
+
     def decode_model(self, latents: np.ndarray) -> np.ndarray:
         """(B, latent_dim) -> (B, n_points, 2) in the model plane."""
         return self.decode(latents)[0]
@@ -194,6 +228,10 @@ class ModelGraphs:
         empty = (np.zeros((0, self.n_points, 2)), np.zeros((0, self.n_ctrl, 2)), np.zeros((0, self.n_points)))
         curves, ctrl, params = (np.concatenate(p) if p else e.astype(np.float32) for p, e in zip(parts, empty))
         return curves, ctrl if self.has_splines else None, params if self.has_params else None
+
+
+def _shape(dims: list[int | None]) -> str:
+    return "(" + ", ".join("any" if d is None else str(d) for d in dims) + ")"
 
 
 class Cancelled(CancelledWork):

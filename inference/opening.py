@@ -65,13 +65,13 @@ def open_model(
         root,
         manifest.ranker,
         "reading ranker",
-        lambda p: Ranker.load(p, n_points=manifest.n_points, providers=graphs.providers, sessions=part_sessions),
+        lambda p: Ranker.load(p, graphs, sessions=part_sessions),
     )
     spacer = _load_part(
         root,
         manifest.spacer,
         "spacing guesser",
-        lambda p: Spacer.load(p, providers=graphs.providers, sessions=part_sessions),
+        lambda p: Spacer.load(p, graphs, sessions=part_sessions),
     )
     closest = None if placement == "model" else placement == "closest"
     cache = EncodingCache(cache_bytes) if cache_bytes > 0 else None

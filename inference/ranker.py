@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.inference.learned import PartGraph
+from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.sessions import SessionConfig
 
 RANKER_KIND = "conv1d-3x5s2-meanmax-v1"
@@ -40,12 +40,14 @@ def ranker_inputs(points: np.ndarray) -> np.ndarray:
 class Ranker:
     """The ranker's graph (ranker.onnx, exported from training/ranker.py's RankerNet) and the scores it gives."""
 
-    def __init__(self, graph: PartGraph) -> None:
-        self.graph = graph
+    def __init__(self, graphs: ModelGraphs) -> None:
+        self.graphs = graphs  # runs "ranker"
 
     @classmethod
-    def load(cls, path: str | Path, *, n_points: int, providers: list[str], sessions: SessionConfig) -> Ranker:
-        return cls(PartGraph.open(path, shape=(4, n_points), providers=providers, sessions=sessions))
+    def load(cls, path: str | Path, graphs: ModelGraphs, *, sessions: SessionConfig) -> Ranker:
+        """The ranker at `path`, opened beside `graphs` (ModelGraphs.add_part: its input (batch, 4, n_points))."""
+        graphs.add_part("ranker", path, shape=(4, graphs.n_points), sessions=sessions)
+        return cls(graphs)
 
     def scores(self, points: np.ndarray) -> np.ndarray:
         """(k, n, 2) model-plane points -> (k,) predicted natural log of each reading's relative RMSE; SCORE_CHUNK
@@ -53,5 +55,8 @@ class Ranker:
         if len(points) == 0:
             return np.zeros(0)
         return np.concatenate(
-            [self.graph.run(ranker_inputs(points[i : i + SCORE_CHUNK])) for i in range(0, len(points), SCORE_CHUNK)]
+            [
+                self.graphs.run_part("ranker", ranker_inputs(points[i : i + SCORE_CHUNK]))
+                for i in range(0, len(points), SCORE_CHUNK)
+            ]
         ).astype(np.float64)

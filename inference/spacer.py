@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.geometry.batch import arc_fractions_of, arc_grids
-from curve_vae.inference.learned import PartGraph
+from curve_vae.inference.graphs import ModelGraphs
 from curve_vae.inference.sessions import SessionConfig
 
 SPACER_KIND = "dilated-conv1d-cumsoftmax-v1"
@@ -49,17 +49,19 @@ def spacer_inputs(grid: np.ndarray) -> np.ndarray:
 class Spacer:
     """The guesser's graph (spacer.onnx, exported from training/spacer.py's SpacerNet) and the guesses it gives."""
 
-    def __init__(self, graph: PartGraph) -> None:
-        self.graph = graph
+    def __init__(self, graphs: ModelGraphs) -> None:
+        self.graphs = graphs  # runs "spacer"
 
     @classmethod
-    def load(cls, path: str | Path, *, providers: list[str], sessions: SessionConfig) -> Spacer:
-        return cls(PartGraph.open(path, shape=(3, GRID), providers=providers, sessions=sessions))
+    def load(cls, path: str | Path, graphs: ModelGraphs, *, sessions: SessionConfig) -> Spacer:
+        """The guesser at `path`, opened beside `graphs` (ModelGraphs.add_part: its input (batch, 3, GRID))."""
+        graphs.add_part("spacer", path, shape=(3, GRID), sessions=sessions)
+        return cls(graphs)
 
     def grid_params(self, inputs: np.ndarray) -> np.ndarray:
         """(k, 3, GRID) spacer_inputs -> (k, GRID) parameters from 0 to 1 at the grid's points (the graph's rising
         cumulative sum, made to end at 1 exactly)."""
-        u = self.graph.run(inputs).astype(np.float64)
+        u = self.graphs.run_part("spacer", inputs).astype(np.float64)
         return u / u[:, -1:]
 
     def guesses(self, curves: Sequence[np.ndarray]) -> list[np.ndarray]:

@@ -12,6 +12,8 @@ from curve_vae.errors import InvalidInput
 from curve_vae.geometry import arc_length_params, random_control_points, sample_bspline
 from curve_vae.geometry.bspline import evaluate_bspline
 from curve_vae.inference import reader as reader_module
+from curve_vae.inference.graphs import Cancelled, CancelToken, ModelGraphs, cancellable
+from curve_vae.inference.manifest import Manifest
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.inference.sessions import SessionConfig
@@ -66,14 +68,31 @@ def test_guesses_rise_from_0_to_1_at_each_curves_own_points_and_follow_the_shape
 
 
 def test_a_graph_of_another_shape_or_numpy_weights_are_refused(tmp_path: Path):
+    graphs = ModelGraphs.open(MODELS, Manifest.read(MODELS), providers="cpu", warm_up=False)
     with pytest.raises(InvalidInput, match=r"its graph takes \(any, 161, 2\); this part takes \(any, 3, 128\)"):
-        Spacer.load(MODELS / "encoder.onnx", providers=["CPUExecutionProvider"], sessions=SessionConfig())
+        Spacer.load(MODELS / "encoder.onnx", graphs, sessions=SessionConfig())
     old = save_npz(tmp_path / "spacer.npz", SPACER_KIND, spacer_weights())
     with pytest.raises(InvalidInput, match=f"curve-vae spacer export {old} --model-dir {tmp_path} --force"):
-        Spacer.load(old, providers=["CPUExecutionProvider"], sessions=SessionConfig())
+        Spacer.load(old, graphs, sessions=SessionConfig())
     (tmp_path / "broken.onnx").write_bytes(b"not a graph")
     with pytest.raises(InvalidInput, match="onnxruntime cannot open it"):
-        Spacer.load(tmp_path / "broken.onnx", providers=["CPUExecutionProvider"], sessions=SessionConfig())
+        Spacer.load(tmp_path / "broken.onnx", graphs, sessions=SessionConfig())
+    assert "spacer" not in graphs.parts  # nothing half-opened is left behind
+
+
+def test_the_learned_parts_run_as_the_model_graphs_do_counted_and_cancellable(shipped_runtime):
+    """The ranker and the guesser run through the model's ModelGraphs: their rows counted beside the encoder's and
+    the decoder's, and a cancelled request stops before their run."""
+    graphs = shipped_runtime.graphs
+    assert set(graphs.parts) == {"ranker", "spacer"}
+    before = dict(graphs.rows)
+    guesses = shipped_runtime.reader.spacer.guesses([np.stack([np.linspace(0, 1, 30), np.linspace(0, 1, 30) ** 2], 1)])
+    assert len(guesses) == 1 and graphs.rows["spacer"] == before["spacer"] + 1
+    token = CancelToken()
+    token.cancel("the client disconnected")
+    with cancellable(token), pytest.raises(Cancelled, match="the client disconnected"):
+        shipped_runtime.reader.ranker.scores(np.zeros((3, graphs.n_points, 2)))
+    assert graphs.rows["ranker"] == before["ranker"]
 
 
 def test_the_shipped_guesser_puts_the_papers_curves_drawn_by_arc_length_near_their_own_parameters(shipped_runtime):
