@@ -101,9 +101,20 @@ class Reader:
     def read(
         self, curves: Sequence[np.ndarray], reading: Reading, *, decoded: bool = True, shared: bool = False
     ) -> Prepared:
-        """Each curve read as `reading` (resolved: no "auto") says. decoded: also decode each latent and, for a model
-        placed closest, place the caller's points on the spline (an encoding alone needs neither). shared: the
-        curves are a set that is mixed together (interpolated, augmented), read in one pose (`_shared`)."""
+        """Each curve read as `reading` (resolved: no "auto") says, in these steps:
+
+        1. the encoding cache: a curve read before the same way comes back as it was read (`_cached`);
+        2. candidates, ranked, encoded: each new curve's poses and spacings, the ranker's first for pose "learned",
+           encoded; where several remain, each decoded and the closest kept (`_fresh`);
+        3. looked at again: z ← z + E(x) − E(D(z)), a step kept where it brings the answer closer (`_looked`);
+        4. refined: the latents fitted closer (`_refined`, inference.fitting);
+        5. decoded and placed: each caller point's parameter on its spline (`_decoded`);
+        6. finished: the ends kept, and an answer that crosses itself where its input does not untangled (`_finish`);
+        7. kept in the cache.
+
+        The runtime takes the rows back to the caller's frame (inference.placing). decoded: also decode each latent
+        and, for a model placed closest, place the caller's points on the spline (an encoding alone needs neither).
+        shared: the curves are a set that is mixed together (interpolated, augmented), read in one pose."""
         inputs = [np.asarray(c, np.float64) for c in curves]
         shared = (
             shared
@@ -111,44 +122,54 @@ class Reader:
             and reading.frame != "model"
             and reading.pose in ("canonical", "search", "learned")
         )
-        key = f"{reading.key}/{'closest' if self.closest else 'index'}/{'ends' if self.keep_ends else 'decoded'}"
-        if shared:  # a curve's pose depends on its set: kept apart from its pose alone, per set
-            key += "/set/" + EncodingCache.key(np.concatenate(inputs), str([len(c) for c in inputs])).hex()
-        keys = [EncodingCache.key(c, key) for c in inputs] if self.cache is not None else []
-        rows: list[ReadCurve | None] = (
-            [self.cache.get(k) for k in keys] if self.cache is not None else [None] * len(inputs)
-        )
-        todo = [i for i, r in enumerate(rows) if r is None]
+        keys, cached = self._cached(inputs, reading, shared=shared)
+        todo = [i for i, r in enumerate(cached) if r is None]
         if shared and todo:  # the set's pose is chosen for all its curves at once
             todo = list(range(len(inputs)))
-        new = self._fresh([inputs[i] for i in todo], todo, reading, shared=shared)
-        earlier: dict[int, list[ReadCurve]] = {i: [] for i in todo}  # each row before its looks, before refine
-        if reading.looks > 0 and new:
-            before, new = self._looked([inputs[i] for i in todo], new, reading.looks)
-            for i, row in zip(todo, before):
-                earlier[i].insert(0, row)
+        fresh = [inputs[i] for i in todo]
+        new = self._fresh(fresh, todo, reading, shared=shared)
+        earlier: list[list[ReadCurve]] = [[] for _ in new]  # each new row before its steps, the latest first
+        new = self._looked(fresh, new, reading.looks, earlier)
+        new = self._refined(fresh, new, reading.refine, earlier)
+        read = list(cached)
         for i, row in zip(todo, new):
+            read[i] = row
+        rows: list[ReadCurve] = [r for r in read if r is not None]  # every row now: cached or read just now
+        missing = [i for i, r in enumerate(rows) if not r.decoded_yet] if decoded or self.closest else []
+        for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [rows[i] for i in missing])[0]):
             rows[i] = row
-        read = [r for r in rows if r is not None]  # every row now: cached or read just now
-        if reading.refine > 0 and todo:  # cached rows were cached refined: the reading's key counts the steps
-            if self.fitter is None or not self.graphs.has_splines:
-                raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
-            for i, row in zip(
-                todo, self.fitter.refine([inputs[i] for i in todo], [read[i] for i in todo], reading.refine)
-            ):
-                earlier[i].insert(0, read[i])
-                read[i] = row
-        missing: list[int] = []
-        if decoded or self.closest:
-            missing = [i for i, r in enumerate(read) if not r.decoded_yet]
-            for i, row in zip(missing, self._decoded([inputs[i] for i in missing], [read[i] for i in missing])[0]):
-                read[i] = row
         # rows read or decoded just now (cached rows were finished when they were read)
-        self._finish(inputs, read, sorted(set(todo) | set(missing)), earlier)
+        self._finish(inputs, rows, sorted(set(todo) | set(missing)), dict(zip(todo, earlier)))
         if self.cache is not None:
-            for k, row in zip(keys, read):
+            for k, row in zip(keys, rows):
                 self.cache.put(k, row)
-        return Prepared(inputs, read, ends_kept=self.keep_ends)
+        return Prepared(inputs, rows, ends_kept=self.keep_ends)
+
+    def _cached(
+        self, inputs: list[np.ndarray], reading: Reading, *, shared: bool
+    ) -> tuple[list[bytes], list[ReadCurve | None]]:
+        """Each curve's cache key (none without a cache) and its row where the cache holds one: keyed by its bytes,
+        the reading, the placement and the ends; a curve of a shared set by its set too (its pose depends on it)."""
+        if self.cache is None:
+            return [], [None] * len(inputs)
+        key = f"{reading.key}/{'closest' if self.closest else 'index'}/{'ends' if self.keep_ends else 'decoded'}"
+        if shared:
+            key += "/set/" + EncodingCache.key(np.concatenate(inputs), str([len(c) for c in inputs])).hex()
+        keys = [EncodingCache.key(c, key) for c in inputs]
+        return keys, [self.cache.get(k) for k in keys]
+
+    def _refined(
+        self, inputs: list[np.ndarray], rows: list[ReadCurve], steps: int, earlier: list[list[ReadCurve]]
+    ) -> list[ReadCurve]:
+        """The rows after `steps` refine steps (inference.fitting), each row before them put first in its
+        `earlier`; the rows as they are for 0 steps (cached rows were cached refined: the reading's key counts them)."""
+        if steps <= 0 or not rows:
+            return rows
+        if self.fitter is None or not self.graphs.has_splines:
+            raise InputError(("refine",), "refining needs a model with a B-spline head; this model has none")
+        for before, row in zip(earlier, rows):
+            before.insert(0, row)
+        return self.fitter.refine(inputs, rows, steps)
 
     # ----------------------------------------------------------------------------------- candidates
 
@@ -269,15 +290,20 @@ class Reader:
         return out
 
     def _looked(
-        self, inputs: list[np.ndarray], rows: list[ReadCurve], steps: int
-    ) -> tuple[list[ReadCurve], list[ReadCurve]]:
-        """The rows decoded (where they are not yet), and after `steps` looks again (inference.looking)."""
+        self, inputs: list[np.ndarray], rows: list[ReadCurve], steps: int, earlier: list[list[ReadCurve]]
+    ) -> list[ReadCurve]:
+        """The rows after `steps` looks again (inference.looking), each row before them (decoded) put first in its
+        `earlier`; the rows as they are for 0 steps."""
+        if steps <= 0 or not rows:
+            return rows
         todo = [i for i, r in enumerate(rows) if not r.decoded_yet or r.distance is None]
         rows = list(rows)
         for i, row in zip(todo, self._decoded([inputs[i] for i in todo], [rows[i] for i in todo])[0]):
             rows[i] = row
+        for before, row in zip(earlier, rows):
+            before.insert(0, row)
         err = np.array([r.distance for r in rows], np.float64)
-        return rows, look_again(self.graphs, inputs, rows, err, steps, self._decoded)[0]
+        return look_again(self.graphs, inputs, rows, err, steps, self._decoded)[0]
 
     def _finish(
         self, inputs: list[np.ndarray], read: list[ReadCurve], fresh: list[int], earlier: dict[int, list[ReadCurve]]
