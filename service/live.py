@@ -48,6 +48,19 @@ def listening_sockets(port: int) -> int | None:
 READY_TIMEOUT = 180.0
 
 
+def _workers(args: list[str], env: dict[str, str]) -> int:
+    """How many workers a server started with `args` in `env` runs: its --workers, or CURVE_VAE_WORKERS; 0 (the
+    default) is one a CPU, as the server counts them (inference.cpus)."""
+    count = env.get("CURVE_VAE_WORKERS", "0")
+    if "--workers" in args[:-1]:
+        count = args[args.index("--workers") + 1]
+    if count.isdigit() and int(count) > 0:
+        return int(count)
+    from curve_vae.inference.cpus import available_cpus
+
+    return available_cpus()
+
+
 class LiveServer:
     """The service in a subprocess on a free loopback port; `wait_ready` polls GET /ready until it answers 200."""
 
@@ -64,6 +77,7 @@ class LiveServer:
         self.url = f"http://127.0.0.1:{self.port}"
         base = list(command) if command is not None else [sys.executable, "-m", "curve_vae.service.server"]
         self.cmd = [*base, "--port", str(self.port), "--log-level", log_level, *args]
+        self.workers = _workers(list(args), {**os.environ, **(env or {})})
         out = subprocess.PIPE if capture else None
         self._printed: str | None = None
         self.proc = subprocess.Popen(
@@ -100,11 +114,12 @@ class LiveServer:
         except subprocess.TimeoutExpired:
             self._printed = ""
 
-    def wait_ready(self, timeout: float = READY_TIMEOUT, *, workers: int = 1) -> None:
-        """Poll /ready until 200. Each of `workers` warms up on its own, and a new connection reaches any one of them:
-        with several, 4 × `workers` new connections in a row must each answer 200 (a worker still warming up is
-        missed by all of them once in 2^8 starts, for two). RuntimeError (with the server's output) if it exits,
-        TimeoutError if it is slow."""
+    def wait_ready(self, timeout: float = READY_TIMEOUT, *, workers: int | None = None) -> None:
+        """Poll /ready until 200. Each of `workers` (default: as many as the server starts) warms up on its own, and
+        a new connection reaches any one of them: with several, 4 × `workers` new connections in a row must each
+        answer 200 (a worker still warming up is missed by all of them once in 2^8 starts, for two). RuntimeError
+        (with the server's output) if it exits, TimeoutError if it is slow."""
+        workers = self.workers if workers is None else workers
         deadline = time.monotonic() + timeout
         in_a_row = 0
         while time.monotonic() < deadline:
