@@ -35,7 +35,7 @@ STAGES = {
     "the two graphs (onnxruntime)": [("graphs.py", "_run_graph")],
     "placement on the spline": [("matching.py", "ordered_closest_params")],
     "canonical frame": [("frame.py", "canonical_frame"), ("batch.py", "canonical_frames")],
-    "to the model plane": [("reader.py", "_model_points"), ("reader.py", "_targets")],
+    "to the model plane": [("reading.py", "model_points"), ("placing.py", "model_targets")],
     "back to the caller, MSE": [("placing.py", "to_caller"), ("placing.py", "placed_to_caller")],
 }
 ONE_PASS = Reading(pose="canonical", spacing="parameter")

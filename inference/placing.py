@@ -11,7 +11,7 @@ from typing import Protocol
 
 import numpy as np
 
-from curve_vae.geometry import Frame, mse_per_curve, polyline_to_caller, spline_to_caller
+from curve_vae.geometry import Frame, mse_per_curve, ordered_closest_params, polyline_to_caller, spline_to_caller
 from curve_vae.geometry.adapt import F32_MAX, is_closed, joined_ends
 from curve_vae.geometry.batch import FrameRows, Ragged
 from curve_vae.geometry.bspline import spline_values
@@ -178,6 +178,34 @@ def closed_rows(out: np.ndarray, ctrl: np.ndarray | None) -> tuple[np.ndarray, n
     rows = [joined(o, None if ctrl is None else ctrl[i]) for i, o in enumerate(out)]
     closed_out = np.stack([o for o, _ in rows]).astype(np.float32)
     return closed_out, None if ctrl is None else np.stack([c for _, c in rows if c is not None]).astype(np.float32)
+
+
+def model_targets(inputs: Sequence[np.ndarray], frames: Sequence[Frame | None], model_size: float) -> list[np.ndarray]:
+    """Each caller curve in the model plane, through its frame: all at once where every curve has one (the points a
+    decoded spline is placed against)."""
+    given = [f for f in frames if f is not None]
+    if frames and len(given) == len(frames):  # every curve has a frame
+        curves = Ragged.of(list(inputs))
+        return curves.split(FrameRows.of(given).to_model(curves, model_size))
+    return [f.to_model(p, model_size) if f is not None else p for f, p in zip(frames, inputs)]
+
+
+def placed_again(
+    inputs: Sequence[np.ndarray], rows: list[ReadCurve], *, model_size: float, degree: int
+) -> list[ReadCurve]:
+    """Rows placed on their splines (closest placement), each caller point placed again on its spline as it is now
+    (its ends moved, below)."""
+    have = [i for i, r in enumerate(rows) if r.feet is not None and r.ctrl is not None]
+    if not have:
+        return rows
+    ctrl = np.stack([rows[i].ctrl for i in have])  # type: ignore[misc]
+    targets = model_targets([inputs[i] for i in have], [rows[i].frame for i in have], model_size)
+    with np.errstate(all="ignore"):
+        feet, err = ordered_closest_params(ctrl, targets, degree=degree)
+    out = list(rows)
+    for k, i in enumerate(have):
+        out[i] = dataclasses.replace(rows[i], feet=feet[k], distance=float(err[k]))
+    return out
 
 
 # Answers that keep their inputs' ends (geometry.ends): a reconstruction starts and ends where its input does, an

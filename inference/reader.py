@@ -29,8 +29,6 @@ from curve_vae.geometry import (
 )
 from curve_vae.geometry.adapt import COINCIDENT, coincident
 from curve_vae.geometry.batch import (
-    FrameRows,
-    Ragged,
     canonical_frames,
     pose_frames_of,
     shared_canonical_frames,
@@ -41,7 +39,7 @@ from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.graphs import ModelGraphs, checkpoint
 from curve_vae.inference.looking import look_again
-from curve_vae.inference.placing import pinned_rows, untangle_rows
+from curve_vae.inference.placing import model_targets, pinned_rows, placed_again, untangle_rows
 from curve_vae.inference.prepared import EncodingCache, Prepared, ReadCurve
 from curve_vae.inference.ranker import RANKED_READS, Ranker
 from curve_vae.inference.reading import Candidate, Reading, model_points
@@ -334,27 +332,14 @@ class Reader:
         untangling may move the ends where holding them leaves an answer crossing."""
         size, degree = self.graphs.model_size, self.graphs.spline_degree
         if self.keep_ends:
-            rows = self._placed_again(inputs, pinned_rows(inputs, rows, model_size=size, degree=degree))
+            rows = placed_again(
+                inputs, pinned_rows(inputs, rows, model_size=size, degree=degree), model_size=size, degree=degree
+            )
         if not self.untangle:
             return rows, []
         return untangle_rows(inputs, rows, model_size=size, degree=degree, free_ends=free_ends or not self.keep_ends)
 
     # ----------------------------------------------------------------------------------- decoding, placement
-
-    def _placed_again(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> list[ReadCurve]:
-        """Rows placed on their splines (closest placement), each caller point placed again on its spline as it is
-        now (its ends moved: inference.placing)."""
-        have = [i for i, r in enumerate(rows) if r.feet is not None and r.ctrl is not None]
-        if not have:
-            return rows
-        ctrl = np.stack([rows[i].ctrl for i in have])  # type: ignore[misc]
-        targets = self._targets([inputs[i] for i in have], [rows[i].frame for i in have])
-        with np.errstate(all="ignore"):
-            feet, err = ordered_closest_params(ctrl, targets, degree=self.graphs.spline_degree)
-        out = list(rows)
-        for k, i in enumerate(have):
-            out[i] = dataclasses.replace(rows[i], feet=feet[k], distance=float(err[k]))
-        return out
 
     def _decoded(self, inputs: list[np.ndarray], rows: list[ReadCurve]) -> tuple[list[ReadCurve], np.ndarray]:
         """Rows with their latents decoded and, placed closest, each caller point's parameter on the spline; and each
@@ -366,7 +351,7 @@ class Reader:
             decoded, ctrl, params = g.decode(np.stack([r.mean for r in rows]))
             feet: list[np.ndarray | None] = [None] * len(rows)
             if self.closest and ctrl is not None:
-                targets = self._targets(inputs, [r.frame for r in rows])
+                targets = model_targets(inputs, [r.frame for r in rows], g.model_size)
                 placed, err = ordered_closest_params(ctrl, targets, degree=g.spline_degree)
                 feet = list(placed)
             else:
@@ -384,14 +369,6 @@ class Reader:
             for i, r in enumerate(rows)
         ]
         return out, err
-
-    def _targets(self, inputs: list[np.ndarray], frames: list[Frame | None]) -> list[np.ndarray]:
-        """Each caller curve in the model plane, through its frame: all at once where every curve has one."""
-        given = [f for f in frames if f is not None]
-        if frames and len(given) == len(frames):  # every curve has a frame
-            curves = Ragged.of(inputs)
-            return curves.split(FrameRows.of(given).to_model(curves, self.graphs.model_size))
-        return [f.to_model(p, self.graphs.model_size) if f is not None else p for f, p in zip(frames, inputs)]
 
 
 def replace_repair(row: ReadCurve) -> ReadCurve:

@@ -21,6 +21,7 @@ import numpy as np
 from curve_vae.files import atomic_path
 from curve_vae.geometry.frame import resample, resample_index
 from curve_vae.geometry.metrics import diagonal
+from curve_vae.inference.placing import model_targets
 from curve_vae.inference.reading import Reading, model_points
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.families import RANKER_FAMILIES, TRAIN_FAMILIES, draw_family
@@ -84,7 +85,7 @@ def label(runtime: CurveRuntime, curves: list[np.ndarray]) -> dict[str, np.ndarr
     rows = [ReadCurve(c.frame, m, fr, mu, lv) for c, m, fr, mu, lv in zip(stage, models, fractions, mean, log_var)]
     owner = np.array([c.curve for c in stage], np.int32)
     _, err = reader._decoded([inputs[o] for o in owner], rows)
-    targets = reader._targets([inputs[o] for o in owner], [c.frame for c in stage])
+    targets = model_targets([inputs[o] for o in owner], [c.frame for c in stage], reader.graphs.model_size)
     diag = np.array([diagonal(t) for t in targets])  # in the model plane, where err is
     rel = np.sqrt(err / np.array([len(t) for t in targets])) / diag  # frames are similarities: the caller's ratio
     return {
