@@ -1,4 +1,4 @@
-"""How soon a freshly started service answers: seconds until `/ready` answers 200 (every worker listening), then the
+"""How soon a freshly started service answers: seconds until `/ready` answers 200 (every worker warmed up), then the
 time of each of the first single-curve default requests, each on a new connection (so the workers share them out).
 
     .venv/bin/python scripts/first_request.py                       # an empty numba cache: a new container's start
