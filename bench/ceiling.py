@@ -136,9 +136,9 @@ def breakdown(model_dir: Path, *, seconds: float = 3.0) -> dict[str, float]:
     also parsing and validating the JSON body and rendering the answer. No encoding cache: every curve is read."""
     import orjson
 
+    from curve_vae.inference.model.sessions import SessionConfig
     from curve_vae.inference.reading import Reading
     from curve_vae.inference.runtime import CurveRuntime
-    from curve_vae.inference.sessions import SessionConfig
     from curve_vae.service.limits import check
     from curve_vae.service.routing import JSON
     from curve_vae.service.schemas import ReconstructRequest

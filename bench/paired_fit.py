@@ -22,7 +22,7 @@ import numpy as np
 from bench.revisions import module_at
 from curve_vae.geometry import closeness
 from curve_vae.geometry import natural as fit_now
-from curve_vae.inference.cpus import limit_blas_threads
+from curve_vae.inference.model.cpus import limit_blas_threads
 from curve_vae.inference.runtime import CurveRuntime
 
 ROOT = Path(__file__).resolve().parents[1]

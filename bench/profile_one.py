@@ -24,10 +24,10 @@ from pathlib import Path
 import numpy as np
 
 from bench import ceiling
-from curve_vae.inference.cpus import limit_blas_threads
+from curve_vae.inference.model.cpus import limit_blas_threads
+from curve_vae.inference.model.sessions import SessionConfig
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.inference.sessions import SessionConfig
 
 ROOT = Path(__file__).resolve().parents[1]
 #: stage -> the functions (file suffix, name) whose cumulative time is the stage's
@@ -59,7 +59,7 @@ def measure(
     asked, stages = READINGS[reading]
     rt = CurveRuntime.load(model_dir, sessions=SessionConfig(intra_op_threads=1), cache_bytes=0)
     if blas_threads is not None:
-        limit_blas_threads(blas_threads)  # as the service does (inference/cpus.py)
+        limit_blas_threads(blas_threads)  # as the service does (inference/model/cpus.py)
     plane = ceiling.curves(curves, seed=1)
     one = list(ceiling.callers_curves(plane, seed=1))
     rt.reconstruct(one, asked)

@@ -26,7 +26,7 @@ from typing import Any
 from bench.ceiling import posted
 from bench.revisions import ROOT, SCRATCH
 from bench.serve import NO_CACHE, json_body, machine, wrk
-from curve_vae.inference.cpus import available_cpus
+from curve_vae.inference.model.cpus import available_cpus
 from curve_vae.service.live import LiveServer
 
 #: The folders installed as the package's sub-packages (pyproject.toml's package-dir).

@@ -36,7 +36,7 @@ import numpy as np
 
 from bench import ceiling
 from bench.report import markdown
-from curve_vae.inference.cpus import available_cpus
+from curve_vae.inference.model.cpus import available_cpus
 from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -25,7 +25,7 @@ from bench.ceiling import posted
 from bench.reading_cost import revision_root
 from bench.revisions import ROOT
 from bench.serve import NO_CACHE, json_body, machine, wrk
-from curve_vae.inference.cpus import available_cpus
+from curve_vae.inference.model.cpus import available_cpus
 from curve_vae.service.live import LiveServer
 
 KINDS = ("against", "this")

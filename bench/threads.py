@@ -17,10 +17,10 @@ import time
 from pathlib import Path
 
 from bench import ceiling
-from curve_vae.inference.cpus import limit_blas_threads
+from curve_vae.inference.model.cpus import limit_blas_threads
+from curve_vae.inference.model.sessions import SessionConfig
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.inference.sessions import SessionConfig
 
 ROOT = Path(__file__).resolve().parents[1]
 READINGS = {"default": Reading(), "one-pass": Reading(pose="canonical", spacing="parameter")}

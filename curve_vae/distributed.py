@@ -5,7 +5,8 @@ an actor holding the onnxruntime sessions of a model directory, writing Parquet 
     ray.init()                                   # or ray.init(address="auto") on a cluster
     augment_on_ray(seeds, 10_000_000, seed=1, out="s3://bucket/batch/", concurrency=64, block=65_536)
 
-Item i of the sequence depends on (seed, i) alone (inference.augmenting.AugmentPlan), so the shards hold exactly the
+Item i of the sequence depends on (seed, i) alone (inference.generation.augmenting.AugmentPlan), so the shards hold
+exactly the
 curves `curve-vae augment … --seed 1` and POST /augment make for the same request, however the blocks are cut or
 scheduled. Each shard's rows: `index` (the item's place in the sequence), `curve` (its points, a list of [x, y]
 float32), `sources` and `weights` (its seed curves, anchor first, and their weights) — the schema
@@ -38,11 +39,11 @@ class AugmentActor:
         reading: dict[str, Any],
         n_points: int | None,
     ) -> None:
-        from curve_vae.inference.cpus import limit_blas_threads
+        from curve_vae.inference.model.cpus import limit_blas_threads
         from curve_vae.inference.runtime import CurveRuntime
 
         self.runtime = CurveRuntime.load(model_dir, providers="cpu", intra_op_threads=1, warm_up=False)
-        limit_blas_threads(1)  # one core an actor: numpy's BLAS too (inference/cpus.py)
+        limit_blas_threads(1)  # one core an actor: numpy's BLAS too (inference/model/cpus.py)
         self.plan = self.runtime.plan_augment(
             [np.asarray(c, np.float64) for c in seeds],
             seed=seed,
@@ -97,7 +98,7 @@ def augment_on_ray(
     returns `out`. Needs a running Ray (ray.init)."""
     import ray
 
-    from curve_vae.inference.shipped import model_directory
+    from curve_vae.inference.model.shipped import model_directory
 
     r = reading or Reading()
     blocks = [{"start": s, "stop": min(s + block, count)} for s in range(0, count, block)]

@@ -5,8 +5,8 @@ still a `ValueError`), so code that caught those before still does.
 
     CurveVaeError
     ├── InvalidInput (ValueError)   inference.errors.InputError, geometry.adapt.BeyondFloat32, curvefiles CurveFileError
-    ├── ModelError (RuntimeError)   inference.manifest.ModelLoadError
-    ├── CancelledWork               inference.graphs.Cancelled
+    ├── ModelError (RuntimeError)   inference.model.manifest.ModelLoadError
+    ├── CancelledWork               inference.model.graphs.Cancelled
     ├── ProtocolError               service.oip.OipError
     └── ClientError (RuntimeError)  client.errors.ApiError, RetriesExhausted
 

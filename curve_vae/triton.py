@@ -24,7 +24,7 @@ import numpy as np
 import onnxruntime as ort
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.manifest import Manifest
+from curve_vae.inference.model.manifest import Manifest
 
 #: onnxruntime's tensor types → Triton's data types
 TRITON_TYPES = {"tensor(float)": "TYPE_FP32", "tensor(double)": "TYPE_FP64", "tensor(int64)": "TYPE_INT64"}

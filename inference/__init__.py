@@ -1,7 +1,8 @@
 """The model at inference time, on numpy arrays: no HTTP, no torch.
 
-`CurveRuntime.load(model_dir)` checks a model directory (`manifest`), opens its ONNX graphs (`graphs`, `sessions`)
-and brings any caller's curve to them and back (`runtime`, with `geometry`); sampling from a latent prior
-(`sampling`, `prior`), augmentation (`augmenting`) and the closer fit of `refine` (`fitting`) sit beside it. The REST
-service (`curve_vae.service`), the command line, training's export and evaluation and the client all use it.
+`CurveRuntime.load(model_dir)` checks a model directory, opens its ONNX graphs (`inference.model`: `manifest`,
+`opening`, `graphs`, `sessions`) and brings any caller's curve to them and back: the reading, in this package
+itself (`runtime`, `reading`, `reader`, `placing`, `results`, with `geometry`); new curves from the model
+(`inference.generation`: `sampling`, `prior`, `augmenting`, `exploring`, `mixing`) sit beside it. The REST service
+(`curve_vae.service`), the command line, training's export and evaluation and the client all use it.
 """

@@ -26,7 +26,7 @@ from curve_vae.geometry import arc_fractions, closest_params, params_at_arc_frac
 from curve_vae.inference.prepared import ReadCurve
 
 if TYPE_CHECKING:
-    from curve_vae.inference.graphs import ModelGraphs
+    from curve_vae.inference.model.graphs import ModelGraphs
 
 #: A decoding: curves (B, n_points, 2), control points (B, n_ctrl, 2), learned parameters (B, n_points) or None.
 Decoding = tuple[np.ndarray, np.ndarray, np.ndarray | None]

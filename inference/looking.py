@@ -16,7 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.model.graphs import ModelGraphs
 from curve_vae.inference.prepared import ReadCurve
 
 #: Decodes rows (with their caller curves) and says how far each decoding lies from its input: Reader._decoded.

@@ -18,7 +18,7 @@ from curve_vae.geometry.bspline import spline_values
 from curve_vae.geometry.ends import pinned_ends
 from curve_vae.geometry.validity import crosses, new_crossings, untangled
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.model.graphs import ModelGraphs
 from curve_vae.inference.prepared import Prepared, ReadCurve
 from curve_vae.inference.results import Curves, Spline, head_splines
 

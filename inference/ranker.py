@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.sessions import SessionConfig
+from curve_vae.inference.model.graphs import ModelGraphs
+from curve_vae.inference.model.sessions import SessionConfig
 
 RANKER_KIND = "conv1d-3x5s2-meanmax-v1"
 #: Readings pose "learned" encodes per curve: the ranker's first. With a look again after it, the first alone reads

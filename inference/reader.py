@@ -37,8 +37,8 @@ from curve_vae.geometry.batch import (
 from curve_vae.inference import picking
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
-from curve_vae.inference.graphs import ModelGraphs, checkpoint
 from curve_vae.inference.looking import look_again
+from curve_vae.inference.model.graphs import ModelGraphs, checkpoint
 from curve_vae.inference.placing import model_targets, pinned_rows, placed_again, untangle_rows
 from curve_vae.inference.prepared import EncodingCache, Prepared, ReadCurve
 from curve_vae.inference.ranker import RANKED_READS, Ranker

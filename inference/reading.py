@@ -26,7 +26,7 @@ from curve_vae.geometry.batch import FrameRows, Ragged
 from curve_vae.geometry.frame import resample_index
 from curve_vae.inference.choices import FRAME, LOOKS, POSE, REFINE, SPACING, FrameMode, Option, Pose, Spacing
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.manifest import ReadingSpec
+from curve_vae.inference.model.manifest import ReadingSpec
 
 
 @dataclass(frozen=True)

@@ -29,7 +29,7 @@ from curve_vae.geometry import (
 from curve_vae.inference.errors import InputError
 
 if TYPE_CHECKING:  # exploring's results are built of this module's Spline
-    from curve_vae.inference.exploring import Explored
+    from curve_vae.inference.generation.exploring import Explored
 
 
 @dataclass(frozen=True)

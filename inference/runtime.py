@@ -5,8 +5,8 @@
     mix = rt.interpolate(curves[:2], [[0.5, 0.5]])  # Interpolation
     new = rt.sample(16, seed=0)                   # Sampled
 
-`CurveRuntime.load(model_dir)` checks the manifest and the sha256 of every file (`inference.manifest`), opens the
-sessions (`inference.graphs`) and reads the learned prior. Its methods take numpy arrays and return result objects
+`CurveRuntime.load(model_dir)` checks the manifest and the sha256 of every file (`inference.model.manifest`), opens the
+sessions (`inference.model.graphs`) and reads the learned prior. Its methods take numpy arrays and return result objects
 (`inference.results`), so everything the service does can be used and tested without HTTP:
 
     caller's curve (n, 2) --Reader (frame, pose, spacing; encoder; decoder; placement)--> latent, spline
@@ -27,16 +27,19 @@ from typing import TypeVar
 import numpy as np
 
 from curve_vae.geometry import Frame
-from curve_vae.inference.augmenting import AugmentPlan, augmented, neighbour_pools
 from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.exploring import Explored, explore
 from curve_vae.inference.fitting import Fitter
-from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.manifest import Manifest, ModelLoadError  # noqa: F401  (ModelLoadError: part of its API)
-from curve_vae.inference.mixing import mix
-from curve_vae.inference.named_priors import NamedPrior
-from curve_vae.inference.opening import open_model, warm_up_request
+from curve_vae.inference.generation.augmenting import AugmentPlan, augmented, neighbour_pools
+from curve_vae.inference.generation.exploring import Explored, explore
+from curve_vae.inference.generation.mixing import mix
+from curve_vae.inference.generation.named_priors import NamedPrior
+from curve_vae.inference.generation.prior import LatentPrior
+from curve_vae.inference.generation.sampling import MAX_DRAWS, Sampler
+from curve_vae.inference.model.graphs import ModelGraphs
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError  # noqa: F401  (ModelLoadError: part of its API)
+from curve_vae.inference.model.opening import open_model, warm_up_request
+from curve_vae.inference.model.sessions import SessionConfig
 from curve_vae.inference.placing import (
     check_range,
     decoded_to_caller,
@@ -44,7 +47,6 @@ from curve_vae.inference.placing import (
     placed_to_caller,
 )
 from curve_vae.inference.prepared import DEFAULT_CACHE_BYTES, EncodingCache, Prepared
-from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
@@ -60,8 +62,6 @@ from curve_vae.inference.results import (
     head_splines,
     no_closeness,
 )
-from curve_vae.inference.sampling import MAX_DRAWS, Sampler
-from curve_vae.inference.sessions import SessionConfig
 from curve_vae.inference.spacer import Spacer
 
 DEFAULT = Reading()
@@ -119,7 +119,7 @@ class CurveRuntime:
     ) -> CurveRuntime:
         """Open a model directory; ModelLoadError says what to fix when it cannot serve.
 
-        `sessions` sets threads, spinning and the number of session pairs (inference.sessions); without it, one
+        `sessions` sets threads, spinning and the number of session pairs (inference.model.sessions); without it, one
         pair of `intra_op_threads` threads. `placement`: "model" places a reconstruction's points as the manifest's
         spline.placement says; "closest" or "index" whatever it says (CURVE_VAE_PLACEMENT). `cache_bytes`: the
         encoding cache's bound (0: no cache). `priors_dir`: priors fitted to users' curves (`curve-vae prior`), by
@@ -141,7 +141,8 @@ class CurveRuntime:
 
     def warm_up(self, *, graphs: bool = True) -> None:
         """The graphs' first runs (ModelGraphs.warm_up) and one default request before the first caller's
-        (inference.opening.warm_up_request: the compiled kernels load, or compile on a first start); ModelLoadError
+        (inference.model.opening.warm_up_request: the compiled kernels load, or compile on a first start);
+        ModelLoadError
         where either fails."""
         if graphs:
             self.graphs.warm_up()
@@ -320,7 +321,8 @@ class CurveRuntime:
         spacing: str = "parameter",
         frame: Frame | None = None,
     ) -> Sampled:
-        """New curves from a latent distribution (inference.sampling), in the model plane or mapped into `frame`."""
+        """New curves from a latent distribution (inference.generation.sampling), in the model plane or mapped into
+        `frame`."""
         return self.sampler.sample(
             count,
             seed=seed,
@@ -346,7 +348,8 @@ class CurveRuntime:
         n_points: int | None = None,
     ) -> Explored:
         """Curves around `curve`: its latent mean moved along the `directions` principal directions of a latent
-        distribution (inference.exploring), a grid of `steps` offsets per direction from −spread to spread standard
+        distribution (inference.generation.exploring), a grid of `steps` offsets per direction from −spread to spread
+        standard
         deviations, decoded in the curve's own frame. The middle of the grid is the curve's own reconstruction."""
         return explore(self, curve, reading, steps=steps, spread=spread, directions=directions, prior=prior,
                        n_points=n_points)  # fmt: skip
@@ -369,7 +372,8 @@ class CurveRuntime:
     def augment(
         self, plan: AugmentPlan, start: int, stop: int, *, n_points: int | None = None, spacing: str = "parameter"
     ) -> Augmented:
-        """Items start … stop-1 of the plan's sequence, each free of self-crossings (inference.augmenting)."""
+        """Items start … stop-1 of the plan's sequence, each free of self-crossings
+        (inference.generation.augmenting)."""
         length = self.mix_length(plan.prep, n_points)
         return augmented(self.graphs, plan, start, stop, n_points=n_points, spacing=spacing, length=length)
 

@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from curve_vae.geometry.batch import arc_fractions_of, arc_grids
-from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.sessions import SessionConfig
+from curve_vae.inference.model.graphs import ModelGraphs
+from curve_vae.inference.model.sessions import SessionConfig
 
 SPACER_KIND = "dilated-conv1d-cumsoftmax-v1"
 #: Points a curve is read at, evenly spaced along its length.

@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from bench.ceiling import posted  # noqa: E402
-from curve_vae.inference.cpus import available_cpus  # noqa: E402
+from curve_vae.inference.model.cpus import available_cpus  # noqa: E402
 from service.live import LiveServer  # noqa: E402
 
 

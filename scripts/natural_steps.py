@@ -21,8 +21,8 @@ import time
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # one core, as the service's inference threads run
 
 from curve_vae.inference import reader  # noqa: E402
+from curve_vae.inference.model.sessions import SessionConfig  # noqa: E402
 from curve_vae.inference.runtime import CurveRuntime  # noqa: E402
-from curve_vae.inference.sessions import SessionConfig  # noqa: E402
 from curve_vae.training.suite import paper_test_split, run_suite, suite_sets  # noqa: E402
 
 SEARCH = {"pose": "search", "spacing": "search"}

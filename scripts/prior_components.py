@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from curve_vae.inference.manifest import file_sha256
-from curve_vae.inference.prior import PRIOR_FILE
+from curve_vae.inference.generation.prior import PRIOR_FILE
+from curve_vae.inference.model.manifest import file_sha256
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.data import DataConfig, default_cache, generate_curves, load_or_generate
 from curve_vae.training.evaluate import sample_quality

@@ -36,9 +36,10 @@ from fastapi import FastAPI
 from fastapi.exceptions import RequestValidationError
 from starlette.exceptions import HTTPException
 
-from curve_vae.inference.batching import GraphBatcher
-from curve_vae.inference.batching import attach as attach_batcher
-from curve_vae.inference.cpus import (
+from curve_vae.inference.errors import InputError
+from curve_vae.inference.model.batching import GraphBatcher
+from curve_vae.inference.model.batching import attach as attach_batcher
+from curve_vae.inference.model.cpus import (
     available_cpus,
     coalescing_readers,
     inference_slots,
@@ -46,9 +47,8 @@ from curve_vae.inference.cpus import (
     session_config,
     worker_count,
 )
-from curve_vae.inference.errors import InputError
-from curve_vae.inference.manifest import ModelLoadError
-from curve_vae.inference.opening import compiled_kernels
+from curve_vae.inference.model.manifest import ModelLoadError
+from curve_vae.inference.model.opening import compiled_kernels
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.deps import runtime_coalescer
 from curve_vae.service.errors import on_http_error, on_input_error, on_validation_error
@@ -178,7 +178,7 @@ async def _load_runtime(settings: Settings, slots: int) -> CurveRuntime:
     except ModelLoadError as e:
         log.error("cannot serve the model: %s", e)
         raise
-    # numpy's and scipy's BLAS get one inference's threads too (inference/cpus.py), now that both are loaded
+    # numpy's and scipy's BLAS get one inference's threads too (inference/model/cpus.py), now that both are loaded
     log.info("BLAS: %d threads an inference", limit_blas_threads(config.intra_op_threads))
     return runtime
 

@@ -20,7 +20,7 @@ from fastapi import Depends, Request
 from fastapi.responses import Response
 from starlette.exceptions import HTTPException
 
-from curve_vae.inference.graphs import Cancelled, CancelToken, cancellable
+from curve_vae.inference.model.graphs import Cancelled, CancelToken, cancellable
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.results import Encoding, Reconstruction, split_encoding, split_reconstruction
 from curve_vae.inference.runtime import CurveRuntime
@@ -68,7 +68,8 @@ RuntimeDep = Annotated[CurveRuntime, Depends(_runtime)]
 
 async def in_executor(request: Request, fn: Callable[..., T], *args: Any, token: CancelToken | None = None) -> T:
     """`fn(*args)` on one of the app's inference threads (at most one inference per slot at once, first come
-    first served), under `token` when given: cancelled, the work stops at its next checkpoint (inference.graphs)."""
+    first served), under `token` when given: cancelled, the work stops at its next checkpoint
+    (inference.model.graphs)."""
 
     def run() -> T:
         if token is None:
@@ -183,7 +184,8 @@ async def run_inference(
 #   sharing one core cost more than one of both (measured: single-curve requests on 16 connections, 132 requests/s
 #   with a batch per inference thread, 156 with one per worker; docs/BENCHMARKS.md).
 # - A failing batch (a bad curve in one job) is run again job by job, so an error names its own request's curve.
-# - A batch is cancelled only when every job in it is (each job's token, inference.graphs); a job abandoned before it
+# - A batch is cancelled only when every job in it is (each job's token, inference.model.graphs); a job abandoned
+# before it
 #   was taken is never read.
 # - Answers equal the lone request's to rounding: onnxruntime may round a batch's rows differently, so where two
 #   candidate readings tie to float32 rounding either may be kept.

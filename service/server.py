@@ -249,9 +249,9 @@ def run(args: argparse.Namespace) -> int:
     """Start the server; returns the exit status (2: bad configuration, 3: the app failed to start)."""
     import uvicorn
 
-    from curve_vae.inference.cpus import worker_count
-    from curve_vae.inference.manifest import Manifest, ModelLoadError
-    from curve_vae.inference.sessions import resolve_providers
+    from curve_vae.inference.model.cpus import worker_count
+    from curve_vae.inference.model.manifest import Manifest, ModelLoadError
+    from curve_vae.inference.model.sessions import resolve_providers
 
     try:
         settings = settings_from_args(args)
@@ -266,7 +266,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"curve-vae serve: error: {e}", file=sys.stderr)
         return 2
     if settings.kernel_cache_seed is not None:  # before the workers start: they load what it holds
-        from curve_vae.inference.opening import seed_kernel_cache
+        from curve_vae.inference.model.opening import seed_kernel_cache
 
         seeded = seed_kernel_cache(settings.kernel_cache_seed)
         if seeded:

@@ -16,7 +16,7 @@ from pydantic import Field, field_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 from curve_vae.inference.choices import Placement, Providers
-from curve_vae.inference.shipped import SHIPPED, model_directory
+from curve_vae.inference.model.shipped import SHIPPED, model_directory
 
 #: The `curve-vae serve --help` group of a field with a flag (`json_schema_extra`; service.server.GROUPS): what
 #: everyone sets, the limits of one request, tuning. A field without one (API keys, metrics) is set by environment only.
@@ -40,7 +40,8 @@ class Settings(BaseSettings):
     port: int = Field(
         default=8000, ge=0, le=65535, description="TCP port; 0 picks a free one", json_schema_extra=EVERYONE
     )
-    # encoder.onnx, decoder.onnx and manifest.json; or a shipped model's name: "default", "paper" (inference/shipped.py)
+    # encoder.onnx, decoder.onnx and manifest.json; or a shipped model's name: "default", "paper"
+    # (inference/model/shipped.py)
     model_dir: Path = Field(
         default=SHIPPED,
         description="directory with encoder.onnx, decoder.onnx and manifest.json, or a shipped model's name: default, "
@@ -53,7 +54,8 @@ class Settings(BaseSettings):
         description="onnxruntime providers: cpu, cuda (an error where CUDA cannot load) or auto",
         json_schema_extra=EVERYONE,
     )
-    # uvicorn worker processes, each with its own ONNX sessions; 0: one per CPU this process may use (inference/cpus.py)
+    # uvicorn worker processes, each with its own ONNX sessions; 0: one per CPU this process may use
+    # (inference/model/cpus.py)
     workers: int = Field(
         default=0,
         ge=0,
@@ -163,7 +165,7 @@ class Settings(BaseSettings):
     # curves per ONNX run: large requests are split to bound memory
     batch_size: int = Field(default=64, ge=1, description="curves per ONNX run", json_schema_extra=TUNING)
     # onnxruntime threads per inference; 0: the CPUs this process may use (cgroup quota, affinity) shared out among
-    # workers × inference_concurrency (inference/cpus.py): no run spreads over more cores than a container's quota
+    # workers × inference_concurrency (inference/model/cpus.py): no run spreads over more cores than a container's quota
     intra_op_threads: int = Field(
         default=0,
         ge=0,
@@ -181,7 +183,8 @@ class Settings(BaseSettings):
     spinning: bool = Field(
         default=False, description="true: onnxruntime threads spin-wait between runs", json_schema_extra=TUNING
     )
-    # inferences running at once = threads of the inference executor; 0: cpus ÷ workers, at least 2 (inference/cpus.py)
+    # inferences running at once = threads of the inference executor; 0: cpus ÷ workers, at least 2
+    # (inference/model/cpus.py)
     inference_concurrency: int = Field(
         default=0,
         ge=0,
@@ -195,7 +198,7 @@ class Settings(BaseSettings):
         description="onnxruntime session pairs per worker; 0: one per inference running at once",
         json_schema_extra=TUNING,
     )
-    # Micro-batching (inference/batching.py): concurrent requests' graph runs gathered into one run of at most
+    # Micro-batching (inference/model/batching.py): concurrent requests' graph runs gathered into one run of at most
     # micro_batch_rows rows, waiting at most micro_batch_wait_ms for company. Off: slower on this CPU
     # (docs/BENCHMARKS.md); on a GPU turn it on.
     micro_batch: bool = Field(

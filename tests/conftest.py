@@ -32,7 +32,8 @@ SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}
 
 @pytest.fixture(autouse=True)
 def blas_threads_restored() -> Iterator[None]:
-    """A started app caps numpy's BLAS threads process-wide (inference/cpus.py); each test gets back what it had."""
+    """A started app caps numpy's BLAS threads process-wide (inference/model/cpus.py); each test gets back what it
+    had."""
     with threadpool_limits(limits=None, user_api="blas"):
         yield
 

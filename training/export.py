@@ -27,7 +27,8 @@ from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_path
 from curve_vae.geometry import canonical_frame, clamped_uniform_knots
 from curve_vae.inference.choices import SplinePlacement, choices
-from curve_vae.inference.manifest import (
+from curve_vae.inference.generation.prior import PRIOR_FILE, LatentPrior
+from curve_vae.inference.model.manifest import (
     DECODER_INPUT,
     ENCODER_INPUT,
     ENCODER_OUTPUTS,
@@ -36,7 +37,6 @@ from curve_vae.inference.manifest import (
     decoder_outputs,
     file_entry,
 )
-from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
 from curve_vae.training.checkpoint import save_weights
 from curve_vae.training.model import VAE, ModelConfig
 

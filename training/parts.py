@@ -14,7 +14,7 @@ from torch import nn
 
 from curve_vae.errors import InvalidInput
 from curve_vae.files import atomic_write_text
-from curve_vae.inference.manifest import file_sha256
+from curve_vae.inference.model.manifest import file_sha256
 from curve_vae.training.export import export_graph
 
 

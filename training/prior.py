@@ -1,4 +1,5 @@
-"""Fit the learned latent distribution (inference/prior.py) to the latent means of training curves, at export.
+"""Fit the learned latent distribution (inference/generation/prior.py) to the latent means of training curves, at
+export.
 
 A full-covariance Gaussian mixture: 8 components bring the share of self-intersecting samples
 from 25% (one Gaussian) to 14% and the samples' nearest-neighbour distances to the real curves'
@@ -12,10 +13,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.generation.prior import LatentPrior
 
 if TYPE_CHECKING:
-    from curve_vae.inference.named_priors import NamedPrior
+    from curve_vae.inference.generation.named_priors import NamedPrior
     from curve_vae.inference.reading import Reading
     from curve_vae.inference.runtime import CurveRuntime
 
@@ -102,13 +103,14 @@ def fit_named_prior(
     seed: int = 0,
     source: str = "",
 ) -> NamedPrior:
-    """The NamedPrior (inference/named_priors.py) of a user's curves: read as `prior_reading` says, with `refine`
+    """The NamedPrior (inference/generation/named_priors.py) of a user's curves: read as `prior_reading` says, with
+    `refine`
     fitting steps, a mixture over their latents — `kind` "parzen" (fit_parzen) or "gmm" (`components`, or chosen by
     BIC) — and the reference statistics its samples are placed and judged by."""
     from curve_vae.geometry import self_intersects
     from curve_vae.geometry.adapt import is_closed, joined_ends
     from curve_vae.geometry.frame import MODEL_CENTER
-    from curve_vae.inference.named_priors import NamedPrior, Reference, frames_array, model_identity
+    from curve_vae.inference.generation.named_priors import NamedPrior, Reference, frames_array, model_identity
 
     reading = prior_reading(runtime.reading(), refine)
     prep = runtime.prepare(curves, reading)

@@ -28,8 +28,8 @@ from curve_vae.progress import bar, counted, shown
 
 def cmd_sample(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import write_output
+    from curve_vae.inference.generation.sampling import fresh_seed
     from curve_vae.inference.results import sample_body, with_output
-    from curve_vae.inference.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
     seed = fresh_seed() if a.seed is None else a.seed
@@ -71,7 +71,7 @@ def _sample_body_of(made: Any, output: str, metrics: bool) -> dict[str, Any]:
 def cmd_augment(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curves, write_output
     from curve_vae.files import write_npy_chunks
-    from curve_vae.inference.sampling import fresh_seed
+    from curve_vae.inference.generation.sampling import fresh_seed
 
     refuse_overwrite(a.output, a.force)
     reading_fields(a)  # a reading outside its options is named before the seed curves are read

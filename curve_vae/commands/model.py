@@ -149,7 +149,7 @@ def _print_measures(report: dict) -> None:
 
 
 def cmd_triton(a: argparse.Namespace) -> int:
-    from curve_vae.inference.shipped import model_directory
+    from curve_vae.inference.model.shipped import model_directory
     from curve_vae.triton import smoke_test, write_repository
 
     folders = write_repository(
@@ -286,9 +286,9 @@ def cmd_warm_up(a: argparse.Namespace) -> None:
     """Compile the reading's kernels into numba's cache, as a first start of the service would."""
     import time
 
-    from curve_vae.inference.opening import compiled_kernels
+    from curve_vae.inference.model.opening import compiled_kernels
+    from curve_vae.inference.model.shipped import model_directory
     from curve_vae.inference.runtime import CurveRuntime
-    from curve_vae.inference.shipped import model_directory
 
     where, missing = compiled_kernels()
     start = time.perf_counter()

@@ -9,7 +9,7 @@ from typing import Any
 from curve_vae.curvefiles.help import OUTPUT_HELP
 from curve_vae.errors import InvalidInput
 from curve_vae.inference.choices import Providers, choices
-from curve_vae.inference.cpus import available_cpus
+from curve_vae.inference.model.cpus import available_cpus
 from curve_vae.inference.reading import Reading, reading_options
 from curve_vae.training.mixes import MIX_VERSION, MIXES
 
@@ -165,9 +165,9 @@ def reading_fields(a: argparse.Namespace) -> dict[str, Any]:
 
 
 def model_runtime(a: argparse.Namespace, priors_dir: Path | None = None):
-    from curve_vae.inference.cpus import limit_blas_threads
+    from curve_vae.inference.model.cpus import limit_blas_threads
+    from curve_vae.inference.model.shipped import model_directory
     from curve_vae.inference.runtime import CurveRuntime
-    from curve_vae.inference.shipped import model_directory
 
     model_dir = model_directory(a.model_dir)
     flag: str | None = getattr(a, "priors_dir", "") or None  # --priors-dir, where the command has it
@@ -176,7 +176,8 @@ def model_runtime(a: argparse.Namespace, priors_dir: Path | None = None):
         model_dir, providers=a.providers, batch_size=a.batch_size, warm_up=False, priors_dir=priors
     )
     # numpy's BLAS on one thread, as a Ray job's actors run it: more threads only cost CPU on the reading's small
-    # products (inference/cpus.py), and their float32 rounding differs, which can tip a near-tie between two readings
+    # products (inference/model/cpus.py), and their float32 rounding differs, which can tip a near-tie between two
+    # readings
     # of a curve, so that a command and a Ray job of the same curves would not write the same answer
     limit_blas_threads(1)
     return runtime

@@ -50,7 +50,7 @@ def cmd_prior(a: argparse.Namespace) -> int:
 def cmd_evaluate_prior(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import read_curve_files
     from curve_vae.evaluation.prior_report import evaluate_prior, format_report
-    from curve_vae.inference.named_priors import NamedPrior
+    from curve_vae.inference.generation.named_priors import NamedPrior
 
     for path in (a.out, a.figure):  # before the evaluation's minutes, not after
         if path:

@@ -13,10 +13,10 @@ import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import Response, StreamingResponse
 
-from curve_vae.inference.augmenting import AugmentPlan
+from curve_vae.inference.generation.augmenting import AugmentPlan
+from curve_vae.inference.generation.sampling import fresh_seed
 from curve_vae.inference.results import augment_body, explore_body, sample_body, with_output
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.inference.sampling import fresh_seed
 from curve_vae.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
 from curve_vae.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service import api_docs as docs

@@ -10,7 +10,7 @@ from fastapi.responses import JSONResponse, Response
 from starlette.exceptions import HTTPException
 
 from curve_vae import __version__
-from curve_vae.inference.cpus import blas_threads
+from curve_vae.inference.model.cpus import blas_threads
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service import responses as r
 from curve_vae.service.api_docs import curl_sample, error_docs

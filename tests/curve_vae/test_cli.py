@@ -21,7 +21,7 @@ from curve_vae.client import ApiError
 from curve_vae.curvefiles import read_curves
 from curve_vae.errors import InvalidInput
 from curve_vae.geometry import random_control_points, sample_bspline
-from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.model.manifest import ModelLoadError
 from tests.helpers import FIXTURES, ROOT, SHIPPED
 
 FILES = FIXTURES / "files"
@@ -87,7 +87,7 @@ def test_revolve_takes_the_body_the_endpoint_takes(tmp_path):
 
 def test_the_papers_model_is_reachable_by_name_from_anywhere(tmp_path, monkeypatch):
     """`--model paper` names the model shipped inside the package, whatever the working directory."""
-    from curve_vae.inference.shipped import NAMED, model_directory
+    from curve_vae.inference.model.shipped import NAMED, model_directory
     from curve_vae.service.settings import Settings
 
     monkeypatch.chdir(tmp_path)

@@ -13,8 +13,8 @@ from curve_vae.client.errors import ApiError, RetriesExhausted
 from curve_vae.curvefiles.common import CurveFileError
 from curve_vae.geometry.adapt import BeyondFloat32
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.graphs import Cancelled
-from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.model.graphs import Cancelled
+from curve_vae.inference.model.manifest import ModelLoadError
 from curve_vae.service.oip import OipError
 from tests.test_layers import MODULES
 

@@ -1,10 +1,10 @@
-"""inference.graphs: a cancelled request stops at its next graph run."""
+"""inference.model.graphs: a cancelled request stops at its next graph run."""
 
 from __future__ import annotations
 
 import pytest
 
-from curve_vae.inference.graphs import Cancelled, CancelToken, cancellable, checkpoint
+from curve_vae.inference.model.graphs import Cancelled, CancelToken, cancellable, checkpoint
 from tests.helpers import bspline_curves
 
 

@@ -12,7 +12,7 @@ import pytest
 
 from curve_vae.inference import picking
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError, file_entry
 from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, ranker_inputs
 from curve_vae.inference.reading import Reading, model_points
 from curve_vae.inference.runtime import CurveRuntime

@@ -7,7 +7,7 @@ import pytest
 
 from curve_vae.errors import InvalidInput
 from curve_vae.inference.choices import MAX_REFINE_STEPS
-from curve_vae.inference.manifest import ReadingSpec
+from curve_vae.inference.model.manifest import ReadingSpec
 from curve_vae.inference.reading import Reading, reading_options
 
 

@@ -14,7 +14,7 @@ import pytest
 
 from curve_vae.geometry import blend_frames, evaluate_bspline, fit_frame, mse_per_curve, simplex_grid
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.model.manifest import ModelLoadError
 from curve_vae.inference.reader import Reader
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime

@@ -12,11 +12,11 @@ from curve_vae.errors import InvalidInput
 from curve_vae.geometry import arc_length_params, random_control_points, sample_bspline
 from curve_vae.geometry.bspline import evaluate_bspline
 from curve_vae.inference import reader as reader_module
-from curve_vae.inference.graphs import Cancelled, CancelToken, ModelGraphs, cancellable
-from curve_vae.inference.manifest import Manifest
+from curve_vae.inference.model.graphs import Cancelled, CancelToken, ModelGraphs, cancellable
+from curve_vae.inference.model.manifest import Manifest
+from curve_vae.inference.model.sessions import SessionConfig
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.inference.sessions import SessionConfig
 from curve_vae.inference.spacer import GRID, SPACER_KIND, Spacer, on_grid, spacer_inputs
 from tests.helpers import natural_fits_asked
 from tests.parts import save_npz, spacer_weights, with_spacer

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.model.manifest import ModelLoadError
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings
 
@@ -33,7 +33,7 @@ def test_the_lifespan_loads_the_model_and_fails_loudly(make_client, tmp_path):
 
 def test_the_shipped_model_is_served_by_default(shipped_runtime, curves):
     """Default settings serve models/; its checksums pass and it keeps the frame behaviour of item 3."""
-    from curve_vae.inference.shipped import SHIPPED
+    from curve_vae.inference.model.shipped import SHIPPED
 
     with TestClient(create_app(Settings(providers="cpu"))) as client:
         info = client.get("/model").json()

@@ -107,7 +107,7 @@ def test_the_shipped_model_is_placed_closest_and_comes_back_closer_so(shipped_ru
 
 
 def test_the_server_setting_overrides_the_manifest(model_dir, raw_model_dir, closest_runtime):
-    from curve_vae.inference.manifest import ModelLoadError
+    from curve_vae.inference.model.manifest import ModelLoadError
     from curve_vae.inference.runtime import CurveRuntime
 
     c = _user_curves()[4]

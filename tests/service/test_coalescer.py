@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.graphs import Cancelled
+from curve_vae.inference.model.graphs import Cancelled
 from curve_vae.inference.reading import Reading
 from curve_vae.service.deps import Coalescer, encode_key, reconstruct_key, runtime_coalescer
 

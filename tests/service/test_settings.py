@@ -51,7 +51,7 @@ def test_api_keys_never_show_in_the_settings_repr():
 
 @pytest.mark.parametrize("name", ["default", "paper"])
 def test_a_shipped_models_name_is_its_directory(name):
-    from curve_vae.inference.shipped import SHIPPED
+    from curve_vae.inference.model.shipped import SHIPPED
 
     expected = SHIPPED if name == "default" else SHIPPED / name
     assert Settings(model_dir=name).model_dir.resolve() == expected.resolve()

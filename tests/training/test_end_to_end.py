@@ -12,7 +12,7 @@ import pytest
 import torch
 
 from curve_vae.cli import main
-from curve_vae.inference.manifest import file_sha256
+from curve_vae.inference.model.manifest import file_sha256
 from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
 
 pytestmark = pytest.mark.slow

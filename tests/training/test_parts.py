@@ -15,7 +15,7 @@ import torch
 from torch import nn
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.manifest import Manifest, file_sha256
+from curve_vae.inference.model.manifest import Manifest, file_sha256
 from curve_vae.training.parts import read_weights, write_part
 
 

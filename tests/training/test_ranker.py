@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import torch
 
-from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError, file_entry
 from curve_vae.inference.ranker import RANKED_READS, RANKER_KIND, ranker_inputs
 from curve_vae.inference.reading import Reading
 from curve_vae.inference.runtime import CurveRuntime

@@ -13,7 +13,7 @@ import pytest
 import torch
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.manifest import Manifest, ModelLoadError, file_entry
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError, file_entry
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.inference.spacer import GRID, SPACER_KIND
 from curve_vae.training.spacer import SpacerNet, export_spacer, paper_examples, train_spacer

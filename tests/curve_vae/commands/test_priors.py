@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from curve_vae.cli import main
-from curve_vae.inference.named_priors import NamedPrior
+from curve_vae.inference.generation.named_priors import NamedPrior
 
 
 @pytest.fixture

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from curve_vae.cli import main
-from curve_vae.inference.manifest import Manifest
+from curve_vae.inference.model.manifest import Manifest
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import shutil
 from pathlib import Path
 
 from curve_vae.cli import main
-from curve_vae.inference.manifest import Manifest
+from curve_vae.inference.model.manifest import Manifest
 
 
 def test_train_then_export_and_the_export_keeps_a_models_guesser_unless_forced(

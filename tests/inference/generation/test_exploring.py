@@ -1,11 +1,12 @@
-"""inference/exploring.py: the principal directions of the latent distribution, the grid of offsets, the latents."""
+"""inference/generation/exploring.py: the principal directions of the latent distribution, the grid of offsets, the
+latents."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from curve_vae.inference.exploring import grid_offsets, neighbour_latents, principal_directions
-from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.generation.exploring import grid_offsets, neighbour_latents, principal_directions
+from curve_vae.inference.generation.prior import LatentPrior
 
 
 def _mixture(rng: np.random.Generator, k: int = 3, z: int = 5) -> LatentPrior:

@@ -1,4 +1,4 @@
-"""inference.manifest: the model-file contract, read, checked and written as one typed Manifest."""
+"""inference.model.manifest: the model-file contract, read, checked and written as one typed Manifest."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import shutil
 
 import pytest
 
-from curve_vae.inference.manifest import Manifest, ModelLoadError
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError
 from tests.helpers import SHIPPED
 
 

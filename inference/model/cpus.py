@@ -20,7 +20,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from curve_vae.inference.sessions import SessionConfig
+from curve_vae.inference.model.sessions import SessionConfig
 
 CGROUP = Path("/sys/fs/cgroup")
 

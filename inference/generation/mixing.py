@@ -9,7 +9,7 @@ from curve_vae.geometry import Frame, blend_frames
 from curve_vae.geometry.adapt import is_closed, joined_ends, spline_params
 from curve_vae.geometry.bspline import spline_values
 from curve_vae.geometry.validity import crosses
-from curve_vae.inference.graphs import ModelGraphs
+from curve_vae.inference.model.graphs import ModelGraphs
 from curve_vae.inference.placing import (
     check_finite,
     check_range,

@@ -1,4 +1,5 @@
-"""inference.graphs: one exported model's ONNX graphs as the runtime runs them (the committed untrained fixtures) —
+"""inference.model.graphs: one exported model's ONNX graphs as the runtime runs them (the committed untrained
+fixtures) —
 runs split into batches with the same answers, the B-spline head's points checked against scipy, empty batches, the
 rows counted, and graphs that do not match their manifest refused with what is wrong."""
 
@@ -9,9 +10,9 @@ import onnxruntime as ort
 import pytest
 from scipy.interpolate import BSpline
 
-from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.manifest import Manifest, ModelLoadError
-from curve_vae.inference.sessions import CPU, SessionConfig
+from curve_vae.inference.model.graphs import ModelGraphs
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError
+from curve_vae.inference.model.sessions import CPU, SessionConfig
 from tests.helpers import bspline_curves
 
 ONE_THREAD = SessionConfig(intra_op_threads=1)

@@ -11,8 +11,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from curve_vae.cli import main
-from curve_vae.inference.manifest import ModelLoadError
-from curve_vae.inference.named_priors import NamedPrior
+from curve_vae.inference.generation.named_priors import NamedPrior
+from curve_vae.inference.model.manifest import ModelLoadError
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.settings import Settings

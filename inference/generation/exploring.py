@@ -1,7 +1,8 @@
 """Curves around one curve: its latent moved along the directions the data varies most (the principal directions of
 the latent distribution the samples come from), a small grid a designer can pick from.
 
-The learned prior is a Gaussian mixture (inference/prior.py); its covariance as a whole is the weighted components'
+The learned prior is a Gaussian mixture (inference/generation/prior.py); its covariance as a whole is the weighted
+components'
 covariances plus the spread of their means, Σ = Σ_k w_k (L_k L_kᵀ + μ_k μ_kᵀ) − μ μᵀ. Its leading eigenvectors are
 the directions along which the training curves' latents vary most, and the square roots of their eigenvalues the
 standard deviations along them: an offset of 1 is one standard deviation of the data along that direction. Under
@@ -16,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from curve_vae.geometry.validity import crosses
-from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.generation.prior import LatentPrior
 from curve_vae.inference.results import Spline
 
 

@@ -3,7 +3,7 @@ them (the reading ranker, the spacing guesser): opened, checked and warmed up, t
 cancellation checkpoint.
 
 `ModelGraphs.open(model_dir, manifest)` opens one encoder/decoder session pair per inference thread
-(`inference.sessions`), checks the graphs' signatures against the manifest and runs a warm-up. `encode_model` and
+(`inference.model.sessions`), checks the graphs' signatures against the manifest and runs a warm-up. `encode_model` and
 `decode_model` take and return model-plane arrays in runs of `batch_size`, through the thread's micro-batcher when
 it has one, each run a cancellation checkpoint (below). `CurveRuntime` (inference.runtime) builds the caller's
 frames, lengths and poses on top.
@@ -33,9 +33,9 @@ import onnxruntime as ort
 
 from curve_vae.errors import CancelledWork, InvalidInput
 from curve_vae.geometry import clamped_uniform_knots
-from curve_vae.inference import batching
-from curve_vae.inference.manifest import ENCODER_OUTPUTS, Manifest, ModelLoadError, decoder_outputs
-from curve_vae.inference.sessions import SessionConfig, SessionPool, open_pair, resolve_providers
+from curve_vae.inference.model import batching
+from curve_vae.inference.model.manifest import ENCODER_OUTPUTS, Manifest, ModelLoadError, decoder_outputs
+from curve_vae.inference.model.sessions import SessionConfig, SessionPool, open_pair, resolve_providers
 
 
 class ModelGraphs:

@@ -1,11 +1,12 @@
-"""inference.shipped: the shipped models by name and how a model directory is named on the command line — a name, a
+"""inference.model.shipped: the shipped models by name and how a model directory is named on the command line — a
+name, a
 path, or nothing (the default), a directory of a shipped model's name in the working directory winning over it."""
 
 from pathlib import Path
 
 import pytest
 
-from curve_vae.inference.shipped import NAMED, SHIPPED, model_directory
+from curve_vae.inference.model.shipped import NAMED, SHIPPED, model_directory
 from tests.helpers import ROOT
 
 

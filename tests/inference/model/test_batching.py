@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from prometheus_client import CollectorRegistry
 
-from curve_vae.inference.batching import GraphBatcher
+from curve_vae.inference.model.batching import GraphBatcher
 from tests.helpers import together
 
 BATCHING = {"micro_batch": True, "micro_batch_rows": 16, "micro_batch_wait_ms": 30.0}

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from curve_vae.inference.manifest import ModelLoadError
-from curve_vae.inference.prior import PRIOR_FILE, LatentPrior
+from curve_vae.inference.generation.prior import PRIOR_FILE, LatentPrior
+from curve_vae.inference.model.manifest import ModelLoadError
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.training.evaluate import nearest_distances, sample_quality
 

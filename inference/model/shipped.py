@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 #: The shipped models' directory: `models/` beside the inference package (in a checkout and in an install).
-SHIPPED = Path(__file__).resolve().parent.parent / "models"
+SHIPPED = Path(__file__).resolve().parents[2] / "models"
 #: Names of the shipped models.
 NAMED = {"default": SHIPPED, "paper": SHIPPED / "paper"}
 

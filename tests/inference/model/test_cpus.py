@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-from curve_vae.inference import cpus
+from curve_vae.inference.model import cpus
 from curve_vae.service.settings import Settings
 
 
@@ -84,7 +84,7 @@ def test_inference_slots_default_to_one_per_cpu_of_a_worker_and_at_least_two(cpu
 
 
 def test_the_service_loads_its_sessions_with_those_threads(make_client, monkeypatch):
-    monkeypatch.setattr("curve_vae.inference.cpus.available_cpus", lambda root=None: 6)
+    monkeypatch.setattr("curve_vae.inference.model.cpus.available_cpus", lambda root=None: 6)
     client = make_client(share_runtime=False, providers="cpu", workers=1, inference_concurrency=3)
     assert client.get("/ready").status_code == 200
     runtime = client.app.state.runtime

@@ -1,4 +1,5 @@
-"""inference.augmenting: who may be mixed with whom (`neighbour_pools`: nearest latent means, or every other curve)
+"""inference.generation.augmenting: who may be mixed with whom (`neighbour_pools`: nearest latent means, or every
+other curve)
 and the seeded rule that draws item i of an augmentation sequence (`AugmentPlan.draw`) — the same item whatever the
 page it is drawn in, its partners distinct and from its anchor's pool, its weights on the simplex."""
 
@@ -7,8 +8,8 @@ import re
 import numpy as np
 import pytest
 
-from curve_vae.inference.augmenting import AugmentPlan, neighbour_pools
 from curve_vae.inference.errors import InputError
+from curve_vae.inference.generation.augmenting import AugmentPlan, neighbour_pools
 from curve_vae.inference.prepared import Prepared
 
 #: latent means on a line (1-D), at distances a reader can check by eye

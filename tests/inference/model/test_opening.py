@@ -1,4 +1,5 @@
-"""inference.opening: a model directory opened into the runtime's parts, and every file beside the graphs that cannot
+"""inference.model.opening: a model directory opened into the runtime's parts, and every file beside the graphs that
+cannot
 serve (a prior or a ranker that is not one, a prior of another latent size, an unknown placement) refused as a
 ModelLoadError or an input error that names the file and the reason."""
 
@@ -12,11 +13,11 @@ import numpy as np
 import pytest
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.manifest import ModelLoadError, file_entry
-from curve_vae.inference.opening import open_model
-from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.generation.prior import LatentPrior
+from curve_vae.inference.model.manifest import ModelLoadError, file_entry
+from curve_vae.inference.model.opening import open_model
+from curve_vae.inference.model.sessions import SessionConfig
 from curve_vae.inference.runtime import CurveRuntime
-from curve_vae.inference.sessions import SessionConfig
 
 OPTIONS = {
     "providers": "cpu",

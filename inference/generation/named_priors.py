@@ -21,8 +21,8 @@ import numpy as np
 from curve_vae.files import atomic_path
 from curve_vae.geometry import Frame, self_intersects
 from curve_vae.geometry.frame import MODEL_CENTER
-from curve_vae.inference.manifest import Manifest, ModelLoadError
-from curve_vae.inference.prior import LatentPrior
+from curve_vae.inference.generation.prior import LatentPrior
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError
 
 NAMED_PRIOR_VERSION = 1
 #: A valid sample reaches no further from the plane's centre than the furthest reference curve × this.

@@ -21,12 +21,12 @@ from curve_vae.errors import InvalidInput, ModelError
 from curve_vae.files import atomic_write_text
 from curve_vae.geometry.frame import MODEL_CENTER
 from curve_vae.inference.choices import ModelPose, ModelSpacing, SplinePlacement, choices
-from curve_vae.inference.prior import PRIOR_FILE
+from curve_vae.inference.generation.prior import PRIOR_FILE
 
 MANIFEST_VERSION = 1
 MANIFEST_FILE = "manifest.json"
 
-#: The graphs' interface, as training/export.py writes it and inference.graphs checks it.
+#: The graphs' interface, as training/export.py writes it and inference.model.graphs checks it.
 ENCODER_INPUT, ENCODER_OUTPUTS = "curves", ("mean", "log_var")  # (B, n_points, 2) -> 2 × (B, latent_dim)
 DECODER_INPUT = "latent"  # (B, latent_dim)
 DECODER_OUTPUTS = ("curves", "control_points", "params")  # the last two with a B-spline head, learned parameters

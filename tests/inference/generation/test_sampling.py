@@ -1,4 +1,5 @@
-"""inference.sampling: new curves from a latent prior through the real (untrained) decoder — item i decided by
+"""inference.generation.sampling: new curves from a latent prior through the real (untrained) decoder — item i decided
+by
 (seed, i) alone, so pages of a sequence are the curves of one larger request; N(0, I) latents as drawn by item i's own
 generator; what counts as a plausible curve (finite, simple, inside the disc); and the priors a request may name."""
 
@@ -6,7 +7,7 @@ import numpy as np
 import pytest
 
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.sampling import Sampler, fresh_seed
+from curve_vae.inference.generation.sampling import Sampler, fresh_seed
 
 CENTER = np.array([64.0, 64.0])
 

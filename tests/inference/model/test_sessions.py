@@ -1,4 +1,5 @@
-"""inference.sessions: onnxruntime sessions as the service opens them — the options read back from onnxruntime, one
+"""inference.model.sessions: onnxruntime sessions as the service opens them — the options read back from onnxruntime,
+one
 encoder/decoder pair per inference thread (round robin, kept), and the errors that say what to fix when a graph or
 a provider cannot be had."""
 
@@ -8,8 +9,15 @@ import onnxruntime as ort
 import pytest
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.manifest import ModelLoadError
-from curve_vae.inference.sessions import CPU, SPINNING_KEYS, SessionConfig, SessionPool, open_pair, resolve_providers
+from curve_vae.inference.model.manifest import ModelLoadError
+from curve_vae.inference.model.sessions import (
+    CPU,
+    SPINNING_KEYS,
+    SessionConfig,
+    SessionPool,
+    open_pair,
+    resolve_providers,
+)
 
 
 def _paths(model_dir):

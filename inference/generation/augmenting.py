@@ -13,11 +13,11 @@ import numpy as np
 
 from curve_vae.inference.choices import SOURCES_PER_MODE
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.mixing import mix
+from curve_vae.inference.generation.mixing import mix
 from curve_vae.inference.results import Augmented, Interpolation
 
 if TYPE_CHECKING:
-    from curve_vae.inference.graphs import ModelGraphs
+    from curve_vae.inference.model.graphs import ModelGraphs
     from curve_vae.inference.prepared import Prepared
 
 #: Draws of one item at most: a mix that crosses itself is drawn again (as /sample redraws), up to this many times.

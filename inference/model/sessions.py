@@ -19,7 +19,7 @@ from typing import Any
 import onnxruntime as ort
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.manifest import ModelLoadError
+from curve_vae.inference.model.manifest import ModelLoadError
 
 CUDA, CPU = "CUDAExecutionProvider", "CPUExecutionProvider"
 

@@ -15,10 +15,10 @@ import numpy as np
 from curve_vae.geometry import Frame, sample_bspline, self_intersects
 from curve_vae.geometry.adapt import joined_ends
 from curve_vae.inference.errors import InputError
-from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.named_priors import NamedPrior
+from curve_vae.inference.generation.named_priors import NamedPrior
+from curve_vae.inference.generation.prior import LatentPrior
+from curve_vae.inference.model.graphs import ModelGraphs
 from curve_vae.inference.placing import closed_rows, decoded_to_caller
-from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.results import Sampled
 
 MAX_DRAWS = 10  # per sampled curve: the shipped prior rejects 25% of draws, so 10 fail with probability ~1e-6;
@@ -52,7 +52,7 @@ class Sampler:
     ):
         self.graphs = graphs
         self.prior = prior
-        self.named = named or {}  # priors fitted to users' curves (inference.named_priors), by name
+        self.named = named or {}  # priors fitted to users' curves (inference.generation.named_priors), by name
         self.disc_center = np.asarray(disc_center, np.float64)
         self.disc_radius = float(disc_radius)
 
@@ -76,8 +76,10 @@ class Sampler:
 
         prior "learned": the Gaussian mixture fitted to the training curves' latent means (the default where the
         model ships one); "standard": the VAE's N(0, I); any other: a prior fitted to a user's curves
-        (inference.named_priors), its validity judged against its own reference curves. temperature scales the spread
-        (see inference/prior.py). valid: a draw whose curve crosses itself or leaves the region of the data is
+        (inference.generation.named_priors), its validity judged against its own reference curves. temperature scales
+        the spread
+        (see inference/generation/prior.py). valid: a draw whose curve crosses itself or leaves the region of the data
+        is
         rejected and item i draws again, at most max_draws times in all. Item i's draws come from its own generator
         default_rng([seed, i]), so the seed decides every curve, across rejections too; `offset` starts the
         sequence at item offset, so pages of it are the curves of one larger request.

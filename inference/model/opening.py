@@ -14,13 +14,13 @@ import numpy as np
 
 from curve_vae.errors import InvalidInput
 from curve_vae.inference.choices import Placement, choices
-from curve_vae.inference.graphs import ModelGraphs
-from curve_vae.inference.manifest import Manifest, ModelLoadError
-from curve_vae.inference.named_priors import load_priors
+from curve_vae.inference.generation.named_priors import load_priors
+from curve_vae.inference.generation.prior import LatentPrior
+from curve_vae.inference.model.graphs import ModelGraphs
+from curve_vae.inference.model.manifest import Manifest, ModelLoadError
+from curve_vae.inference.model.sessions import SessionConfig
 from curve_vae.inference.prepared import EncodingCache
-from curve_vae.inference.prior import LatentPrior
 from curve_vae.inference.ranker import Ranker
-from curve_vae.inference.sessions import SessionConfig
 from curve_vae.inference.spacer import Spacer
 
 if TYPE_CHECKING:  # the runtime is made of what this module opens
