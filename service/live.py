@@ -18,6 +18,7 @@ import time
 import urllib.request
 from collections.abc import Sequence
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Self
 
 
@@ -51,14 +52,12 @@ READY_TIMEOUT = 180.0
 def _workers(args: list[str], env: dict[str, str]) -> int:
     """How many workers a server started with `args` in `env` runs: its --workers, or CURVE_VAE_WORKERS; 0 (the
     default) is one a CPU, as the server counts them (inference.model.cpus)."""
+    from curve_vae.inference.model.cpus import worker_count
+
     count = env.get("CURVE_VAE_WORKERS", "0")
     if "--workers" in args[:-1]:
         count = args[args.index("--workers") + 1]
-    if count.isdigit() and int(count) > 0:
-        return int(count)
-    from curve_vae.inference.model.cpus import available_cpus
-
-    return available_cpus()
+    return worker_count(SimpleNamespace(workers=int(count) if count.isdigit() else 0))
 
 
 class LiveServer:

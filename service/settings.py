@@ -26,17 +26,16 @@ TUNING: dict[str, Any] = {"flag": "tuning"}
 
 
 class Settings(BaseSettings):
-    """Configuration of one service process (every worker reads the same)."""
+    """Configuration of one service process (every worker reads the same). A field's description is its `serve --help`
+    line; a comment above it says what the line has no room for."""
 
     model_config = SettingsConfigDict(env_prefix="CURVE_VAE_", extra="ignore", frozen=True)
 
-    # loopback by default; "0.0.0.0" to listen on every interface
     host: str = Field(
         default="127.0.0.1",
         description="interface to listen on; 0.0.0.0 for every interface",
         json_schema_extra=EVERYONE,
     )
-    # 0 picks a free port
     port: int = Field(
         default=8000, ge=0, le=65535, description="TCP port; 0 picks a free one", json_schema_extra=EVERYONE
     )
@@ -99,18 +98,15 @@ class Settings(BaseSettings):
         "start",
         json_schema_extra=EVERYONE,
     )
-    # curves (or latents, or interpolants) in one request or response
     max_curves: int = Field(
         default=256,
         ge=1,
         description="most curves, latents or interpolants per request",
         json_schema_extra=LIMITS,
     )
-    # points per curve, in and out
     max_points: int = Field(
         default=4096, ge=4, description="most points per curve, in and out", json_schema_extra=LIMITS
     )
-    # larger request bodies get 413
     max_body_bytes: int = Field(
         default=8 << 20,
         ge=1024,
@@ -140,14 +136,12 @@ class Settings(BaseSettings):
         description="most refine work in one request: refine × (input points + 300 per curve) + looks × 80 per curve",
         json_schema_extra=LIMITS,
     )
-    # requests waiting for an inference slot; beyond them: 503 with Retry-After
     max_queue: int = Field(
         default=64,
         ge=0,
         description="requests waiting for an inference slot; beyond them 503 with Retry-After",
         json_schema_extra=LIMITS,
     )
-    # seconds a request may take, queueing included (504); 0: no limit
     request_timeout: float = Field(
         default=60.0,
         ge=0,
@@ -191,7 +185,6 @@ class Settings(BaseSettings):
         description="inferences at once; 0: one per CPU of a worker, at least 2",
         json_schema_extra=TUNING,
     )
-    # encoder/decoder session pairs per worker; 0: one per inference running at once
     sessions: int = Field(
         default=0,
         ge=0,

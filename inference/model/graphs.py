@@ -39,7 +39,8 @@ from curve_vae.inference.model.sessions import SessionConfig, SessionPool, open_
 
 
 class ModelGraphs:
-    """The encoder and decoder sessions of one exported model, and the dimensions its manifest gives them."""
+    """The sessions of one exported model, its encoder's and decoder's (a pair per inference thread) and its learned
+    parts' (`add_part`), and the dimensions its manifest gives them."""
 
     def __init__(
         self,
