@@ -15,6 +15,7 @@ import socket
 import subprocess
 import sys
 import time
+import urllib.error
 import urllib.request
 from collections.abc import Sequence
 from pathlib import Path
@@ -76,7 +77,9 @@ class LiveServer:
         self.url = f"http://127.0.0.1:{self.port}"
         base = list(command) if command is not None else [sys.executable, "-m", "curve_vae.service.server"]
         self.cmd = [*base, "--port", str(self.port), "--log-level", log_level, *args]
-        self.workers = _workers(list(args), {**os.environ, **(env or {})})
+        # the service's workers; another command (a stand-in) is one process unless it says --workers
+        given = command is None or "--workers" in args
+        self.workers = _workers(list(args), {**os.environ, **(env or {})}) if given else 1
         out = subprocess.PIPE if capture else None
         self._printed: str | None = None
         self.proc = subprocess.Popen(
@@ -116,8 +119,8 @@ class LiveServer:
     def wait_ready(self, timeout: float = READY_TIMEOUT, *, workers: int | None = None) -> None:
         """Poll /ready until 200. Each of `workers` (default: as many as the server starts) warms up on its own, and
         a new connection reaches any one of them: with several, 4 × `workers` new connections in a row must each
-        answer 200 (a worker still warming up is missed by all of them once in 2^8 starts, for two). RuntimeError
-        (with the server's output) if it exits, TimeoutError if it is slow."""
+        answer 200, and /metrics must say every worker is ready (`_every_worker_ready`). RuntimeError (with the
+        server's output) if it exits, TimeoutError if it is slow."""
         workers = self.workers if workers is None else workers
         deadline = time.monotonic() + timeout
         in_a_row = 0
@@ -131,10 +134,26 @@ class LiveServer:
                 ready = False
             in_a_row = in_a_row + 1 if ready else 0
             if in_a_row >= (1 if workers <= 1 else 4 * workers):
-                return
+                if workers <= 1 or self._every_worker_ready():
+                    return
+                ready = False
             if not ready:
                 time.sleep(0.1)
         raise TimeoutError(f"{self.url} not ready after {timeout:g} s")
+
+    def _every_worker_ready(self) -> bool:
+        """What /metrics says of the workers (`curve_vae_ready`: the least over the live workers, service.metrics):
+        the workers share one socket, and new connections in a row may all reach the same one. True where the
+        server keeps no metrics."""
+        try:
+            with urllib.request.urlopen(f"{self.url}/metrics", timeout=5) as r:
+                text = r.read().decode()
+        except urllib.error.HTTPError as e:
+            return e.code in (401, 403, 404)  # metrics off, or behind a key: the connections in a row are all there is
+        except OSError:
+            return False
+        values = [line.split()[-1] for line in text.splitlines() if line.startswith("curve_vae_ready ")]
+        return bool(values) and float(values[0]) == 1.0
 
     def pids(self) -> list[int]:
         """The server process and all its descendants (uvicorn's workers), from /proc."""
