@@ -24,7 +24,7 @@ from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.live import LiveServer
 from curve_vae.service.settings import Settings
-from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves, shipped_live_server, wait_ready
+from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves, shipped_live_server, spawn_server, wait_ready
 
 #: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
 SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}
@@ -146,7 +146,7 @@ def server_factory() -> Iterator[Callable[..., LiveServer]]:
     servers: list[LiveServer] = []
 
     def start(*args: str, env: dict[str, str] | None = None) -> LiveServer:
-        servers.append(LiveServer(*args, env=env, cwd=ROOT))
+        servers.append(spawn_server(*args, env=env))
         return servers[-1]
 
     yield start
@@ -162,7 +162,5 @@ def shipped_server() -> Iterator[LiveServer]:
 
 @pytest.fixture(scope="session")
 def live_server(model_dir: Path) -> Iterator[LiveServer]:
-    with LiveServer(
-        "--model-dir", str(model_dir), "--providers", "cpu", "--max-body-bytes", "200000", cwd=ROOT
-    ) as server:
+    with spawn_server("--model-dir", str(model_dir), "--providers", "cpu", "--max-body-bytes", "200000") as server:
         yield server

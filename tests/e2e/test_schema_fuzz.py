@@ -14,8 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from curve_vae.service.live import LiveServer
-from tests.helpers import SHIPPED
+from tests.helpers import SHIPPED, spawn_server
 
 pytestmark = pytest.mark.integration
 
@@ -48,7 +47,7 @@ OIP_CROSS_FIELD_RULES = {
 
 
 def test_schemathesis_finds_nothing_but_the_named_cross_field_rules(tmp_path):
-    server = LiveServer("--model-dir", str(SHIPPED), "--providers", "cpu")
+    server = spawn_server("--model-dir", str(SHIPPED), "--providers", "cpu")
     try:
         server.wait_ready()
         junit = tmp_path / "junit.xml"
