@@ -21,8 +21,8 @@ TINY_DATA = ["--n-train", "256", "--n-val", "64", "--n-test", "64"]
 TINY = {
     "dataset": TINY_DATA,
     "train": [*TINY_DATA, "--epochs", "1", "--no-progress"],
-    "export": ["--prior-components", "2", "--suite-count", "8", "--fresh-count", "64"],
-    "evaluate": ["--fresh-seed", "-1", "--suite-count", "8", "--morph-count", "2"],
+    "export": ["--prior-components", "2", "--suite-count", "2", "--fresh-count", "16"],
+    "evaluate": ["--fresh-seed", "-1", "--suite-count", "2", "--morph-count", "2"],
     "average": ["--bn-curves", "128"],
     "augment": ["--count", "300"],
     "ranker label": ["--curves", "24", "--chunk", "12"],

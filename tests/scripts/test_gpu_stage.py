@@ -18,8 +18,8 @@ def _stage(tmp_path: Path, **settings: str) -> tuple[subprocess.CompletedProcess
         **os.environ,
         "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",  # python3: this interpreter's
         "DEVICE": "cpu",
-        "NTRAIN": "600",
-        "NVAL": "64",
+        "NTRAIN": "512",
+        "NVAL": "32",
         "NTEST": "32",
         "WORKERS": "1",
         "BUDGET": "2",
@@ -41,7 +41,7 @@ def test_a_stage_from_a_checkout_leaves_a_slim_best_checkpoint_and_its_log(tmp_p
     assert done.returncode == 0, done.stdout + done.stderr
     assert "initialised from" in done.stdout and "stage done" in done.stdout
     config = json.loads((out / "config.json").read_text())
-    assert config["data"]["mix_version"] == 2 and config["data"]["n_train"] == 600
+    assert config["data"]["mix_version"] == 2 and config["data"]["n_train"] == 512
     assert config["train"]["device"] == "cpu" and config["train"]["time_budget"] == 2
     assert config["model"]["spline_params"] is True  # from models/vae.pt, its head widened
     assert (out / "log.jsonl").read_text().strip() and (out / "train.log").exists()

@@ -66,7 +66,7 @@ def test_export_parity_and_manifest(trained):
     assert (
         main(
             ["export", "--checkpoint", str(cut / "best.pt"), "--out", str(out), "--data", data, "--version", "9.9.9"]
-            + ["--suite-count", "20", "--fresh-count", "64"]  # the suite: tests/training/test_suite.py
+            + ["--suite-count", "4", "--fresh-count", "16"]  # the suite: tests/training/test_suite.py
         )
         == 0
     )
@@ -75,7 +75,7 @@ def test_export_parity_and_manifest(trained):
     for name, meta in manifest["files"].items():
         assert file_sha256(out / name) == meta["sha256"], name
     assert set(manifest["metrics"]["test_sets"]) == {"test", "fresh_seed_7919"}
-    assert manifest["metrics"]["test_sets"]["fresh_seed_7919"]["n_curves"] == 64  # --fresh-count
+    assert manifest["metrics"]["test_sets"]["fresh_seed_7919"]["n_curves"] == 16  # --fresh-count
     assert manifest["training"]["train"]["epochs"] == 3
 
     model = model_from_checkpoint(cut / "best.pt")
@@ -100,12 +100,12 @@ def test_export_parity_and_manifest(trained):
 def test_evaluate_exported_model(trained, capsys):
     tmp, data, _, _, _ = trained
     out = tmp / "eval"
-    args = ["evaluate", "--model-dir", str(tmp / "models"), "--data", data, "--out", str(out), "--suite-count", "20"]
-    assert main([*args, "--morph-count", "4", "--fresh-count", "64"]) == 0
+    args = ["evaluate", "--model-dir", str(tmp / "models"), "--data", data, "--out", str(out), "--suite-count", "4"]
+    assert main([*args, "--morph-count", "2", "--fresh-count", "16"]) == 0
     printed = capsys.readouterr().out
     assert "test: MSE" in printed and "fresh_seed_7919: MSE" in printed
     report = json.loads((out / "report.json").read_text())
-    assert "morph suite (4 pairs, 7 steps)" in printed and report["morphs"]["pointwise"]["end_drift_max"] < 1e-9
+    assert "morph suite (2 pairs, 7 steps)" in printed and report["morphs"]["pointwise"]["end_drift_max"] < 1e-9
     assert 0 <= report["morphs"]["default"]["share_turning_beyond_limit"] <= 1
     for name in ("test", "fresh_seed_7919"):
         interp = report["test_sets"][name]["interpolation"]
