@@ -42,10 +42,33 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         if SERVER_FIXTURES & set(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.integration)
-    # the longest first (training, then servers and browsers), so that the processes finish together
-    items.sort(
-        key=lambda item: 0 if item.get_closest_marker("slow") else 1 if item.get_closest_marker("integration") else 2
-    )
+    # the longest first, so that the processes finish together: the scopes that take longest (LONGEST), then the
+    # rest of training, then servers and browsers
+    items.sort(key=_longest_first)
+
+
+#: The scopes (a module, or a class of one) that take longest, the longest first: each 30-150 s of one process in a
+#: full run here (`pytest --durations=40`). xdist hands out scopes in this order; one started last would leave the
+#: other process idle at the end.
+LONGEST = (
+    "tests/training/test_end_to_end.py",
+    "tests/test_readme_cli.py::TestTrainingChain",
+    "tests/scripts/test_gpu_stage.py",
+    "tests/service/test_server.py",
+    "tests/test_readme_cli.py::TestOwnCurvesTrainingChain",
+    "tests/bench/test_serve.py",
+    "tests/test_readme_cli.py::TestLearnedPartsChain",
+    "tests/test_wheel.py",
+    "tests/training/test_train.py",
+    "tests/curve_vae/commands/test_train.py",
+)
+
+
+def _longest_first(item: pytest.Item) -> tuple[int, int]:
+    scope = item.nodeid.rsplit("::", 1)[0]
+    rank = LONGEST.index(scope) if scope in LONGEST else len(LONGEST)
+    kind = 0 if item.get_closest_marker("slow") else 1 if item.get_closest_marker("integration") else 2
+    return rank, kind
 
 
 @pytest.fixture(scope="session")
