@@ -2,10 +2,10 @@
 as scipy.optimize returns an OptimizeResult. Arrays are numpy; curves are in the caller's frame unless the call was
 in the model's plane (frames None).
 
-Each result's JSON body is built here too, shared by the REST routes and the offline CLI: `curve-vae
-encode|reconstruct|sample|augment|fit` write exactly what POST /encode, /reconstruct, /sample, /augment and /fit answer
-for the same request. Arrays stay numpy (the service's orjson writes them directly; the CLI's JSON writer turns them
-into lists).
+Each result's JSON body is built here too, as its shape in inference.answers, shared by the REST routes and the
+offline CLI: `curve-vae encode|reconstruct|sample|augment|fit` write exactly what POST /encode, /reconstruct, /sample,
+/augment and /fit answer for the same request. Arrays stay numpy (the service's orjson writes them directly; the CLI's
+JSON writer turns them into lists).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from curve_vae.geometry import (
     self_intersects,
     smoothness,
 )
+from curve_vae.inference import answers as a
 from curve_vae.inference.errors import InputError
 
 if TYPE_CHECKING:  # exploring's results are built of this module's Spline
@@ -42,13 +43,13 @@ class Spline:
     degree: int
     params: np.ndarray  # (n,) parameter of each returned point, in [0, 1]
 
-    def json(self) -> dict[str, Any]:
-        return {
-            "control_points": self.control_points.tolist(),
-            "knots": self.knots.tolist(),
-            "degree": self.degree,
-            "params": self.params.tolist(),
-        }
+    def json(self) -> a.SplineOut:
+        return a.SplineOut(
+            control_points=self.control_points.tolist(),
+            knots=self.knots.tolist(),
+            degree=self.degree,
+            params=self.params.tolist(),
+        )
 
 
 @dataclass(frozen=True)
@@ -68,10 +69,11 @@ class Closeness:
     def part(self, cut: slice) -> Closeness:
         return Closeness(self.rms[cut], self.max[cut], self.max_at[cut])
 
-    def json(self) -> list[dict[str, Any]]:
+    def json(self) -> list[a.ClosenessOut]:
         """As the API reports it: one {rms, max, max_at} per curve (null where float64 overflowed)."""
         return [
-            {"rms": _finite(r), "max": _finite(m), "max_at": int(i)} for r, m, i in zip(self.rms, self.max, self.max_at)
+            a.ClosenessOut(rms=_finite(r), max=_finite(m), max_at=int(i))
+            for r, m, i in zip(self.rms, self.max, self.max_at)
         ]
 
 
@@ -190,102 +192,108 @@ class Augmented(Curves):
     invalid: int = 0  # items still crossing themselves after MAX_REDRAWS draws (returned; normally 0)
 
 
-# The JSON bodies.
+# The JSON bodies (their shapes: inference.answers).
+
+Body = TypeVar("Body", bound=a.CurvesResponse)  # a body of curves: /decode's, /reconstruct's, /interpolate's, …
 
 
-def frames_json(frames: Sequence[Frame | None]) -> list[dict[str, Any]] | None:
+def frames_json(frames: Sequence[Frame | None]) -> list[a.FrameOut] | None:
     """Frames as the API reports them; None for frame "model"."""
     if not frames or frames[0] is None:
         return None
     return [
-        {"center": list(f.center), "size": f.size, "rotation": f.rotation, "mirror": f.mirror, "reverse": f.reverse}
+        a.FrameOut(center=f.center, size=f.size, rotation=f.rotation, mirror=f.mirror, reverse=f.reverse)
         for f in frames
         if f is not None
     ]
 
 
-def with_metrics(body: dict[str, Any], curves: Sequence[np.ndarray] | np.ndarray, wanted: bool) -> dict[str, Any]:
-    """`body` plus the per-curve quality measures when the request asked for them: `curves` a list of (n, 2) arrays
-    or one (n_curves, n, 2) array."""
-    return {**body, "metrics": curve_metrics(curves)} if wanted else body
-
-
-def with_output(body: dict[str, Any], splines: Sequence[Spline] | None, output: str = "points") -> dict[str, Any]:
-    """`body` with its curves as the request's `output` asks: "points" (`curves`), "bspline" (`splines`) or "both"."""
+def with_curves(
+    body: Body,
+    curves: Sequence[np.ndarray] | np.ndarray,
+    splines: Sequence[Spline] | None,
+    *,
+    metrics: bool = False,
+    output: str = "points",
+) -> Body:
+    """`body` with the per-curve quality measures when the request asked for them (`curves` a list of (n, 2) arrays
+    or one (n_curves, n, 2) array), and its curves as the request's `output` asks: "points" (`curves`), "bspline"
+    (`splines`) or "both"."""
+    if metrics:
+        body["metrics"] = curve_metrics(curves)
     if output == "points" or splines is None:
         return body
-    out = {**body, "splines": [sp.json() for sp in splines]}
+    body["splines"] = [sp.json() for sp in splines]
     if output == "bspline":
-        out.pop("curves", None)
-    return out
+        del body["curves"]
+    return body
 
 
-def encode_body(enc: Encoding) -> dict[str, Any]:
+def encode_body(enc: Encoding) -> a.EncodeResponse:
     # float64 as the JSON always carried: orjson would write float32 at float32's shorter precision
-    body = {
-        "mean": enc.mean.astype(np.float64),
-        "log_var": enc.log_var.astype(np.float64),
-        "frames": frames_json(enc.frames),
-    }
+    body = a.EncodeResponse(
+        mean=enc.mean.astype(np.float64), log_var=enc.log_var.astype(np.float64), frames=frames_json(enc.frames)
+    )
     if enc.closeness is not None:  # the reading decoded each latent (closest placement): how close it came
         body["closeness"] = enc.closeness.json()
     return body
 
 
-def decode_body(made: Curves, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
-    body = with_metrics({"curves": made.curves.tolist()}, made.curves, metrics)
-    return with_output(body, made.splines, output)
+def decode_body(made: Curves, *, metrics: bool = False, output: str = "points") -> a.CurvesResponse:
+    body = a.CurvesResponse(curves=made.curves.tolist())
+    return with_curves(body, made.curves, made.splines, metrics=metrics, output=output)
 
 
-def reconstruct_body(rec: Reconstruction, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
-    body = {
-        "curves": [np.ascontiguousarray(c) for c in rec.curves],
-        "mse": rec.mse,
-        "closeness": rec.closeness.json(),
-        "repaired": rec.repaired.tolist(),
-    }
-    return with_output(with_metrics(body, rec.curves, metrics), rec.splines, output)
+def reconstruct_body(rec: Reconstruction, *, metrics: bool = False, output: str = "points") -> a.ReconstructResponse:
+    body = a.ReconstructResponse(
+        curves=[np.ascontiguousarray(c) for c in rec.curves],
+        mse=rec.mse,
+        closeness=rec.closeness.json(),
+        repaired=rec.repaired.tolist(),
+    )
+    return with_curves(body, rec.curves, rec.splines, metrics=metrics, output=output)
 
 
-def interpolate_body(mix: Interpolation, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
-    body = {
-        "weights": mix.weights,
-        "curves": np.ascontiguousarray(mix.curves),
-        "frames": frames_json(mix.frames),
-        "valid": mix.valid.tolist(),
-        "repaired": mix.repaired.tolist(),
-        "ends": mix.ends.json(),
-    }
-    return with_output(with_metrics(body, mix.curves, metrics), mix.splines, output)
+def interpolate_body(mix: Interpolation, *, metrics: bool = False, output: str = "points") -> a.InterpolateResponse:
+    body = a.InterpolateResponse(
+        weights=mix.weights,
+        curves=np.ascontiguousarray(mix.curves),
+        frames=frames_json(mix.frames),
+        valid=mix.valid.tolist(),
+        repaired=mix.repaired.tolist(),
+        ends=mix.ends.json(),
+    )
+    return with_curves(body, mix.curves, mix.splines, metrics=metrics, output=output)
 
 
-def sample_body(made: Sampled, *, metrics: bool = False) -> dict[str, Any]:
-    body = {
-        "latents": made.latents.tolist(),
-        "curves": made.curves.tolist(),
-        "seed": made.seed,
-        "offset": made.offset,
-        "prior": made.prior,
-        "rejected": made.rejected,
-        "invalid": made.invalid,
+def sample_body(made: Sampled, *, metrics: bool = False, output: str = "points") -> a.SampleResponse:
+    body = a.SampleResponse(
+        latents=made.latents.tolist(),
+        curves=made.curves.tolist(),
+        seed=made.seed,
+        offset=made.offset,
+        prior=made.prior,
+        rejected=made.rejected,
+        invalid=made.invalid,
+    )
+    if made.prior not in ("learned", "standard"):
         # a prior of users' curves places each curve in the frame of its nearest reference curve: say which
-        **({"frames": frames_json(made.frames)} if made.prior not in ("learned", "standard") else {}),
-    }
-    return with_metrics(body, made.curves, metrics)
+        body["frames"] = frames_json(made.frames)
+    return with_curves(body, made.curves, made.splines, metrics=metrics, output=output)
 
 
-def augment_body(made: Augmented, *, metrics: bool = False) -> dict[str, Any]:
-    body = {
-        "curves": made.curves.tolist(),
-        "sources": made.sources.tolist(),
-        "weights": made.weights.tolist(),
-        "frames": frames_json(made.frames),
-        "seed": made.seed,
-        "offset": made.offset,
-        "redrawn": made.redrawn,
-        "invalid": made.invalid,
-    }
-    return with_metrics(body, made.curves, metrics)
+def augment_body(made: Augmented, *, metrics: bool = False, output: str = "points") -> a.AugmentResponse:
+    body = a.AugmentResponse(
+        curves=made.curves.tolist(),
+        sources=made.sources.tolist(),
+        weights=made.weights.tolist(),
+        frames=frames_json(made.frames),
+        seed=made.seed,
+        offset=made.offset,
+        redrawn=made.redrawn,
+        invalid=made.invalid,
+    )
+    return with_curves(body, made.curves, made.splines, metrics=metrics, output=output)
 
 
 def fit_body(
@@ -295,7 +303,7 @@ def fit_body(
     param: str = "chord",
     n_points: int | None = None,
     tolerance: float = 1e-3,
-) -> dict[str, Any]:
+) -> a.FitResponse:
     """Least-squares cubic B-spline of each curve (geometry.fit_bspline; without n_ctrl, fit_bspline_auto picks the
     fewest control points within `tolerance` of the diagonal); InputError names a curve it cannot fit."""
     fits = []
@@ -317,18 +325,18 @@ def fit_body(
             raise InputError(("curves", i), _unfittable(n_ctrl, e)) from e
         if not (np.isfinite(f.control_points).all() and np.isfinite([f.rms_error, f.max_error]).all()):
             raise InputError(("curves", i), _unfittable(len(f.control_points)))
-        out: dict[str, Any] = {
-            "control_points": f.control_points.tolist(),
-            "knots": f.knots.tolist(),
-            "degree": f.degree,
-            "n_ctrl": len(f.control_points),
-            "rms_error": f.rms_error,
-            "max_error": f.max_error,
-        }
+        out = a.BSplineOut(
+            control_points=f.control_points.tolist(),
+            knots=f.knots.tolist(),
+            degree=f.degree,
+            n_ctrl=len(f.control_points),
+            rms_error=f.rms_error,
+            max_error=f.max_error,
+        )
         if n_points is not None:
             out["curve"] = f.evaluate(n_points).tolist()
         fits.append(out)
-    return {"fits": fits}
+    return a.FitResponse(fits=fits)
 
 
 def _unfittable(n_ctrl: int | None, error: Exception | None = None) -> str:
@@ -350,15 +358,20 @@ def mesh_file(mesh: Any, *, points: int, segments: int, axis: str, fmt: str) -> 
     return mesh.to_obj(comment=comment).encode()
 
 
-def curve_metrics(curves: Sequence[np.ndarray] | np.ndarray) -> list[dict[str, Any]]:
+def curve_metrics(curves: Sequence[np.ndarray] | np.ndarray) -> list[a.CurveMetrics]:
     """Per curve (a list of (n, 2) arrays or one (n_curves, n, 2) array), as the API reports it: smoothness (paper
     §3.4, degrees), self-intersection, length."""
     out = []
     for c in curves:
         with np.errstate(all="ignore"):
-            smooth = {name: _number(v) for name, v in smoothness(c).items()}
+            turns = smoothness(c)
+            smooth = a.Smoothness(
+                mean_turn=_number(turns["mean_turn"]),
+                max_turn=_number(turns["max_turn"]),
+                roughness=_number(turns["roughness"]),
+            )
             length = _number(curve_length(c))
-        out.append({"smoothness": smooth, "self_intersects": bool(self_intersects(c)), "length": length})
+        out.append(a.CurveMetrics(smoothness=smooth, self_intersects=bool(self_intersects(c)), length=length))
     return out
 
 
@@ -368,13 +381,13 @@ def _number(value: Any) -> float | None:
     return v if math.isfinite(v) else None
 
 
-def explore_body(made: Explored, *, metrics: bool = False, output: str = "points") -> dict[str, Any]:
+def explore_body(made: Explored, *, metrics: bool = False, output: str = "points") -> a.ExploreResponse:
     d = made.directions
-    body = {
-        "curves": made.curves.tolist(),
-        "offsets": made.offsets.tolist(),
-        "valid": made.valid.tolist(),
-        "directions": [{"deviation": float(v), "share": float(s)} for v, s in zip(d.deviations, d.shares)],
-        "prior": made.prior,
-    }
-    return with_output(with_metrics(body, made.curves, metrics), made.splines, output)
+    body = a.ExploreResponse(
+        curves=made.curves.tolist(),
+        offsets=made.offsets.tolist(),
+        valid=made.valid.tolist(),
+        directions=[a.DirectionOut(deviation=float(v), share=float(s)) for v, s in zip(d.deviations, d.shares)],
+        prior=made.prior,
+    )
+    return with_curves(body, made.curves, made.splines, metrics=metrics, output=output)

@@ -27,7 +27,7 @@ from typing import TypeVar
 import numpy as np
 
 from curve_vae.geometry import Frame
-from curve_vae.inference.choices import SOURCES_PER_MODE
+from curve_vae.inference.choices import SOURCES_PER_MODE, Providers
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.fitting import Fitter
 from curve_vae.inference.generation.augmenting import AugmentPlan, augmented, neighbour_pools
@@ -108,7 +108,7 @@ class CurveRuntime:
         cls,
         model_dir: str | Path,
         *,
-        providers: str = "auto",
+        providers: Providers = "auto",
         intra_op_threads: int = 0,
         batch_size: int = 64,
         warm_up: bool = True,

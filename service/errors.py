@@ -15,6 +15,7 @@ from fastapi.responses import JSONResponse, Response
 from starlette.exceptions import HTTPException
 
 from curve_vae.inference.errors import InputError, format_loc
+from curve_vae.service.responses import ErrorItem, ErrorResponse
 
 MAX_ERRORS_SHOWN = 20
 
@@ -29,13 +30,14 @@ def error_response(
 ) -> JSONResponse:
     """The one error body of the API: a line naming the first problem, and the list of all of them. Under /v2 (the
     Open Inference Protocol, `path`) the protocol's `{"error": line}` instead, which its clients read."""
-    items = [{"loc": loc, "msg": msg} for loc, msg in errors[:MAX_ERRORS_SHOWN]]
     if detail is None:
         loc, msg = errors[0]
         detail = f"{loc}: {msg}" if loc else msg
     if speaks_oip(path):
         return oip_error(status, detail, headers=headers)
-    return JSONResponse({"detail": detail, "errors": items}, status_code=status, headers=headers)
+    items = [ErrorItem(loc=loc, msg=msg) for loc, msg in errors[:MAX_ERRORS_SHOWN]]
+    body = ErrorResponse(detail=detail, errors=items)
+    return JSONResponse(body.model_dump(), status_code=status, headers=headers)
 
 
 def speaks_oip(path: str) -> bool:

@@ -1,5 +1,5 @@
 """Request bodies of the v1 REST API, with the field docs and examples the OpenAPI page shows (field types:
-service.fields; responses: service.responses).
+service.fields; responses: inference.answers and service.responses).
 
 Only what a schema can check on its own lives here (finite numbers, [x, y] pairs, ≥ 4 points, ≥ 2 distinct points,
 either `steps` or `weights`); the limits that come from the settings are service.limits'. The fields every curve

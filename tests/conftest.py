@@ -24,7 +24,7 @@ from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.live import LiveServer
 from curve_vae.service.settings import Settings
-from tests.helpers import FIXTURES, ROOT, SHIPPED, bspline_curves, shipped_live_server, spawn_server, wait_ready
+from tests.helpers import FIXTURES, SHIPPED, bspline_curves, shipped_live_server, spawn_server, wait_ready
 
 #: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
 SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}

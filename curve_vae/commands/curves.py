@@ -36,18 +36,19 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
     if a.server:
         with server_client(a) as c:
             rec = c.reconstruct(curves, **reading, n_points=a.n_points, output=a.output_as, metrics=a.metrics)
-            body: dict[str, Any] = {}
+            served: dict[str, Any] = {}
             if a.output_as != "bspline":
-                body["curves"] = [np.asarray(x).tolist() for x in rec.curves]
-            body["mse"] = rec.mse.tolist()
+                served["curves"] = [np.asarray(x).tolist() for x in rec.curves]
+            served["mse"] = rec.mse.tolist()
             if rec.closeness is not None:
-                body["closeness"] = rec.closeness.json()
+                served["closeness"] = rec.closeness.json()
             if rec.repaired is not None:
-                body["repaired"] = rec.repaired.tolist()
+                served["repaired"] = rec.repaired.tolist()
             if a.output_as != "points":
-                body["splines"] = rec.splines
+                served["splines"] = rec.splines
             if a.metrics:
-                body["metrics"] = rec.metrics
+                served["metrics"] = rec.metrics
+            body: Mapping[str, Any] = served
     else:
         rec = model_runtime(a).reconstruct(curves, Reading(**reading), n_points=a.n_points)
         body = reconstruct_body(rec, metrics=a.metrics, output=a.output_as)
@@ -64,7 +65,7 @@ def cmd_reconstruct(a: argparse.Namespace) -> int:
 DRAWINGS = (".svg", ".dxf")
 
 
-def with_inputs(inputs: list[np.ndarray], body: dict[str, Any]) -> tuple[dict[str, Any], list[Mapping[str, Any]]]:
+def with_inputs(inputs: list[np.ndarray], body: Mapping[str, Any]) -> tuple[dict[str, Any], list[Mapping[str, Any]]]:
     """A reconstruction's answer as a drawing the page would export: each input, named A, B, … (role input), then its
     reconstruction (role reconstruction, of its input), a B-spline where the answer holds splines; and the marks."""
     from curve_vae.curvefiles.roles import curve_name
@@ -81,7 +82,7 @@ def with_inputs(inputs: list[np.ndarray], body: dict[str, Any]) -> tuple[dict[st
     return drawing, marks
 
 
-def reconstruct_summary(body: dict[str, Any]) -> str:
+def reconstruct_summary(body: Mapping[str, Any]) -> str:
     """One line a person reads: how close the curves came relative to their size, the worst point and where it is,
     how many were untangled, and the paper's MSE in the curves' own units."""
     mse = np.asarray(body["mse"], np.float64)
@@ -113,9 +114,10 @@ def cmd_encode(a: argparse.Namespace) -> int:
     if a.server:
         with server_client(a) as c:
             enc = c.encode(curves, **reading)
-            body = {"mean": enc.mean, "log_var": enc.log_var, "frames": enc.frames}
+            latents: dict[str, Any] = {"mean": enc.mean, "log_var": enc.log_var, "frames": enc.frames}
             if enc.closeness is not None:
-                body["closeness"] = enc.closeness.json()
+                latents["closeness"] = enc.closeness.json()
+            body: Mapping[str, Any] = latents
     else:
         body = encode_body(model_runtime(a).encode(curves, Reading(**reading)))
     write_output(a.output, body)

@@ -22,6 +22,7 @@ from curve_vae.commands.options import (
 from curve_vae.curvefiles.help import INPUT_HELP
 from curve_vae.errors import InvalidInput
 from curve_vae.files import refuse_overwrite
+from curve_vae.inference.answers import AugmentResponse, SampleResponse
 from curve_vae.inference.choices import AugmentMode, Output, choices
 from curve_vae.progress import bar, counted, shown
 
@@ -29,7 +30,7 @@ from curve_vae.progress import bar, counted, shown
 def cmd_sample(a: argparse.Namespace) -> int:
     from curve_vae.curvefiles import write_output
     from curve_vae.inference.generation.sampling import fresh_seed
-    from curve_vae.inference.results import sample_body, with_output
+    from curve_vae.inference.results import sample_body
 
     refuse_overwrite(a.output, a.force)
     seed = fresh_seed() if a.seed is None else a.seed
@@ -44,7 +45,7 @@ def cmd_sample(a: argparse.Namespace) -> int:
         made = runtime.sample(
             a.count, seed=seed, temperature=a.temperature, prior=a.prior, valid=a.valid, n_points=a.n_points
         )
-        body = with_output(sample_body(made, metrics=a.metrics), made.splines, a.output_as)
+        body = sample_body(made, metrics=a.metrics, output=a.output_as)
         prior, rejected, points = made.prior, made.rejected, made.curves.shape[1]
     write_output(a.output, body, array_key="curves" if "curves" in body else None)
     print(
@@ -55,12 +56,19 @@ def cmd_sample(a: argparse.Namespace) -> int:
     return 0
 
 
-def _sample_body_of(made: Any, output: str, metrics: bool) -> dict[str, Any]:
+def _sample_body_of(made: Any, output: str, metrics: bool) -> SampleResponse:
     """A client's Sampled as the JSON body the endpoint answered (and the local command writes)."""
-    body: dict[str, Any] = {"latents": made.latents.tolist()}
-    if output != "bspline":
-        body["curves"] = np.asarray(made.curves).tolist()
-    body.update(seed=made.seed, offset=0, prior=made.prior, rejected=made.rejected, invalid=made.invalid)
+    body = SampleResponse(
+        latents=made.latents.tolist(),
+        curves=np.asarray(made.curves).tolist(),
+        seed=made.seed,
+        offset=0,
+        prior=made.prior,
+        rejected=made.rejected,
+        invalid=made.invalid,
+    )
+    if output == "bspline":
+        del body["curves"]
     if metrics:
         body["metrics"] = made.metrics
     if output != "points":
@@ -150,17 +158,17 @@ def _write_augment(a: argparse.Namespace, chunks: Any, progress: Any, seed: int,
     for m in made:
         parts.append(m)
         progress.update(len(m.curves))
-    body: dict[str, Any] = {
-        "curves": [c for m in parts for c in np.asarray(m.curves).tolist()],
-        "sources": [s for m in parts for s in np.asarray(m.sources).tolist()],
-        "weights": [w for m in parts for w in np.asarray(m.weights).tolist()],
-        "frames": _frames(parts, frames_json),
-        "seed": seed,
-        "offset": a.offset,
+    body = AugmentResponse(
+        curves=[c for m in parts for c in np.asarray(m.curves).tolist()],
+        sources=[s for m in parts for s in np.asarray(m.sources).tolist()],
+        weights=[w for m in parts for w in np.asarray(m.weights).tolist()],
+        frames=_frames(parts, frames_json),
+        seed=seed,
+        offset=a.offset,
         # mixes that crossed themselves, drawn again (a server's JSON pages say so too)
-        "redrawn": sum(int(getattr(m, "redrawn", 0) or 0) for m in parts),
-        "invalid": sum(int(getattr(m, "invalid", 0) or 0) for m in parts),
-    }
+        redrawn=sum(int(getattr(m, "redrawn", 0) or 0) for m in parts),
+        invalid=sum(int(getattr(m, "invalid", 0) or 0) for m in parts),
+    )
     if a.metrics:
         body["metrics"] = [x for m in parts for x in (m.metrics or _metrics(m))]
     return shape, body

@@ -19,13 +19,13 @@ from curve_vae.curvefiles.common import CurveFileError
 from curve_vae.files import atomic_path, atomic_write_text
 
 
-def _splines(payload: dict[str, Any]) -> list[dict[str, Any] | None] | None:
+def _splines(payload: Mapping[str, Any]) -> list[dict[str, Any] | None] | None:
     """The B-splines of an answer: `splines` (--output-as bspline or both) or `fits` (curve-vae fit); a drawing's
     entries are None for its curves of points."""
     return payload.get("splines") or payload.get("fits")
 
 
-def _points(payload: dict[str, Any], path: str, array_key: str | None) -> list[Any]:
+def _points(payload: Mapping[str, Any], path: str, array_key: str | None) -> list[Any]:
     key = array_key or "curves"
     if key not in payload:
         hint = " (ask for points: --output-as points or both)" if _splines(payload) else ""
@@ -34,7 +34,7 @@ def _points(payload: dict[str, Any], path: str, array_key: str | None) -> list[A
 
 
 def write_output(
-    path: str, payload: dict[str, Any], array_key: str | None = None, marks: list[Mapping[str, Any]] | None = None
+    path: str, payload: Mapping[str, Any], array_key: str | None = None, marks: list[Mapping[str, Any]] | None = None
 ) -> None:
     """`payload` (an endpoint's JSON answer) to `path` in the format its extension names; `marks`, one a curve, say
     each curve's role, name, input (`of`) and weights in CSV, SVG and DXF."""
@@ -86,7 +86,7 @@ def _cell(text: str) -> str:
 
 
 def _write_drawing(
-    path: str, suffix: str, payload: dict[str, Any], array_key: str | None, marks: list[Mapping[str, Any]] | None
+    path: str, suffix: str, payload: Mapping[str, Any], array_key: str | None, marks: list[Mapping[str, Any]] | None
 ) -> None:
     from curve_vae.curvefiles.dxf import write_dxf
     from curve_vae.curvefiles.svg import svg_text

@@ -33,6 +33,7 @@ import onnxruntime as ort
 
 from curve_vae.errors import CancelledWork, InvalidInput
 from curve_vae.geometry import clamped_uniform_knots
+from curve_vae.inference.choices import Providers
 from curve_vae.inference.model import batching
 from curve_vae.inference.model.manifest import ENCODER_OUTPUTS, Manifest, ModelLoadError, decoder_outputs
 from curve_vae.inference.model.sessions import SessionConfig, SessionPool, open_pair, resolve_providers
@@ -48,7 +49,7 @@ class ModelGraphs:
         manifest: Manifest,
         *,
         batch_size: int = 64,
-        requested_providers: str = "cpu",
+        requested_providers: Providers = "cpu",
     ) -> None:
         self.pool = pool  # the pair of each inference thread
         self.manifest = manifest
@@ -75,7 +76,7 @@ class ModelGraphs:
         model_dir: str | Path,
         manifest: Manifest,
         *,
-        providers: str = "auto",
+        providers: Providers = "auto",
         sessions: SessionConfig | None = None,
         batch_size: int = 64,
         warm_up: bool = True,

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from curve_vae.errors import InvalidInput
-from curve_vae.inference.choices import Placement, choices
+from curve_vae.inference.choices import Placement, Providers, choices
 from curve_vae.inference.generation.named_priors import load_priors
 from curve_vae.inference.generation.prior import LatentPrior
 from curve_vae.inference.model.graphs import ModelGraphs
@@ -34,7 +34,7 @@ WARM_UP_POINTS = 57
 def open_model(
     model_dir: str | Path,
     *,
-    providers: str,
+    providers: Providers,
     batch_size: int,
     warm_up: bool,
     sessions: SessionConfig,

@@ -9,10 +9,10 @@ import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
+from curve_vae.inference import answers
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.results import Reconstruction, decode_body, encode_body, interpolate_body, reconstruct_body
 from curve_vae.service import api_docs as docs
-from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 from curve_vae.service.deps import coalesced, encode_key, reconstruct_key, run_inference, runtime_of, settings_of
 from curve_vae.service.limits import check_output, check_weights
@@ -28,7 +28,7 @@ curves_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
     npy=True,
     examples=docs.ENCODE,
     openapi_extra=docs.curl_sample("/encode", docs.ONE_CURVE),
-    response_model=r.EncodeResponse,
+    response_model=answers.EncodeResponse,
     responses=docs.POST_ERRORS,
     summary="Latent mean and log-variance of each curve",
 )
@@ -43,7 +43,7 @@ async def encode(request: Request, req: s.EncodeRequest, curves: list[np.ndarray
     "/decode",
     s.DecodeRequest,
     examples=docs.DECODE,
-    response_model=r.CurvesResponse,
+    response_model=answers.CurvesResponse,
     responses=docs.POST_ERRORS,
     summary="Curves for latent vectors",
     openapi_extra=docs.curl_sample("/decode", '{"latents": [[' + ",".join(["0"] * 32) + ']], "n_points": 50}'),
@@ -77,7 +77,7 @@ async def decode(request: Request, req: s.DecodeRequest, _curves: list[np.ndarra
     npy=True,
     examples=docs.RECONSTRUCT,
     openapi_extra=docs.curl_sample("/reconstruct", docs.ONE_CURVE),
-    response_model=r.ReconstructResponse,
+    response_model=answers.ReconstructResponse,
     responses=docs.POST_ERRORS,
     summary="Pass curves through the VAE",
 )
@@ -99,7 +99,7 @@ async def reconstruct(request: Request, req: s.ReconstructRequest, curves: list[
     npy=True,
     examples=docs.INTERPOLATE,
     openapi_extra=docs.curl_sample("/interpolate", docs.TWO_CURVES[:-1] + ', "steps": 5}'),
-    response_model=r.InterpolateResponse,
+    response_model=answers.InterpolateResponse,
     responses=docs.POST_ERRORS,
     summary="Curves between curves, by mixing latent means",
 )

@@ -8,9 +8,9 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
 from curve_vae.geometry import revolve
+from curve_vae.inference import answers
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.results import fit_body, mesh_file
-from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 from curve_vae.service.api_docs import C1, C2, curl_sample, error_docs, example
 from curve_vae.service.deps import run_inference
@@ -42,7 +42,7 @@ REVOLVE_EXAMPLES = {
     "/fit",
     s.FitRequest,
     examples=FIT_EXAMPLES,
-    response_model=r.FitResponse,
+    response_model=answers.FitResponse,
     responses=error_docs(413, 422),
     summary="Least-squares cubic B-spline of each curve",
     openapi_extra=curl_sample(

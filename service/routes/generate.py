@@ -13,14 +13,14 @@ import numpy as np
 from fastapi import APIRouter, Request
 from fastapi.responses import Response, StreamingResponse
 
+from curve_vae.inference import answers
 from curve_vae.inference.generation.augmenting import AugmentPlan
 from curve_vae.inference.generation.sampling import fresh_seed
-from curve_vae.inference.results import augment_body, explore_body, sample_body, with_output
+from curve_vae.inference.results import augment_body, explore_body, sample_body
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.npy import MEDIA_TYPE as NPY_MEDIA_TYPE
 from curve_vae.npy import chunk_bytes, npy_header, npy_size
 from curve_vae.service import api_docs as docs
-from curve_vae.service import responses as r
 from curve_vae.service import schemas as s
 from curve_vae.service.deps import in_executor, run_inference, runtime_of
 from curve_vae.service.limits import check_output
@@ -35,7 +35,7 @@ generate_router = APIRouter(route_class=FastJSONRoute, tags=["curves"])
     "/sample",
     s.SampleRequest,
     examples=docs.SAMPLE,
-    response_model=r.SampleResponse,
+    response_model=answers.SampleResponse,
     responses=docs.POST_ERRORS,
     summary="New curves from a latent distribution: the learned one, a named prior, or the standard prior",
     openapi_extra=docs.curl_sample("/sample", '{"count": 3, "seed": 7, "n_points": 50}'),
@@ -62,7 +62,7 @@ async def sample(request: Request, req: s.SampleRequest, _curves: list[np.ndarra
             spacing=req.spacing,
             frame=frame,
         )
-        return JSON(with_output(sample_body(made, metrics=req.metrics), made.splines, req.output))
+        return JSON(sample_body(made, metrics=req.metrics, output=req.output))
 
     return await run_inference(request, "/sample", req.count, work)
 
@@ -72,7 +72,7 @@ async def sample(request: Request, req: s.SampleRequest, _curves: list[np.ndarra
     "/explore",
     s.ExploreRequest,
     examples=docs.EXPLORE,
-    response_model=r.ExploreResponse,
+    response_model=answers.ExploreResponse,
     responses=docs.POST_ERRORS,
     summary="Curves around one curve, along the directions the data varies most",
     openapi_extra=docs.curl_sample("/explore", docs.ONE_CURVE),
@@ -119,7 +119,7 @@ AUGMENT_NPY = {
     "/augment",
     s.AugmentRequest,
     examples=docs.AUGMENT,
-    response_model=r.AugmentResponse,
+    response_model=answers.AugmentResponse,
     responses={200: AUGMENT_NPY, **docs.POST_ERRORS},
     summary="New curves between given curves",
     openapi_extra=docs.curl_sample("/augment", docs.THREE_CURVES[:-1] + ', "count": 4, "mode": "triplet", "seed": 1}'),
@@ -142,7 +142,7 @@ async def augment(request: Request, req: s.AugmentRequest, curves: list[np.ndarr
 
     def work() -> Response:
         made = runtime.augment(plan(), start, stop, n_points=req.n_points, spacing=spacing)
-        return JSON(with_output(augment_body(made, metrics=req.metrics), made.splines, req.output))
+        return JSON(augment_body(made, metrics=req.metrics, output=req.output))
 
     return await run_inference(request, "/augment", req.count, work)
 

@@ -41,10 +41,10 @@ async def health(request: Request) -> Any:
     restart it)."""
     state = request.app.state
     if state.failed:
-        return JSONResponse({"status": "failed", "detail": f"the model cannot serve: {state.failed}"}, status_code=503)
+        return _status(503, "failed", f"the model cannot serve: {state.failed}")
     if state.warming is not None and not state.warming.done():
-        return {"status": "warming up", "detail": WARMING_UP}
-    return {"status": "ok"}
+        return r.StatusResponse(status="warming up", detail=WARMING_UP)
+    return r.StatusResponse(status="ok")
 
 
 @ops_router.get(
@@ -60,12 +60,16 @@ async def ready(request: Request) -> Any:
     ("failed") and while shutting down ("stopping"), with `detail` saying which."""
     state = request.app.state
     if state.failed:
-        return JSONResponse({"status": "failed", "detail": f"the model cannot serve: {state.failed}"}, 503)
+        return _status(503, "failed", f"the model cannot serve: {state.failed}")
     if state.warming is not None and not state.warming.done():
-        return JSONResponse({"status": "warming up", "detail": WARMING_UP}, 503)
+        return _status(503, "warming up", WARMING_UP)
     if not state.ready or state.runtime is None:
-        return JSONResponse({"status": "stopping", "detail": "the model is not loaded"}, 503)
-    return {"status": "ready"}
+        return _status(503, "stopping", "the model is not loaded")
+    return r.StatusResponse(status="ready")
+
+
+def _status(code: int, status: str, detail: str) -> JSONResponse:
+    return JSONResponse(r.StatusResponse(status=status, detail=detail).model_dump(), status_code=code)
 
 
 @ops_router.get(
@@ -75,25 +79,25 @@ async def ready(request: Request) -> Any:
     summary="The model being served",
     openapi_extra=curl_sample("/model"),
 )
-async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDep) -> dict[str, Any]:
+async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDep) -> r.ModelInfo:
     """Name, version, dimensions and checksums from the manifest, and the providers the sessions actually use."""
     m = runtime.manifest
     present = runtime.model_dir
-    return {
-        "name": m.name,
-        "version": m.version,
-        "service_version": __version__,
-        "created": m.created,
-        "variant": m.variant,
-        "n_points": runtime.n_points,
-        "latent_dim": runtime.latent_dim,
-        "model_size": runtime.model_size,
-        "reading": default_reading(runtime),
-        "ranker": m.ranker.model_dump(include={"file", "kind", "held_out"}) if m.ranker else None,
-        "spacer": m.spacer.model_dump(include={"file", "kind", "held_out"}) if m.spacer else None,
-        "prior": m.prior.model_dump(include={"kind", "components", "fitted_on"}) if m.prior else None,
-        "priors": {name: p.describe() for name, p in runtime.priors.items()},
-        "spline": (
+    return r.ModelInfo(
+        name=m.name,
+        version=m.version,
+        service_version=__version__,
+        created=m.created,
+        variant=m.variant,
+        n_points=runtime.n_points,
+        latent_dim=runtime.latent_dim,
+        model_size=runtime.model_size,
+        reading=default_reading(runtime),
+        ranker=m.ranker.model_dump(include={"file", "kind", "held_out"}) if m.ranker else None,
+        spacer=m.spacer.model_dump(include={"file", "kind", "held_out"}) if m.spacer else None,
+        prior=m.prior.model_dump(include={"kind", "components", "fitted_on"}) if m.prior else None,
+        priors={name: p.describe() for name, p in runtime.priors.items()},
+        spline=(
             {"n_ctrl": m.spline.n_ctrl, "degree": m.spline.degree, "knots": runtime.graphs.knots.tolist()}
             | {
                 "learned_params": runtime.graphs.has_params,
@@ -103,13 +107,13 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
             else None
         ),
         # the files this model directory holds (an installed package ships no vae.pt: serving never reads it)
-        "files": {k: v.model_dump(include={"sha256", "bytes"}) for k, v in m.files.items() if (present / k).is_file()},
-        "cache": runtime.cache.stats() if runtime.cache is not None else None,
-        "providers": runtime.graphs.providers,
-        "requested_providers": runtime.graphs.requested_providers,
-        "onnxruntime": runtime.graphs.onnxruntime_version,
-        "metrics": m.metrics,
-        "limits": {
+        files={k: r.FileInfo(sha256=v.sha256, bytes=v.bytes) for k, v in m.files.items() if (present / k).is_file()},
+        cache=runtime.cache.stats() if runtime.cache is not None else None,
+        providers=runtime.graphs.providers,
+        requested_providers=runtime.graphs.requested_providers,
+        onnxruntime=runtime.graphs.onnxruntime_version,
+        metrics=m.metrics,
+        limits={
             "max_curves": settings.max_curves,
             "max_points": settings.max_points,
             "max_body_bytes": settings.max_body_bytes,
@@ -117,8 +121,8 @@ async def model_info(request: Request, runtime: RuntimeDep, settings: SettingsDe
             "max_mesh_triangles": settings.max_mesh_triangles,
             "max_refine_work": settings.max_refine_work,
         },
-        "execution": execution_of(request, runtime),
-    }
+        execution=execution_of(request, runtime),
+    )
 
 
 def default_reading(runtime: Any) -> dict[str, str | int]:

@@ -9,6 +9,7 @@ import pytest
 
 from curve_vae.geometry import Frame, clamped_uniform_knots, random_control_points, revolve, sample_bspline
 from curve_vae.inference import results
+from curve_vae.inference.answers import CurvesResponse
 from curve_vae.inference.errors import InputError
 from curve_vae.inference.results import (
     Augmented,
@@ -32,7 +33,7 @@ def _spline(n: int = 3) -> Spline:
 
 def test_frames_as_the_api_reports_them_and_none_in_the_models_plane():
     assert results.frames_json([FRAME]) == [
-        {"center": [1.0, -2.0], "size": 3.5, "rotation": 0.25, "mirror": True, "reverse": False}
+        {"center": (1.0, -2.0), "size": 3.5, "rotation": 0.25, "mirror": True, "reverse": False}
     ]
     assert results.frames_json([None, None]) is None and results.frames_json([]) is None
 
@@ -57,15 +58,16 @@ def test_a_length_beyond_float64_is_null_not_infinity():
 
 
 def test_metrics_and_output_are_added_only_where_asked():
-    body = {"curves": [LINE.tolist()]}
-    assert results.with_metrics(body, [LINE], False) is body
-    assert results.with_metrics(body, [LINE], True)["metrics"] == results.curve_metrics([LINE])
+    def body():
+        return CurvesResponse(curves=[LINE.tolist()])
+
+    assert results.with_curves(body(), [LINE], None) == body()
+    assert results.with_curves(body(), [LINE], None, metrics=True)["metrics"] == results.curve_metrics([LINE])
     splines = [_spline()]
-    assert results.with_output(body, splines, "points") is body
-    assert results.with_output(body, None, "bspline") is body  # no head: points whatever was asked
-    assert results.with_output(body, splines, "bspline") == {"splines": [splines[0].json()]}
-    assert results.with_output(body, splines, "both") == {**body, "splines": [splines[0].json()]}
-    assert "splines" not in body  # the caller's body is never changed
+    assert results.with_curves(body(), [LINE], splines) == body()
+    assert results.with_curves(body(), [LINE], None, output="bspline") == body()  # no head: points whatever was asked
+    assert results.with_curves(body(), [LINE], splines, output="bspline") == {"splines": [splines[0].json()]}
+    assert results.with_curves(body(), [LINE], splines, output="both") == {**body(), "splines": [splines[0].json()]}
 
 
 def test_result_bodies_carry_their_parts():

@@ -1,5 +1,6 @@
-"""The v1 response bodies (service.responses): what each route answers is what the OpenAPI page documents for it, every
-key documented and every documented type right (the real answers validated against the published schema)."""
+"""The v1 response bodies (inference.answers; service.responses for errors, status and GET /model): what each route
+answers is what the OpenAPI page documents for it, every key documented and every documented type right (the real
+answers validated against the published schema)."""
 
 from __future__ import annotations
 
