@@ -91,14 +91,19 @@ class FrameOut(TypedDict):
     reverse: Annotated[bool, Field(description="Whether the curve's point order was reversed.")]
 
 
-class SplineOut(TypedDict):
-    """A returned curve as a clamped cubic B-spline, in the frame the curve is returned in."""
+class ClampedSpline(TypedDict):
+    """A clamped cubic B-spline: what every spline of a body holds."""
 
     control_points: Annotated[list[Point], Field(description="n_ctrl control points [x, y].")]
     knots: Annotated[
         list[float], Field(description="Clamped uniform knot vector on [0, 1], n_ctrl + degree + 1 entries.")
     ]
     degree: Annotated[int, Field(description="3: cubic.")]
+
+
+class SplineOut(ClampedSpline):
+    """A returned curve as a clamped cubic B-spline, in the frame the curve is returned in."""
+
     params: Annotated[
         list[float], Field(description="The spline parameter in [0, 1] of each point of the returned curve, in order.")
     ]
@@ -283,12 +288,7 @@ class AugmentResponse(CurvesResponse):
     invalid: Annotated[int, Field(description="Curves still crossing themselves after 10 draws each (normally 0).")]
 
 
-class BSplineOut(TypedDict):
-    control_points: Annotated[list[Point], Field(description="n_ctrl control points [x, y].")]
-    knots: Annotated[
-        list[float], Field(description="Clamped uniform knot vector on [0, 1], n_ctrl + degree + 1 entries.")
-    ]
-    degree: Annotated[int, Field(description="3: cubic.")]
+class BSplineOut(ClampedSpline):
     n_ctrl: Annotated[int, Field(description="Number of control points (given, or chosen by the tolerance).")]
     rms_error: Annotated[
         float, Field(description="Root mean squared distance of the points from the spline at their parameter.")
