@@ -13,7 +13,8 @@
 # its own shape instead of bending it to put even parameters at the points: docs/RESULTS.md), ONLY_ENCODER (1: --only-encoder), DEVICE (cuda), WORKERS drawing the data (16), INIT weights (models/vae.pt), RUN folder
 # (/tmp/r), DATA cache (/tmp/d.npz: a second stage on the same curves reads it), WHEELS (a folder of wheels of
 # what the machine lacks, e.g. pydantic, shapely; installed to /tmp/site without an index), OUT (/tmp/out).
-# OUT receives train.log, log.jsonl, config.json and best.pt without its optimiser state (a third of the size).
+# OUT receives train.log, log.jsonl, config.json and best.pt without its optimiser state (a third of the size); no
+# figures are drawn on the lent machine (seconds of its time): `curve-vae evaluate` draws them from the export.
 set -euo pipefail
 T0=$(date +%s)
 REPO=$(cd "$(dirname "$0")/.." && pwd)
@@ -40,7 +41,7 @@ python3 -m curve_vae.cli train --run-dir "$RUN" --init-from "${INIT:-$REPO/model
   "${mix_version[@]}" "${params[@]}" --n-train "${NTRAIN:-2000000}" \
   --n-val "${NVAL:-2000}" --n-test "${NTEST:-1000}" --data "${DATA:-/tmp/d.npz}" --workers "${WORKERS:-16}" \
   --device "${DEVICE:-cuda}" --batch-size 512 --lr "${LR:-3e-4}" --warmup "${WARMUP:-0.05}" --epochs 1000 \
-  --time-budget "${BUDGET:-400}" --snapshots 1 --no-progress 2>&1 | tee "$OUT/train.log"
+  --time-budget "${BUDGET:-400}" --snapshots 1 --no-progress --no-figures 2>&1 | tee "$OUT/train.log"
 python3 - <<'PY'
 import os
 

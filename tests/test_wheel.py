@@ -111,9 +111,10 @@ def test_the_installed_wheel_serves_its_shipped_model_from_anywhere(venv, tmp_pa
     from curve_vae import __version__
 
     env = {k: v for k, v in os.environ.items() if not k.startswith("CURVE_VAE_")}
-    # the wheel's own command, run from elsewhere, in an install without torch
+    # the wheel's own command, run from elsewhere, in an install without torch; one worker, as the tests' servers run
+    # (a fresh install compiles its kernels in each worker: tests/service/test_server.py tests two)
     assert subprocess.run([str(venv / "bin" / "python"), "-c", "import torch"], capture_output=True).returncode != 0
-    server = LiveServer(command=[str(venv / "bin" / "curve-vae"), "serve"], cwd=tmp_path, env=env)
+    server = LiveServer("--workers", "1", command=[str(venv / "bin" / "curve-vae"), "serve"], cwd=tmp_path, env=env)
     try:
         server.wait_ready()
         url = server.url

@@ -100,6 +100,8 @@ def plot_suite(runtime: Any, sets: dict[str, tuple[str, list[np.ndarray]]], path
 
     plt = pyplot()
     fig, axes = plt.subplots(len(sets), n, figsize=(1.7 * n, 1.7 * len(sets)), squeeze=False)
+    for ax in axes.flat:  # a set of fewer than n curves leaves its last panels blank, not empty boxes
+        ax.axis("off")
     for row, (name, (kind, curves)) in zip(axes, sets.items()):
         out = runtime.reconstruct(curves[:n]).curves
         rel = relative_rmse(curves[:n], out)
@@ -109,7 +111,6 @@ def plot_suite(runtime: Any, sets: dict[str, tuple[str, list[np.ndarray]]], path
             ax.plot(*c[0], "o", color="0.3", ms=2.5)
             ax.set_title(f"{100 * r:.2f}%", fontsize=7, pad=1)
             ax.set_aspect("equal")
-            ax.axis("off")
         row[0].text(-0.08, 0.5, f"{name}\n({kind})", transform=row[0].transAxes, ha="right", va="center", fontsize=7)
     fig.suptitle("grey: input (dot: first point) · red: reconstruction · relative RMSE", fontsize=8)
     fig.tight_layout(rect=(0.12, 0, 1, 0.98))

@@ -17,7 +17,7 @@ from curve_vae.training.checkpoint import load_checkpoint, model_from_checkpoint
 
 pytestmark = pytest.mark.slow
 
-TINY = ["--n-train", "256", "--n-val", "32", "--n-test", "32", "--batch-size", "32", "--no-progress", "--threads", "2"]
+TINY = ["--n-train", "128", "--n-val", "32", "--n-test", "32", "--batch-size", "32", "--no-progress", "--threads", "2"]
 
 
 def _log(run):
@@ -158,8 +158,8 @@ def test_ddp_two_cpu_processes(tmp_path):
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
     rows = _log(tmp_path / "run")
     assert [r["epoch"] for r in rows] == [1, 2]  # one writer: rank 0
-    # Each of the 2 processes takes half of every global batch: 256 curves → 8 steps of 16 each.
-    assert load_checkpoint(tmp_path / "run" / "last.pt")["optimizer"]["state"][0]["step"] == 16
+    # Each of the 2 processes takes half of every global batch: 128 curves → 4 steps of 16 each.
+    assert load_checkpoint(tmp_path / "run" / "last.pt")["optimizer"]["state"][0]["step"] == 8
 
 
 def test_init_from_shipped_weights(trained):
@@ -327,5 +327,5 @@ def test_train_never_rewrites_a_data_file_of_another_configuration(trained, tmp_
     before = open(data, "rb").read()
     args = ["train", "--run-dir", str(tmp_path / "run"), *TINY, "--n-train", "512", "--data", data, "--epochs", "1"]
     assert main(args) == 2
-    assert "holds a data set of another configuration: n_train 256 (file) vs 512 (asked)" in capsys.readouterr().err
+    assert "holds a data set of another configuration: n_train 128 (file) vs 512 (asked)" in capsys.readouterr().err
     assert open(data, "rb").read() == before
