@@ -8,6 +8,7 @@ checkout and must find the shipped model inside the package.
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -37,14 +38,33 @@ sys.meta_path.insert(0, HideTorch())
 """
 
 
+#: Where the wheel's folders come from in the tree (pyproject.toml's package-dir); the rest is curve_vae/ itself.
+MAPPED = ("geometry", "inference", "service", "training", "models")
+
+
+def tree_files() -> list[str]:
+    """The project's files: tracked, or new and not ignored (what the next commit would hold)."""
+    listed = subprocess.run(
+        ["git", "ls-files", "--cached", "--others", "--exclude-standard", "-z"],
+        cwd=ROOT,
+        check=True,
+        capture_output=True,
+    )
+    return [name for name in listed.stdout.decode().split("\0") if name and (ROOT / name).is_file()]
+
+
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("wheel")
-    build = tmp_path_factory.mktemp("build")  # setuptools' build/ folder, kept out of the checkout
+    """The wheel built from a copy of the tree's files: setuptools builds in the source folder, and its build/ keeps
+    every file it ever copied there, so a wheel built in a checkout can hold modules the tree no longer has."""
+    out, src = tmp_path_factory.mktemp("wheel"), tmp_path_factory.mktemp("src")
+    for name in tree_files():
+        (src / name).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(ROOT / name, src / name)
     subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(out), str(ROOT)],
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(out), str(src)],
         check=True,
-        cwd=build,
+        cwd=src,
         env={**os.environ, "PIP_NO_INPUT": "1"},
         capture_output=True,
     )
@@ -95,6 +115,13 @@ def test_the_wheel_holds_one_namespace_and_the_shipped_model(wheel):
         assert f"curve_vae/service/static/{page}" in names
     assert "curve_vae/curvefiles/svg.py" in names and "curve_vae/curvefiles/dxf.py" in names
     assert not [n for n in names if n.endswith(".pt")]  # torch weights are for training from a checkout
+    # every file of the package is one of the tree's: nothing left over from an earlier build
+    tree = set(tree_files())
+    for name in names:
+        if name.split("/")[0].endswith(".dist-info"):
+            continue
+        inside = name.removeprefix("curve_vae/")
+        assert (inside if inside.split("/")[0] in MAPPED else name) in tree, name
 
 
 def test_the_installed_command_tells_one_version(venv, tmp_path):
