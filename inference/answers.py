@@ -77,18 +77,25 @@ class ClosenessOut(TypedDict):
     max_at: Annotated[int, Field(description="Index in the input of that worst point.")]
 
 
+#: What a frame's fields mean, said once: for the answers' FrameOut and for a request's frame (service.fields).
+FRAME_FIELDS = {
+    "center": "Bounding-box centre [x, y].",
+    "size": "Larger side of the bounding box.",
+    "rotation": "Radians, counter-clockwise, the curve was turned by (after `mirror`) to reach the model.",
+    "mirror": "Whether it was mirrored (x -> -x about `center`) first.",
+    "reverse": "Whether the curve's point order was reversed.",
+}
+
+
 class FrameOut(TypedDict):
     """Where a curve lives: centre of its bounding box and its larger side; and the pose that turned it into the
     model's orientation (pose "auto"). /decode and /reconstruct read it back as a request's `frames`."""
 
-    center: Annotated[Point, Field(description="Bounding-box centre [x, y].")]
-    size: Annotated[float, Field(description="Larger side of the bounding box.")]
-    rotation: Annotated[
-        float,
-        Field(description="Radians, counter-clockwise, the curve was turned by (after `mirror`) to reach the model."),
-    ]
-    mirror: Annotated[bool, Field(description="Whether it was mirrored (x -> -x about `center`) first.")]
-    reverse: Annotated[bool, Field(description="Whether the curve's point order was reversed.")]
+    center: Annotated[Point, Field(description=FRAME_FIELDS["center"])]
+    size: Annotated[float, Field(description=FRAME_FIELDS["size"])]
+    rotation: Annotated[float, Field(description=FRAME_FIELDS["rotation"])]
+    mirror: Annotated[bool, Field(description=FRAME_FIELDS["mirror"])]
+    reverse: Annotated[bool, Field(description=FRAME_FIELDS["reverse"])]
 
 
 class ClampedSpline(TypedDict):

@@ -11,6 +11,7 @@ from pydantic_core import PydanticCustomError
 from curve_vae.geometry import Frame
 from curve_vae.geometry.adapt import COINCIDENT, coincident
 from curve_vae.inference import choices
+from curve_vae.inference.answers import FRAME_FIELDS
 from curve_vae.inference.reading import ReadingOption
 
 FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # numbers only: no "1.5", no true
@@ -109,15 +110,11 @@ class FrameInfo(BaseModel):
     """Where a curve lives: centre of its bounding box and its larger side; and the pose that turned it into the
     model's orientation (pose "auto"). Mapping into a frame applies the pose's inverse: rotation, mirror and order."""
 
-    center: tuple[FiniteFloat, FiniteFloat] = Field(description="Bounding-box centre [x, y].")
-    size: Annotated[
-        float, Field(gt=0, strict=True, allow_inf_nan=False, description="Larger side of the bounding box.")
-    ]
-    rotation: FiniteFloat = Field(
-        0.0, description="Radians, counter-clockwise, the curve was turned by (after `mirror`) to reach the model."
-    )
-    mirror: bool = Field(False, strict=True, description="Whether it was mirrored (x -> -x about `center`) first.")
-    reverse: bool = Field(False, strict=True, description="Whether the curve's point order was reversed.")
+    center: tuple[FiniteFloat, FiniteFloat] = Field(description=FRAME_FIELDS["center"])
+    size: Annotated[float, Field(gt=0, strict=True, allow_inf_nan=False, description=FRAME_FIELDS["size"])]
+    rotation: FiniteFloat = Field(0.0, description=FRAME_FIELDS["rotation"])
+    mirror: bool = Field(False, strict=True, description=FRAME_FIELDS["mirror"])
+    reverse: bool = Field(False, strict=True, description=FRAME_FIELDS["reverse"])
 
     def frame(self) -> Frame:
         return Frame(self.center, self.size, self.rotation, self.mirror, self.reverse)
