@@ -17,12 +17,13 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY_DATA = ["--n-train", "256", "--n-val", "64", "--n-test", "64"]
-#: What each subcommand gets appended to run in seconds; the README's own flags all stay.
+#: What each subcommand gets appended to run in seconds; the README's own flags all stay. Training and evaluation
+#: draw no figures here (9 CPU-s a chain): tests/training/test_end_to_end.py checks every figure they draw.
 TINY = {
     "dataset": TINY_DATA,
-    "train": [*TINY_DATA, "--epochs", "1", "--no-progress"],
+    "train": [*TINY_DATA, "--epochs", "1", "--no-progress", "--no-figures"],
     "export": ["--prior-components", "2", "--suite-count", "2", "--fresh-count", "16"],
-    "evaluate": ["--fresh-seed", "-1", "--suite-count", "2", "--morph-count", "2"],
+    "evaluate": ["--fresh-seed", "-1", "--suite-count", "2", "--morph-count", "2", "--no-figures"],
     "average": ["--bn-curves", "128"],
     "augment": ["--count", "300"],
     "ranker label": ["--curves", "24", "--chunk", "12"],
