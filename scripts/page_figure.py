@@ -2,7 +2,8 @@
 
 Five curves (four strokes and an in-between taken), the mix of two picked in the list (A and C), the view zoomed in on
 them, curve A selected with its control points as handles and its neighbours, the vase revolved.
-Needs Debian's chromium (`apt-get install chromium`) and the test extra (Playwright).
+Needs the page tests' browser (tests/e2e/browser.py: `apt-get install chromium-headless-shell`) and the test extra
+(Playwright).
 
     .venv/bin/python scripts/page_figure.py                # writes docs/figures/page.png
     .venv/bin/python scripts/page_figure.py --out /tmp/p.png
@@ -12,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -24,19 +24,17 @@ from curve_vae.service.live import LiveServer
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+from tests.e2e.browser import ARGS, CHROMIUM  # noqa: E402 - the page tests' browser
 from tests.e2e.drawing import arc, draw  # noqa: E402 - the page tests' own strokes
-
-ARGS = ["--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking"]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "figures" / "page.png")
     args = parser.parse_args()
-    chromium = shutil.which("chromium") or "/usr/bin/chromium"
     with LiveServer("--model-dir", str(ROOT / "models"), "--providers", "cpu", "--workers", "1", cwd=ROOT) as server:
         with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=chromium, args=ARGS)
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
             page = browser.new_context(viewport={"width": 1440, "height": 900}).new_page()
             page.goto(server.url + "/")
             bowl = arc(250, 420, 160, 1.05 * np.pi, 1.95 * np.pi)

@@ -1,6 +1,6 @@
-"""The page at / in a real headless browser (Debian's chromium, driven by Playwright) against uvicorn on loopback.
+"""The page at / in a real headless browser (Debian's chromium-headless-shell, driven by Playwright: tests/e2e/
+browser.py) against uvicorn on loopback.
 
-No browser download: Playwright launches /usr/bin/chromium (`apt-get install chromium`, done by .ci/run).
 Every test fails on a JavaScript error or a console error. A screenshot of the page lands in test-artifacts/.
 """
 
@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import shutil
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -18,33 +17,22 @@ import numpy as np
 import pytest
 
 from curve_vae.service.live import LiveServer
+from tests.e2e.browser import ARGS, CHROMIUM
 from tests.helpers import ROOT, SHIPPED, shipped_live_server
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 ARTIFACTS = ROOT / "test-artifacts"
 H = 700  # the board's height: API coordinates are the board's with y up
 
-if not Path(CHROMIUM).exists():
+if CHROMIUM is None:
     if os.environ.get("CI"):
-        raise RuntimeError("chromium is missing: .ci/run installs it with apt-get install chromium")
-    pytest.skip("chromium is not installed (apt-get install chromium)", allow_module_level=True)
+        raise RuntimeError("no browser: .ci/run installs one with apt-get install chromium-headless-shell")
+    pytest.skip("no browser is installed (apt-get install chromium-headless-shell)", allow_module_level=True)
 
 from playwright.sync_api import Browser, Page, sync_playwright  # noqa: E402
 
 from tests.e2e.drawing import arc, draw  # noqa: E402,F401 - the page tests import them from here too
 
 pytestmark = pytest.mark.integration
-
-ARGS = [
-    "--headless=new",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
 
 
 @pytest.fixture(scope="module")
