@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import subprocess
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -22,6 +23,7 @@ import pytest
 from fastapi.testclient import TestClient
 from threadpoolctl import threadpool_limits
 
+from curve_vae.inference.model.opening import compiled_kernels
 from curve_vae.inference.runtime import CurveRuntime
 from curve_vae.service.app import create_app
 from curve_vae.service.live import LiveServer
@@ -47,6 +49,29 @@ def blas_threads_restored() -> Iterator[None]:
     had."""
     with threadpool_limits(limits=None, user_api="blas"):
         yield
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """A checkout without the reading's compiled kernels (a fresh clone) compiles them once, in the background, while
+    the workers collect: otherwise each process that reads a curve before the cache holds them compiles them again
+    (17 CPU-s each; servers, the command line and both workers start at once), as a first `curve-vae serve` does.
+    The same `curve-vae warm-up` an image runs at its build (docs/DEPLOYMENT.md); tests/service/test_startup.py
+    watches a first start compile, in a cache of its own."""
+    if hasattr(config, "workerinput") or not compiled_kernels()[1]:  # an xdist worker, or compiled already
+        return
+    config.stash[_KERNELS] = subprocess.Popen(
+        [sys.executable, "-m", "curve_vae.cli", "warm-up"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    warming = config.stash.get(_KERNELS, None)
+    if warming is not None and warming.poll() is None:  # a short run: what is compiled by now stays cached
+        warming.terminate()
+        warming.wait()
+
+
+_KERNELS = pytest.StashKey[subprocess.Popen]()
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
