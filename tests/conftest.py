@@ -51,6 +51,10 @@ def blas_threads_restored() -> Iterator[None]:
         yield
 
 
+#: The background compile of the reading's kernels a fresh checkout starts (pytest_configure), stopped at the end.
+_KERNELS = pytest.StashKey[subprocess.Popen]()
+
+
 def pytest_configure(config: pytest.Config) -> None:
     """A checkout without the reading's compiled kernels (a fresh clone) compiles them once, in the background, while
     the workers collect: otherwise each process that reads a curve before the cache holds them compiles them again
@@ -69,9 +73,6 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     if warming is not None and warming.poll() is None:  # a short run: what is compiled by now stays cached
         warming.terminate()
         warming.wait()
-
-
-_KERNELS = pytest.StashKey[subprocess.Popen]()
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
