@@ -30,7 +30,7 @@ from curve_vae.service.live import LiveServer
 from curve_vae.service.settings import Settings
 from tests.helpers import FIXTURES, SHIPPED, bspline_curves, shipped_live_server, spawn_server, wait_ready
 
-# The suite starts a few hundred Python processes (xdist's workers, servers, the command line, training runs) that
+# The suite starts many Python processes (xdist's workers, servers, the command line, training runs) that
 # import the same modules: where the environment says PYTHONDONTWRITEBYTECODE (containers often do, these machines
 # among them), each would compile the project's sources again, and each worker would rewrite every test module's
 # asserts again (the collection alone 15.2 s -> 8.7 s a process with the caches). They are written to __pycache__/,

@@ -2,8 +2,8 @@
 client (no browser download; `apt-get install chromium-headless-shell`, done by .ci/run).
 
 The headless shell is Chromium's engine without the browser around it, the build Playwright itself runs headless
-tests in. It opens a page in a sixth of the CPU the full browser's `--headless=new` takes (0.25 against 1.4 CPU-s
-for a new context loading the page, here; a stroke costs the same): the page's ~60 tests each open one. Where only
+tests in. It opens a page in a fifth of the CPU the full browser's `--headless=new` takes (0.25 against 1.2-1.5
+CPU-s for a new context loading the page, here; a stroke costs the same): the page's ~60 tests each open one. Where only
 Debian's `chromium` is installed, that runs them, headless.
 """
 
