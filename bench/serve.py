@@ -10,7 +10,8 @@ reads the server's CPU time from /proc (all its processes), so the server's cost
 The headline rows A and B are the request a user sends: no pose or spacing fields, the paper's curves as a caller
 posts them (turned, mirrored or reversed, in pixels, spaced by arc length); beside them the fast path (pose "as_is",
 spacing "parameter") and, one connection at a time, the search. wrk posts one body again and again, so those
-servers run without the encoding cache (every request read afresh); B_cached shows what a re-posted curve costs.
+servers run without the encoding cache (every request read afresh); B_cached, against a server of its own with the
+cache on, shows what a re-posted curve costs.
 The report is a Markdown section (`bench.report`; printed, and written with --markdown FILE) and JSON (--json FILE).
 """
 
@@ -44,6 +45,7 @@ LUA = Path(__file__).resolve().parent / "post.lua"
 RUNS = (
     "A",
     "B",
+    "B_cached",
     "one_pass",
     "B_npy",
     "latency",
@@ -282,7 +284,7 @@ def _default_server_runs(
             report["augment"] = augment(server, ceiling.posted(8, seed=4), augment_count)
     finally:
         server.stop()
-    if "B" in runs:
+    if "B_cached" in runs:
         cached = Server(model_dir)
         try:
             load("B_cached", cached, "/reconstruct", json_body(one))

@@ -29,12 +29,11 @@ AIRFOIL_WHEEL = Path("data/aerosandbox-4.2.10-py3-none-any.whl")
 @cache
 def paper_test_split() -> np.ndarray:
     """The paper's 1,000 test curves: the test split of the default data set (seed 0), generated once a process
-    (about 2 s; read-only, shared by the family suite, the morph suite and the figures)."""
+    (under a second; read-only, shared by the family suite, the morph suite and the figures)."""
     from curve_vae.training.data import DataConfig, generate_curves
 
     cfg = DataConfig()
-    every = generate_curves(cfg.n_train + cfg.n_val + cfg.n_test, cfg.seed, n_points=cfg.n_points)[0]
-    split = every[-cfg.n_test :].copy()
+    split = generate_curves(cfg.n_test, cfg.seed, n_points=cfg.n_points, skip=cfg.n_train + cfg.n_val)[0]
     split.flags.writeable = False
     return split
 

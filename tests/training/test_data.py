@@ -51,6 +51,15 @@ def test_deterministic_and_prefix_stable():
     assert not np.allclose(a, d)
 
 
+@pytest.mark.parametrize("skip", [0, 37, 300, 419])
+def test_skipped_curves_are_drawn_but_not_kept(skip):
+    # in chunks of 64 (about 45 curves kept a chunk), the kept range starts and ends inside chunks and across them
+    every, every_ctrl = generate_curves(500, seed=4, chunk=64)
+    tail, tail_ctrl = generate_curves(81, seed=4, chunk=64, skip=skip)
+    np.testing.assert_array_equal(tail, every[skip : skip + 81])
+    np.testing.assert_array_equal(tail_ctrl, every_ctrl[skip : skip + 81])
+
+
 def test_splits_are_disjoint(small):
     flat = {c.tobytes() for c in np.concatenate([small.train, small.val, small.test])}
     assert len(flat) == 390
