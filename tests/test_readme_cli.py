@@ -8,7 +8,6 @@ import json
 import re
 import shlex
 import shutil
-import sys
 import warnings
 from pathlib import Path
 
