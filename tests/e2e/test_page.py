@@ -189,7 +189,7 @@ def test_errors_appear_next_to_their_cause(browser, server_factory, model_dir):
     api = server_factory("--model-dir", str(model_dir), "--providers", "cpu", "--max-curves", "1")
     api.wait_ready()
     page, errors = open_page(browser, api.url + "/")
-    draw(page, [(100, 100), (112, 100)])  # a dab of three points, not a stroke (a click of one or two selects)
+    draw(page, [(100, 100), (106, 100), (112, 100)])  # a dab of three points, not a stroke (one or two: a click)
     assert "Too short" in page.locator("#board-error").inner_text()
     page.click("#sample")  # two curves, but this server takes one per request
     page.wait_for_function("document.getElementById('board-error').textContent.includes('at most 1')")
