@@ -44,6 +44,9 @@ sys.dont_write_bytecode = False
 # tests/curve_vae/commands/test_train.py on two workers: 179 CPU-s and 109 s against 230 and 134). What the tests
 # check does not depend on how an idle thread waits; the command line's and the servers' processes inherit it.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# numpy's OpenBLAS threads likewise spin 2^28 cycles after each call before they sleep; 2^4 here (the data, mixes,
+# fitting and suite tests on two workers: 68-69 CPU-s and 37-39 s against 77 and 43, two runs each).
+os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
 #: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
 SERVER_FIXTURES = {"server_factory", "shipped_server", "live_server"}
