@@ -45,7 +45,7 @@ sys.dont_write_bytecode = False
 # check does not depend on how an idle thread waits; the command line's and the servers' processes inherit it.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 # numpy's OpenBLAS threads likewise spin 2^28 cycles after each call before they sleep; 2^4 here (the data, mixes,
-# fitting and suite tests on two workers: 68-69 CPU-s and 37-39 s against 77 and 43, two runs each).
+# fitting and suite tests on two workers: 68-73 CPU-s and 37-41 s against 77 and 43, over five runs and two).
 os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
 #: Fixtures that start a server in a subprocess: a test that uses one is marked "integration".
